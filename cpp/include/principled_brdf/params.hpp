@@ -1,0 +1,63 @@
+// The 11 parameters of SPEC §2: names, defaults, domains.
+// Shared by the reference, the batch layer and (through the bindings) Python,
+// so the table exists exactly once.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <limits>
+
+namespace principled_brdf {
+
+// Index of each parameter in a packed parameter row. base_color takes three
+// slots (linear R, G, B); every other parameter takes one.
+enum Param : int {
+    kBaseColorR = 0,
+    kBaseColorG,
+    kBaseColorB,
+    kMetallic,
+    kSubsurface,
+    kSpecular,
+    kSpecularTint,
+    kRoughness,
+    kAnisotropic,
+    kSheen,
+    kSheenTint,
+    kClearcoat,
+    kClearcoatGloss,
+    kParamSlots  // 13
+};
+
+struct ParamInfo {
+    const char* name;
+    int first_slot;
+    int slots;  // 3 for base_color, else 1
+    double default_value[3];
+    double lower;
+    double upper;  // +inf where SPEC §2 gives no upper bound
+};
+
+inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+
+// Defaults are the BRDF Explorer's (seed 002, disney.brdf header).
+inline constexpr std::array<ParamInfo, 11> kParams{{
+    {"base_color", kBaseColorR, 3, {0.82, 0.67, 0.16}, 0.0, kUnbounded},
+    {"metallic", kMetallic, 1, {0.0}, 0.0, 1.0},
+    {"subsurface", kSubsurface, 1, {0.0}, 0.0, 1.0},
+    {"specular", kSpecular, 1, {0.5}, 0.0, kUnbounded},
+    {"specular_tint", kSpecularTint, 1, {0.0}, 0.0, 1.0},
+    {"roughness", kRoughness, 1, {0.5}, 0.0, kUnbounded},
+    {"anisotropic", kAnisotropic, 1, {0.0}, 0.0, 1.0},
+    {"sheen", kSheen, 1, {0.0}, 0.0, kUnbounded},
+    {"sheen_tint", kSheenTint, 1, {0.5}, 0.0, 1.0},
+    {"clearcoat", kClearcoat, 1, {0.0}, 0.0, kUnbounded},
+    {"clearcoat_gloss", kClearcoatGloss, 1, {1.0}, 0.0, 1.0},
+}};
+
+// Which specular masking term the model uses (SPEC §3).
+enum class Model : int {
+    kDisney2014 = 0,  // anisotropic Smith GGX with the material's alpha_x, alpha_y
+    kDisney2012 = 1,  // isotropic Smith GGX with alpha_g = (0.5 + roughness / 2)^2
+};
+
+}  // namespace principled_brdf

@@ -1,0 +1,141 @@
+"""The material: the 11 parameters of SPEC §2, each uniform or per element."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+from ._validate import as_real_array, broadcast_leading, require_in_domain
+
+
+class _ParamInfo:
+    __slots__ = ("name", "first_slot", "slots", "default", "lower", "upper")
+
+    def __init__(self, name, first_slot, slots, default, lower, upper):
+        self.name, self.first_slot, self.slots = name, first_slot, slots
+        self.default = default[0] if slots == 1 else tuple(default)
+        self.lower, self.upper = lower, upper
+
+
+# Names, defaults and domains come from the C++ table (params.hpp), defined once.
+PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
+
+
+class Material:
+    """Disney principled BRDF parameters (SPEC §2).
+
+    Each parameter is a number or an array broadcastable to the directions'
+    leading shape; ``base_color`` is linear RGB, shape ``(3,)`` or ``(..., 3)``.
+    Values are checked on construction: out of domain, NaN or infinite values
+    raise ``ValueError`` naming the parameter and the first bad element.
+    """
+
+    __slots__ = tuple(PARAMETERS)
+
+    def __init__(
+        self,
+        base_color=PARAMETERS["base_color"].default,
+        metallic=PARAMETERS["metallic"].default,
+        subsurface=PARAMETERS["subsurface"].default,
+        specular=PARAMETERS["specular"].default,
+        specular_tint=PARAMETERS["specular_tint"].default,
+        roughness=PARAMETERS["roughness"].default,
+        anisotropic=PARAMETERS["anisotropic"].default,
+        sheen=PARAMETERS["sheen"].default,
+        sheen_tint=PARAMETERS["sheen_tint"].default,
+        clearcoat=PARAMETERS["clearcoat"].default,
+        clearcoat_gloss=PARAMETERS["clearcoat_gloss"].default,
+    ):
+        values = dict(locals())
+        for name, info in PARAMETERS.items():
+            array = as_real_array(name, values[name])
+            if info.slots == 3 and (array.ndim == 0 or array.shape[-1] != 3):
+                raise ValueError(f"{name}: expected an RGB triple, shape (3,) or (..., 3), got shape {array.shape}")
+            require_in_domain(name, array, info.lower, info.upper)
+            array = array.copy()  # a Material never aliases the caller's buffers
+            array.flags.writeable = False
+            object.__setattr__(self, name, array)
+        self.shape  # raises now if the parameters' shapes do not broadcast
+
+    def __setattr__(self, name, value):
+        raise AttributeError("Material is immutable; build a new one (or use Material.replace)")
+
+    @property
+    def shape(self) -> tuple:
+        """Leading shape the per-element parameters broadcast to (``()`` if all uniform)."""
+        return broadcast_leading(**{name: self._leading_shape(name) for name in PARAMETERS})
+
+    @property
+    def is_uniform(self) -> bool:
+        return self.shape == ()
+
+    def _leading_shape(self, name: str) -> tuple:
+        array = getattr(self, name)
+        return array.shape[:-1] if PARAMETERS[name].slots == 3 else array.shape
+
+    def replace(self, **changes) -> "Material":
+        """A copy with some parameters changed."""
+        unknown = set(changes) - set(PARAMETERS)
+        if unknown:
+            raise TypeError(f"unknown parameter(s): {', '.join(sorted(unknown))}")
+        return Material(**{**self.as_dict(), **changes})
+
+    def as_dict(self) -> dict:
+        return {name: getattr(self, name) for name in PARAMETERS}
+
+    @staticmethod
+    def mix(a: "Material", b: "Material", t) -> "Material":
+        """Every parameter linearly interpolated, ``a + (b - a) t`` (seed 000 §5.7).
+
+        ``t`` is a number or a per-element mask in [0, 1], broadcast against the
+        materials' leading shapes (it applies to all three channels of base_color).
+        """
+        for name, material in (("a", a), ("b", b)):
+            if not isinstance(material, Material):
+                raise TypeError(f"{name}: expected a Material, got {type(material).__name__}")
+        weight = as_real_array("t", t)
+        require_in_domain("t", weight, 0.0, 1.0)
+        mixed = {}
+        for name, info in PARAMETERS.items():
+            start, end = getattr(a, name), getattr(b, name)
+            w = weight[..., None] if info.slots == 3 else weight
+            mixed[name] = start + (end - start) * w
+        return Material(**mixed)
+
+    def packed(self, leading_shape: tuple) -> np.ndarray:
+        """All parameters broadcast to ``leading_shape`` as contiguous ``(N, 13)`` float64 rows."""
+        n = int(np.prod(leading_shape, dtype=np.int64))
+        rows = np.empty((n, _core.PARAM_SLOTS), dtype=np.float64)
+        for name, info in PARAMETERS.items():
+            array = getattr(self, name)
+            if info.slots == 3:
+                rows[:, info.first_slot : info.first_slot + 3] = np.broadcast_to(array, leading_shape + (3,)).reshape(n, 3)
+            else:
+                rows[:, info.first_slot] = np.broadcast_to(array, leading_shape).reshape(n)
+        return rows
+
+    def __eq__(self, other):
+        if not isinstance(other, Material):
+            return NotImplemented
+        return all(np.array_equal(getattr(self, n), getattr(other, n)) for n in PARAMETERS)
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        parts = []
+        for name, info in PARAMETERS.items():
+            array = getattr(self, name)
+            if array.ndim == 0:
+                parts.append(f"{name}={float(array):g}")
+            elif info.slots == 3 and array.shape == (3,):
+                parts.append(f"{name}=({', '.join(f'{v:g}' for v in array)})")
+            else:
+                parts.append(f"{name}=<{array.shape} in [{array.min():g}, {array.max():g}]>")
+        return "Material(" + ", ".join(parts) + ")"
+
+
+def gamma22_to_linear(color):
+    """Display (gamma 2.2) colour to linear RGB, the BRDF Explorer's ``mon2lin``: ``c ** 2.2``."""
+    array = as_real_array("color", color)
+    require_in_domain("color", array, 0.0, np.inf)
+    return np.power(array, 2.2)

@@ -1,0 +1,1 @@
+"""Microfacet toolkit (SPEC §4)."""

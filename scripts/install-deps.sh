@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs what building and testing principled-brdf needs, skipping what is
+# already there: Debian's C++ packages and compiler, then the Python build and
+# test packages. Safe to run again.
+set -euo pipefail
+
+debian_packages=(g++ make libxsimd-dev libeigen3-dev libbenchmark-dev)
+missing=()
+for package in "${debian_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+done
+if ((${#missing[@]})); then
+  echo "installing Debian packages: ${missing[*]}"
+  sudo_cmd=()
+  [[ $(id -u) -eq 0 ]] || sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+python=${PYTHON:-python3}
+# Build requirements (the package is built without isolation so repeated
+# builds reuse them) and the test/plot extras' packages.
+"$python" -m pip install -q --disable-pip-version-check \
+  "scikit-build-core>=0.10" "pybind11>=3" "cmake>=3.18" ninja numpy \
+  "pytest>=7" "hypothesis>=6" "scipy>=1.9" "matplotlib>=3.6" 2>&1 | grep -v "Running pip as the 'root' user" || true
