@@ -8,4 +8,5 @@ PYBIND11_MODULE(_core, m) {
     principled_brdf::bindings::bind_params(m);
     principled_brdf::bindings::bind_reference(m);
     principled_brdf::bindings::bind_microfacet(m);
+    principled_brdf::bindings::bind_batch(m);
 }

@@ -30,7 +30,7 @@ class Material:
     raise ``ValueError`` naming the parameter and the first bad element.
     """
 
-    __slots__ = tuple(PARAMETERS)
+    __slots__ = tuple(PARAMETERS) + ("_float32_cache",)
 
     def __init__(
         self,
@@ -55,6 +55,7 @@ class Material:
             array = array.copy()  # a Material never aliases the caller's buffers
             array.flags.writeable = False
             object.__setattr__(self, name, array)
+        object.__setattr__(self, "_float32_cache", {})
         self.shape  # raises now if the parameters' shapes do not broadcast
 
     def __setattr__(self, name, value):
@@ -95,6 +96,7 @@ class Material:
                 raise TypeError(f"{name}: expected a Material, got {type(material).__name__}")
         weight = as_real_array("t", t)
         require_in_domain("t", weight, 0.0, 1.0)
+        broadcast_leading(a=a.shape, b=b.shape, t=weight.shape)  # else numpy's message names no argument
         mixed = {}
         for name, info in PARAMETERS.items():
             start, end = getattr(a, name), getattr(b, name)
@@ -113,6 +115,20 @@ class Material:
             else:
                 rows[:, info.first_slot] = np.broadcast_to(array, leading_shape).reshape(n)
         return rows
+
+    def _float32(self, name: str, leading_shape: tuple) -> np.ndarray:
+        """A per-element parameter broadcast to ``leading_shape`` as contiguous float32 (cached)."""
+        key = (name, leading_shape)
+        cached = self._float32_cache.get(key)
+        if cached is None:
+            array = getattr(self, name)
+            target = leading_shape + (3,) if PARAMETERS[name].slots == 3 else leading_shape
+            cached = np.ascontiguousarray(np.broadcast_to(array, target), dtype=np.float32)
+            cached.flags.writeable = False
+            if len(self._float32_cache) > 32:
+                self._float32_cache.clear()
+            self._float32_cache[key] = cached
+        return cached
 
     def __eq__(self, other):
         if not isinstance(other, Material):

@@ -1,0 +1,121 @@
+// Bindings for the batched SIMD path. The Python side (principled_brdf/_batch.py)
+// validates, converts and allocates; these functions re-check sizes so that no
+// call can read or write out of bounds, then release the GIL around the work.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "bindings.hpp"
+#include "principled_brdf/batch.hpp"
+
+namespace py = pybind11;
+
+namespace principled_brdf::bindings {
+namespace {
+
+using Float32Array = py::array_t<float, py::array::c_style>;
+
+// A (N, 3), (3, N) or (3,) float32 array as a Vec3Array of n elements.
+Vec3Array vec3_view(const Float32Array& a, int layout, std::int64_t n, const char* name) {
+    const auto kind = static_cast<Vec3Layout>(layout);
+    const bool ok = (kind == Vec3Layout::kInterleaved && a.ndim() == 2 && a.shape(0) == n && a.shape(1) == 3) ||
+                    (kind == Vec3Layout::kRows && a.ndim() == 2 && a.shape(0) == 3 && a.shape(1) == n) ||
+                    (kind == Vec3Layout::kSingle && a.ndim() == 1 && a.shape(0) == 3);
+    if (!ok) throw std::invalid_argument(std::string(name) + ": array shape does not match its layout and length");
+    return {a.data(), kind, kind == Vec3Layout::kRows ? n : 0};
+}
+
+MutableVec3Array output_view(Float32Array& a, int layout, std::int64_t n, const char* name) {
+    if (layout == static_cast<int>(Vec3Layout::kSingle))
+        throw std::invalid_argument(std::string(name) + ": outputs are (N, 3) or (3, N)");
+    const Vec3Array view = vec3_view(a, layout, n, name);
+    if (!a.writeable()) throw std::invalid_argument(std::string(name) + ": array is read-only");
+    return {a.mutable_data(), view.layout, view.row_stride};
+}
+
+// params: 11 entries in the order of kParams, each a number (base_color: a
+// 3-sequence) or a float32 array of n values ((n, 3) for base_color).
+void fill_params(const py::sequence& params, std::int64_t n, EvalJob& job, py::list& keep_alive) {
+    if (static_cast<std::size_t>(py::len(params)) != kParams.size())
+        throw std::invalid_argument("params: expected one entry per parameter");
+    for (std::size_t p = 0; p < kParams.size(); ++p) {
+        const ParamInfo& info = kParams[p];
+        py::object value = params[p];
+        if (py::isinstance<py::array>(value)) {
+            auto array = py::cast<Float32Array>(value);
+            keep_alive.append(array);
+            const bool ok = info.slots == 3 ? (array.ndim() == 2 && array.shape(0) == n && array.shape(1) == 3)
+                                            : (array.ndim() == 1 && array.shape(0) == n);
+            if (!ok) throw std::invalid_argument(std::string(info.name) + ": per-element array of the wrong shape");
+            for (int s = 0; s < info.slots; ++s)
+                job.params[info.first_slot + s] = ParamSlot{0.0f, array.data() + s, info.slots};
+        } else if (info.slots == 3) {
+            auto rgb = py::cast<std::vector<float>>(value);
+            if (rgb.size() != 3) throw std::invalid_argument(std::string(info.name) + ": expected 3 values");
+            for (int s = 0; s < 3; ++s) job.params[info.first_slot + s].value = rgb[s];
+        } else {
+            job.params[info.first_slot].value = py::cast<float>(value);
+        }
+    }
+}
+
+void batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                const py::sequence& params, py::list outputs, int out_layout, std::int64_t n, int model, bool lobes,
+                bool cosine, int threads, const std::string& isa) {
+    EvalJob job;
+    job.wi = vec3_view(wi, wi_layout, n, "wi");
+    job.wo = vec3_view(wo, wo_layout, n, "wo");
+    py::list keep_alive;
+    fill_params(params, n, job, keep_alive);
+    if (model != 0 && model != 1) throw std::invalid_argument("model: expected 0 (disney2014) or 1 (disney2012)");
+    job.model = static_cast<Model>(model);
+    job.output = lobes ? Output::kLobes : Output::kTotal;
+    job.cosine = cosine;
+    const int expected = lobes ? kLobeCount : 1;
+    if (py::len(outputs) != static_cast<std::size_t>(expected))
+        throw std::invalid_argument("out: expected " + std::to_string(expected) + " arrays");
+    std::vector<Float32Array> out_arrays;
+    for (int k = 0; k < expected; ++k) {
+        out_arrays.push_back(py::cast<Float32Array>(outputs[k]));
+        if (!out_arrays.back().is(outputs[k])) throw std::invalid_argument("out: expected C-contiguous float32 arrays");
+        job.out[k] = output_view(out_arrays.back(), out_layout, n, "out");
+    }
+    if (n == 0) return;
+    py::gil_scoped_release release;
+    eval(job, n, threads, isa);
+}
+
+std::int64_t check_directions(const Float32Array& w, int layout, std::int64_t n, float tolerance, int threads) {
+    const Vec3Array view = vec3_view(w, layout, n, "directions");
+    py::gil_scoped_release release;
+    return first_bad_direction(view, n, tolerance, threads);
+}
+
+py::dict cpu_info() {
+    py::dict info;
+    const std::string isa = active_isa();
+    info["isa"] = isa;
+    info["float_lanes"] = float_lanes(isa);
+    info["available"] = available_isas();
+    info["threads"] = hardware_threads();
+    return info;
+}
+
+}  // namespace
+
+void bind_batch(py::module_& m) {
+    m.def("batch_eval", &batch_eval, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
+          py::arg("params"), py::arg("outputs"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
+          py::arg("lobes"), py::arg("cosine"), py::arg("threads"), py::arg("isa"),
+          "SIMD evaluation into preallocated float32 outputs (validated by the caller).");
+    m.def("check_directions", &check_directions, py::arg("w"), py::arg("layout"), py::arg("n"),
+          py::arg("tolerance"), py::arg("threads"),
+          "Index of the first non-finite or non-unit direction, or -1.");
+    m.def("cpu_info", &cpu_info, "Instruction set in use, the available ones, SIMD width, hardware threads.");
+    m.def("float_lanes", &float_lanes, py::arg("isa"));
+}
+
+}  // namespace principled_brdf::bindings

@@ -1,0 +1,25 @@
+// The per-instruction-set kernel entry points, as seen from baseline code.
+// No xsimd here: this header is included by baseline and per-arch code alike.
+#pragma once
+
+#include <cstdint>
+
+#include "principled_brdf/batch.hpp"
+
+namespace principled_brdf::kernel {
+
+struct KernelTable {
+    const char* isa;  // "sse2", "avx2", "avx512", "neon"
+    int float_lanes;
+    // Evaluates elements [begin, end) of job.
+    void (*eval_range)(const EvalJob& job, std::int64_t begin, std::int64_t end);
+};
+
+// Defined in kernel_<isa>.cpp, each compiled with its own flags; call one
+// only after the CPU was found to support it (dispatch.cpp).
+const KernelTable& sse2_kernels();
+const KernelTable& avx2_kernels();
+const KernelTable& avx512_kernels();
+const KernelTable& neon_kernels();
+
+}  // namespace principled_brdf::kernel

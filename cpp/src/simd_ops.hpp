@@ -1,0 +1,214 @@
+// Per-instruction-set building blocks of the kernel: fast reciprocal and
+// reciprocal square root refined to float precision, and the (N, 3)
+// interleaved <-> structure-of-arrays transposes done in registers.
+//
+// Included by kernel.hpp inside the per-arch namespace, after `Floats` is
+// defined; the intrinsic paths are chosen by the flags of the including file.
+#pragma once  // (per translation unit: each kernel_<isa>.cpp includes it once)
+
+// An element's three components sit at flat indices 3 j + k of the interleaved
+// array. For a register of L lanes (L = 8 or 16, both coprime with 3), lane l
+// of the r-th register of a group of three holds flat index L r + l. Loading:
+// blend the three registers so that lane l takes register r with
+// (L r + l) % 3 == k, then permute lane l's element j = (L r + l) / 3 to lane j.
+// Storing inverts both steps.
+template <int L>
+struct Interleave3 {
+    static constexpr int source_register(int k, int lane) {
+        for (int r = 0; r < 3; ++r)
+            if ((L * r + lane) % 3 == k) return r;
+        return -1;
+    }
+    // lane that holds element j of component k after the blend
+    static constexpr int lane_of_element(int k, int j) {
+        for (int lane = 0; lane < L; ++lane)
+            if ((L * source_register(k, lane) + lane) / 3 == j) return lane;
+        return -1;
+    }
+    // element of component k that lands in `lane` when writing register r
+    static constexpr int element_at_lane(int k, int lane) {
+        for (int j = 0; j < L; ++j)
+            if ((3 * j + k) % L == lane) return j;
+        return -1;
+    }
+};
+
+#if defined(__AVX512F__)
+
+inline Floats reciprocal(Floats x) {
+    const __m512 estimate = _mm512_rcp14_ps(x);  // relative error < 2^-14
+    // One Newton-Raphson step: y (2 - x y)
+    return _mm512_mul_ps(estimate, _mm512_fnmadd_ps(x, estimate, _mm512_set1_ps(2.0f)));
+}
+
+inline Floats reciprocal_sqrt(Floats x) {
+    const __m512 estimate = _mm512_rsqrt14_ps(x);
+    // y (1.5 - 0.5 x y²)
+    const __m512 half_x_y2 = _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(0.5f), x), _mm512_mul_ps(estimate, estimate));
+    return _mm512_mul_ps(estimate, _mm512_sub_ps(_mm512_set1_ps(1.5f), half_x_y2));
+}
+
+template <int k>
+inline __m512i interleave_load_permutation() {
+    alignas(64) int indices[16];
+    for (int j = 0; j < 16; ++j) indices[j] = Interleave3<16>::lane_of_element(k, j);
+    return _mm512_load_si512(indices);
+}
+
+template <int k>
+inline __m512i interleave_store_permutation() {
+    alignas(64) int indices[16];
+    for (int lane = 0; lane < 16; ++lane) indices[lane] = Interleave3<16>::element_at_lane(k, lane);
+    return _mm512_load_si512(indices);
+}
+
+template <int k, int r>
+constexpr __mmask16 lanes_from_register() {
+    unsigned mask = 0;
+    for (int lane = 0; lane < 16; ++lane)
+        if (Interleave3<16>::source_register(k, lane) == r) mask |= 1u << lane;
+    return static_cast<__mmask16>(mask);
+}
+
+template <int k>
+inline Floats gather_component(__m512 a, __m512 b, __m512 c) {
+    __m512 blended = _mm512_mask_blend_ps(lanes_from_register<k, 1>(), a, b);
+    blended = _mm512_mask_blend_ps(lanes_from_register<k, 2>(), blended, c);
+    return _mm512_permutexvar_ps(interleave_load_permutation<k>(), blended);
+}
+
+inline void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
+    const __m512 a = _mm512_loadu_ps(p), b = _mm512_loadu_ps(p + 16), c = _mm512_loadu_ps(p + 32);
+    x = gather_component<0>(a, b, c);
+    y = gather_component<1>(a, b, c);
+    z = gather_component<2>(a, b, c);
+}
+
+template <int r>
+inline __m512 scatter_register(__m512 px, __m512 py, __m512 pz) {
+    // lane l of register r holds component (16 r + l) % 3
+    constexpr __mmask16 from_y = [] {
+        unsigned mask = 0;
+        for (int lane = 0; lane < 16; ++lane)
+            if ((16 * r + lane) % 3 == 1) mask |= 1u << lane;
+        return static_cast<__mmask16>(mask);
+    }();
+    constexpr __mmask16 from_z = [] {
+        unsigned mask = 0;
+        for (int lane = 0; lane < 16; ++lane)
+            if ((16 * r + lane) % 3 == 2) mask |= 1u << lane;
+        return static_cast<__mmask16>(mask);
+    }();
+    return _mm512_mask_blend_ps(from_z, _mm512_mask_blend_ps(from_y, px, py), pz);
+}
+
+inline void store_interleaved(float* p, Floats x, Floats y, Floats z) {
+    const __m512 px = _mm512_permutexvar_ps(interleave_store_permutation<0>(), x);
+    const __m512 py = _mm512_permutexvar_ps(interleave_store_permutation<1>(), y);
+    const __m512 pz = _mm512_permutexvar_ps(interleave_store_permutation<2>(), z);
+    _mm512_storeu_ps(p, scatter_register<0>(px, py, pz));
+    _mm512_storeu_ps(p + 16, scatter_register<1>(px, py, pz));
+    _mm512_storeu_ps(p + 32, scatter_register<2>(px, py, pz));
+}
+
+#elif defined(__AVX2__)
+
+inline Floats reciprocal(Floats x) {
+    const __m256 estimate = _mm256_rcp_ps(x);  // relative error < 1.5 * 2^-12
+    return _mm256_mul_ps(estimate, _mm256_fnmadd_ps(x, estimate, _mm256_set1_ps(2.0f)));
+}
+
+inline Floats reciprocal_sqrt(Floats x) {
+    const __m256 estimate = _mm256_rsqrt_ps(x);
+    const __m256 half_x_y2 = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), x), _mm256_mul_ps(estimate, estimate));
+    return _mm256_mul_ps(estimate, _mm256_sub_ps(_mm256_set1_ps(1.5f), half_x_y2));
+}
+
+template <int k>
+inline __m256i interleave_load_permutation() {
+    alignas(32) int indices[8];
+    for (int j = 0; j < 8; ++j) indices[j] = Interleave3<8>::lane_of_element(k, j);
+    return _mm256_load_si256(reinterpret_cast<const __m256i*>(indices));
+}
+
+template <int k>
+inline __m256i interleave_store_permutation() {
+    alignas(32) int indices[8];
+    for (int lane = 0; lane < 8; ++lane) indices[lane] = Interleave3<8>::element_at_lane(k, lane);
+    return _mm256_load_si256(reinterpret_cast<const __m256i*>(indices));
+}
+
+template <int k, int r>
+constexpr int lanes_from_register() {
+    int mask = 0;
+    for (int lane = 0; lane < 8; ++lane)
+        if (Interleave3<8>::source_register(k, lane) == r) mask |= 1 << lane;
+    return mask;
+}
+
+template <int k>
+inline Floats gather_component(__m256 a, __m256 b, __m256 c) {
+    __m256 blended = _mm256_blend_ps(a, b, lanes_from_register<k, 1>());
+    blended = _mm256_blend_ps(blended, c, lanes_from_register<k, 2>());
+    return _mm256_permutevar8x32_ps(blended, interleave_load_permutation<k>());
+}
+
+inline void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
+    const __m256 a = _mm256_loadu_ps(p), b = _mm256_loadu_ps(p + 8), c = _mm256_loadu_ps(p + 16);
+    x = gather_component<0>(a, b, c);
+    y = gather_component<1>(a, b, c);
+    z = gather_component<2>(a, b, c);
+}
+
+template <int r, int k>
+constexpr int lanes_of_component() {
+    int mask = 0;
+    for (int lane = 0; lane < 8; ++lane)
+        if ((8 * r + lane) % 3 == k) mask |= 1 << lane;
+    return mask;
+}
+
+template <int r>
+inline __m256 scatter_register(__m256 px, __m256 py, __m256 pz) {
+    return _mm256_blend_ps(_mm256_blend_ps(px, py, lanes_of_component<r, 1>()), pz, lanes_of_component<r, 2>());
+}
+
+inline void store_interleaved(float* p, Floats x, Floats y, Floats z) {
+    const __m256 px = _mm256_permutevar8x32_ps(x, interleave_store_permutation<0>());
+    const __m256 py = _mm256_permutevar8x32_ps(y, interleave_store_permutation<1>());
+    const __m256 pz = _mm256_permutevar8x32_ps(z, interleave_store_permutation<2>());
+    _mm256_storeu_ps(p, scatter_register<0>(px, py, pz));
+    _mm256_storeu_ps(p + 8, scatter_register<1>(px, py, pz));
+    _mm256_storeu_ps(p + 16, scatter_register<2>(px, py, pz));
+}
+
+#else  // SSE2, NEON: exact division and square root, transposes through memory
+
+inline Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
+inline Floats reciprocal_sqrt(Floats x) { return Floats(1.0f) / xsimd::sqrt(x); }
+
+inline void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
+    alignas(64) float xs[Floats::size], ys[Floats::size], zs[Floats::size];
+    for (std::size_t j = 0; j < Floats::size; ++j) {
+        xs[j] = p[3 * j];
+        ys[j] = p[3 * j + 1];
+        zs[j] = p[3 * j + 2];
+    }
+    x = Floats::load_aligned(xs);
+    y = Floats::load_aligned(ys);
+    z = Floats::load_aligned(zs);
+}
+
+inline void store_interleaved(float* p, Floats x, Floats y, Floats z) {
+    alignas(64) float xs[Floats::size], ys[Floats::size], zs[Floats::size];
+    x.store_aligned(xs);
+    y.store_aligned(ys);
+    z.store_aligned(zs);
+    for (std::size_t j = 0; j < Floats::size; ++j) {
+        p[3 * j] = xs[j];
+        p[3 * j + 1] = ys[j];
+        p[3 * j + 2] = zs[j];
+    }
+}
+
+#endif

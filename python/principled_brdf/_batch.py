@@ -1,0 +1,189 @@
+"""The batched float32 SIMD path: pb.eval, pb.eval_lobes, pb.cpu_info.
+
+Input handling, once per call:
+
+* directions are ``(..., 3)`` (``layout="aos"``, the default) or ``(3, ...)``
+  (``layout="soa"``); a float32 C-contiguous array is read in place, anything
+  else (other dtypes, strides) is converted once to a float32 copy;
+* a direction whose leading shape is ``()`` is one vector for every element
+  (read once, never copied); other broadcasts are materialised;
+* uniform material parameters are passed as numbers (no per-element loads);
+  per-element ones as float32 arrays, cached on the Material.
+"""
+
+from __future__ import annotations
+
+import operator
+
+import numpy as np
+
+from . import _core
+from ._validate import DIRECTION_LENGTH_TOLERANCE, as_real_array, broadcast_leading, element_name, model_index
+from .material import PARAMETERS, Material
+from .reference import Lobes
+
+__all__ = ["eval", "eval_lobes", "cpu_info"]
+
+_INTERLEAVED, _ROWS, _SINGLE = 0, 1, 2
+_LAYOUTS = ("aos", "soa")
+
+
+def cpu_info() -> dict:
+    """The instruction set in use (``PRINCIPLED_BRDF_ISA`` forces one), the
+    available ones, SIMD width in floats and hardware threads."""
+    return dict(_core.cpu_info())
+
+
+def _layout(layout) -> str:
+    if layout not in _LAYOUTS:
+        raise ValueError(f"layout: expected 'aos' for (..., 3) or 'soa' for (3, ...), got {layout!r}")
+    return layout
+
+
+def _threads(threads) -> int:
+    if threads is None:
+        return 0
+    try:
+        count = operator.index(threads)
+    except TypeError:
+        raise TypeError(f"threads: expected an integer, got {type(threads).__name__}") from None
+    if count < 1:
+        raise ValueError(f"threads: expected at least 1, got {count}")
+    return count
+
+
+def _isa(isa) -> str:
+    if isa is None:
+        return ""
+    available = _core.cpu_info()["available"]
+    if isa not in available:
+        raise ValueError(f"isa: {isa!r} is not available here (available: {', '.join(available)})")
+    return isa
+
+
+class _Directions:
+    """A direction argument as float32, with its leading shape and layout."""
+
+    def __init__(self, name: str, value, layout: str):
+        self.name = name
+        if isinstance(value, np.ndarray) and value.dtype == np.float32:
+            array = value
+        else:
+            array = as_real_array(name, value).astype(np.float32)
+        if layout == "aos":
+            if array.ndim == 0 or array.shape[-1] != 3:
+                raise ValueError(f"{name}: expected shape (..., 3) with layout='aos', got {array.shape}")
+            self.leading = array.shape[:-1]
+        else:
+            if array.ndim == 0 or array.shape[0] != 3:
+                raise ValueError(f"{name}: expected shape (3, ...) with layout='soa', got {array.shape}")
+            self.leading = array.shape[1:]
+        self.layout = layout
+        self.array = np.ascontiguousarray(array)  # no copy when already C-contiguous
+
+    def flat(self, leading: tuple):
+        """(array, layout code) with ``leading`` elements; broadcasts if needed."""
+        array = self.array
+        if self.leading == ():
+            return array.reshape(3), _SINGLE
+        if self.leading != leading:
+            target = leading + (3,) if self.layout == "aos" else (3,) + leading
+            array = np.ascontiguousarray(np.broadcast_to(array, target))
+        n = int(np.prod(leading, dtype=np.int64))
+        return (array.reshape(n, 3), _INTERLEAVED) if self.layout == "aos" else (array.reshape(3, n), _ROWS)
+
+    def check(self, threads: int) -> None:
+        """SPEC §7: every direction finite and of unit length within tolerance."""
+        flat, code = self.flat(self.leading)
+        n = 1 if code == _SINGLE else int(np.prod(self.leading, dtype=np.int64))
+        bad = _core.check_directions(flat, code, n, DIRECTION_LENGTH_TOLERANCE, threads)
+        if bad < 0:
+            return
+        vector = flat[bad] if code == _INTERLEAVED else flat[:, bad] if code == _ROWS else flat
+        where = element_name(self.name, bad, self.leading)
+        if not np.all(np.isfinite(vector)):
+            raise ValueError(f"{where}: {vector.tolist()} is not a finite vector")
+        length = float(np.sqrt(np.sum(vector.astype(np.float64) ** 2)))
+        raise ValueError(f"{where}: length {length:.6g} is not 1 (within {DIRECTION_LENGTH_TOLERANCE:g})")
+
+
+def _params(material: Material, leading: tuple) -> list:
+    """One entry per parameter: a number (uniform) or a float32 per-element array."""
+    n = int(np.prod(leading, dtype=np.int64))
+    entries = []
+    for name, info in PARAMETERS.items():
+        value = getattr(material, name)
+        uniform = value.shape == (() if info.slots == 1 else (3,))
+        if uniform:
+            entries.append(tuple(float(v) for v in value) if info.slots == 3 else float(value))
+        else:
+            per_element = material._float32(name, leading)
+            entries.append(per_element.reshape((n, 3) if info.slots == 3 else (n,)))
+    return entries
+
+
+def _output(out, shape: tuple, name: str = "out") -> np.ndarray:
+    if out is None:
+        return np.empty(shape, dtype=np.float32)
+    if not isinstance(out, np.ndarray):
+        raise TypeError(f"{name}: expected a numpy array, got {type(out).__name__}")
+    if out.dtype != np.float32:
+        raise TypeError(f"{name}: expected dtype float32, got {out.dtype}")
+    if out.shape != shape:
+        raise ValueError(f"{name}: expected shape {shape}, got {out.shape}")
+    if not out.flags.c_contiguous or not out.flags.writeable:
+        raise ValueError(f"{name}: expected a writeable C-contiguous array")
+    return out
+
+
+def _run(material, wi, wo, model, cosine, layout, threads, check, isa, outputs_for_shape):
+    if not isinstance(material, Material):
+        raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
+    model_id = model_index(model)
+    layout = _layout(layout)
+    thread_count = _threads(threads)
+    isa_name = _isa(isa)
+    wi_dirs = _Directions("wi", wi, layout)
+    wo_dirs = _Directions("wo", wo, layout)
+    leading = broadcast_leading(wi=wi_dirs.leading, wo=wo_dirs.leading, material=material.shape)
+    out_shape = leading + (3,) if layout == "aos" else (3,) + leading
+    outputs = outputs_for_shape(out_shape)
+    if check:
+        wi_dirs.check(thread_count)
+        wo_dirs.check(thread_count)
+    n = int(np.prod(leading, dtype=np.int64))
+    wi_flat, wi_code = wi_dirs.flat(leading)
+    wo_flat, wo_code = wo_dirs.flat(leading)
+    out_code = _INTERLEAVED if layout == "aos" else _ROWS
+    flat_outputs = [o.reshape((n, 3) if layout == "aos" else (3, n)) for o in outputs]
+    _core.batch_eval(
+        wi_flat, wi_code, wo_flat, wo_code, _params(material, leading), flat_outputs, out_code, n,
+        model_id, len(outputs) == 4, bool(cosine), thread_count, isa_name,
+    )
+    return outputs
+
+
+def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False, layout: str = "aos",
+         threads=None, out=None, check: bool = True, isa=None) -> np.ndarray:
+    """f(wi, wo) in 1/sr as float32, by the SIMD kernel (SPEC §3).
+
+    ``wi``, ``wo``: unit directions, ``(..., 3)`` or with ``layout="soa"``
+    ``(3, ...)``; leading shapes broadcast with each other and with the
+    material's. Returns ``(..., 3)`` (``(3, ...)`` for ``"soa"``), written into
+    ``out`` if given (float32, C-contiguous, exact shape). ``cosine`` multiplies
+    by cos θl. ``threads``: default all cores; results are bit-identical for
+    every thread count. ``check=False`` skips the direction checks (then a
+    non-finite direction gives 0, a non-unit one is used as given). ``isa``
+    picks one of ``cpu_info()["available"]`` (for tests and benchmarks).
+    """
+    (f,) = _run(material, wi, wo, model, cosine, layout, threads, check, isa, lambda shape: [_output(out, shape)])
+    return f
+
+
+def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False, layout: str = "aos",
+               threads=None, check: bool = True, isa=None) -> Lobes:
+    """The four lobes (diffuse, sheen, specular, clearcoat) as a :class:`Lobes`
+    of float32 arrays, each shaped like :func:`eval`'s result."""
+    outputs = _run(material, wi, wo, model, cosine, layout, threads, check, isa,
+                   lambda shape: [np.empty(shape, dtype=np.float32) for _ in range(4)])
+    return Lobes(*outputs)
