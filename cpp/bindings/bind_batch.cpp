@@ -62,9 +62,11 @@ void fill_params(const py::sequence& params, std::int64_t n, EvalJob& job, py::l
     }
 }
 
-void batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
-                const py::sequence& params, py::list outputs, int out_layout, std::int64_t n, int model, bool lobes,
-                bool cosine, int threads, const std::string& isa) {
+// Returns -1, or with check_tolerance > 0 the index of an element whose wi or
+// wo is not a unit vector (the outputs are then partly written: pass fresh ones).
+std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                        const py::sequence& params, py::list outputs, int out_layout, std::int64_t n, int model,
+                        bool lobes, bool cosine, float check_tolerance, int threads, const std::string& isa) {
     EvalJob job;
     job.wi = vec3_view(wi, wi_layout, n, "wi");
     job.wo = vec3_view(wo, wo_layout, n, "wo");
@@ -74,6 +76,7 @@ void batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, i
     job.model = static_cast<Model>(model);
     job.output = lobes ? Output::kLobes : Output::kTotal;
     job.cosine = cosine;
+    if (check_tolerance > 0.0f) set_direction_check(job, check_tolerance);
     const int expected = lobes ? kLobeCount : 1;
     if (py::len(outputs) != static_cast<std::size_t>(expected))
         throw std::invalid_argument("out: expected " + std::to_string(expected) + " arrays");
@@ -83,9 +86,9 @@ void batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, i
         if (!out_arrays.back().is(outputs[k])) throw std::invalid_argument("out: expected C-contiguous float32 arrays");
         job.out[k] = output_view(out_arrays.back(), out_layout, n, "out");
     }
-    if (n == 0) return;
+    if (n == 0) return -1;
     py::gil_scoped_release release;
-    eval(job, n, threads, isa);
+    return eval(job, n, threads, isa);
 }
 
 std::int64_t check_directions(const Float32Array& w, int layout, std::int64_t n, float tolerance, int threads) {
@@ -109,7 +112,7 @@ py::dict cpu_info() {
 void bind_batch(py::module_& m) {
     m.def("batch_eval", &batch_eval, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
           py::arg("params"), py::arg("outputs"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
-          py::arg("lobes"), py::arg("cosine"), py::arg("threads"), py::arg("isa"),
+          py::arg("lobes"), py::arg("cosine"), py::arg("check_tolerance"), py::arg("threads"), py::arg("isa"),
           "SIMD evaluation into preallocated float32 outputs (validated by the caller).");
     m.def("check_directions", &check_directions, py::arg("w"), py::arg("layout"), py::arg("n"),
           py::arg("tolerance"), py::arg("threads"),

@@ -47,39 +47,43 @@ std::string active_isa() { return kernel::active().isa; }
 
 int float_lanes(const std::string& isa) { return kernel::by_name(isa, "isa").float_lanes; }
 
-void eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa) {
+void set_direction_check(EvalJob& job, float tolerance) {
+    // |w| within [1 - tol, 1 + tol]  <=>  |w|² within [(1 - tol)², (1 + tol)²]
+    job.check_directions = true;
+    job.length2_lowest = (1.0f - tolerance) * (1.0f - tolerance);
+    job.length2_highest = (1.0f + tolerance) * (1.0f + tolerance);
+}
+
+std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa) {
     const kernel::KernelTable& kernels = isa.empty() ? kernel::active() : kernel::by_name(isa, "isa");
     const int thread_count = resolve_threads(threads);
     const Chunks chunks = split(n, thread_count);
+    std::vector<std::int64_t> bad(chunks.count, -1);
     parallel_for(chunks.count, thread_count, [&](int c) {
         const std::int64_t begin = c * chunks.size;
-        kernels.eval_range(job, begin, std::min(n, begin + chunks.size));
+        bad[c] = kernels.eval_range(job, begin, std::min(n, begin + chunks.size));
     });
+    for (std::int64_t b : bad)
+        if (b >= 0) return b;
+    return -1;
 }
 
 std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_t n, float tolerance, int threads) {
-    // |w| within [1 - tol, 1 + tol]  <=>  |w|² within [(1 - tol)², (1 + tol)²]; NaN fails both.
-    const float lowest = (1.0f - tolerance) * (1.0f - tolerance);
-    const float highest = (1.0f + tolerance) * (1.0f + tolerance);
-    const std::int64_t count = directions.layout == Vec3Layout::kSingle ? std::min<std::int64_t>(n, 1) : n;
-    const std::int64_t stride = directions.layout == Vec3Layout::kRows ? directions.row_stride : 1;
-    const std::int64_t step = directions.layout == Vec3Layout::kRows ? 1 : 3;
-    const float* data = directions.data;
-
+    EvalJob bounds;
+    set_direction_check(bounds, tolerance);
+    const float lowest = bounds.length2_lowest, highest = bounds.length2_highest;
+    const kernel::KernelTable& kernels = kernel::active();
+    if (directions.layout == Vec3Layout::kSingle) {
+        const float* w = directions.data;
+        const float length2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+        return n > 0 && !(length2 >= lowest && length2 <= highest) ? 0 : -1;
+    }
     const int thread_count = resolve_threads(threads);
-    const Chunks chunks = split(count, thread_count);
+    const Chunks chunks = split(n, thread_count);
     std::vector<std::int64_t> first_bad(chunks.count, -1);
     parallel_for(chunks.count, thread_count, [&](int c) {
-        const std::int64_t begin = c * chunks.size, end = std::min(count, begin + chunks.size);
-        for (std::int64_t i = begin; i < end; ++i) {
-            const float* p = data + i * step;
-            const float x = p[0], y = p[stride], z = p[2 * stride];
-            const float length2 = x * x + y * y + z * z;
-            if (!(length2 >= lowest && length2 <= highest)) {
-                first_bad[c] = i;
-                return;
-            }
-        }
+        const std::int64_t begin = c * chunks.size;
+        first_bad[c] = kernels.first_bad_direction(directions, begin, std::min(n, begin + chunks.size), lowest, highest);
     });
     for (std::int64_t bad : first_bad)
         if (bad >= 0) return bad;

@@ -12,7 +12,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include <cstdint>
-#include <cstring>
+#include <limits>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -151,6 +151,7 @@ inline Floats smith_s_iso(Floats cos_theta, Floats a2) {
 struct LobeValues {
     Rgb diffuse, sheen, specular;
     Floats clearcoat;
+    Mask finite_half_vector;  // false where a direction held NaN or infinity (checks off)
 };
 
 template <Model model>
@@ -162,6 +163,8 @@ inline LobeValues eval_lobes(const Vec3& wi, const Vec3& wo, const Shading& s) {
     const Floats hx = wi.x + wo.x, hy = wi.y + wo.y, hz = wi.z + wo.z;
     const Floats hx2 = hx * hx, hy2 = hy * hy, hz2 = hz * hz;
     const Floats h_len2 = hx2 + hy2 + hz2;
+    LobeValues out;
+    out.finite_half_vector = h_len2 <= Floats(std::numeric_limits<float>::max());
     const Floats inv_h_len = reciprocal_sqrt(h_len2);
     const Floats wi_dot_h = wi.x * hx + wi.y * hy + wi.z * hz;  // |H| cos θd
     const Floats cos_theta_d = wi_dot_h * inv_h_len;
@@ -170,8 +173,6 @@ inline LobeValues eval_lobes(const Vec3& wi, const Vec3& wo, const Shading& s) {
     const Floats fl = schlick_weight(cos_theta_l);
     const Floats fv = schlick_weight(cos_theta_v);
     const Floats fh = schlick_weight(cos_theta_d);
-
-    LobeValues out;
 
     // Diffuse: Fd = mix(1, Fd90, FL) mix(1, Fd90, FV), Fd90 = 0.5 + 2 roughness cos²θd
     const Floats fd90_minus_1 = xsimd::fma(2.0f * s.roughness, cos2_theta_d, Floats(-0.5f));
@@ -235,18 +236,41 @@ inline void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb& c) {
     }
 }
 
+// ---------------------------------------------------------------- checks
+
+// SPEC §7: squared length within [lowest, highest]; a NaN fails both
+// comparisons and an infinity the second.
+inline Mask unit_length(const Vec3& w, float lowest, float highest) {
+    const Floats length2 = w.x * w.x + w.y * w.y + w.z * w.z;
+    return (length2 >= Floats(lowest)) & (length2 <= Floats(highest));
+}
+
+inline bool unit_length(const Vec3Array& a, std::int64_t i, float lowest, float highest) {
+    const float* p = a.layout == Vec3Layout::kSingle ? a.data : a.layout == Vec3Layout::kRows ? a.data + i : a.data + 3 * i;
+    const std::int64_t stride = a.layout == Vec3Layout::kRows ? a.row_stride : 1;
+    const float length2 = p[0] * p[0] + p[stride] * p[stride] + p[2 * stride] * p[2 * stride];
+    return length2 >= lowest && length2 <= highest;
+}
+
+inline std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_t begin, std::int64_t end,
+                                        float lowest, float highest) {
+    std::int64_t i = begin;
+    while (i + kLanes <= end && xsimd::all(unit_length(load_vec3(directions, i), lowest, highest))) i += kLanes;
+    for (; i < end; ++i)
+        if (!unit_length(directions, i, lowest, highest)) return i;
+    return -1;
+}
+
 // ---------------------------------------------------------------- the loop
 
 template <Model model, Output output>
-inline void eval_batch(const EvalJob& job, std::int64_t i, const Shading& s) {
-    const Vec3 wi = load_vec3(job.wi, i);
-    const Vec3 wo = load_vec3(job.wo, i);
+inline void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const Vec3& wo, const Shading& s) {
     const LobeValues lobes = eval_lobes<model>(wi, wo, s);
 
     // f = 0 unless both directions are strictly above the surface (SPEC §1);
     // select also discards whatever the formulas gave there (H may be 0).
-    const Mask above = (wi.z > Floats(0.0f)) & (wo.z > Floats(0.0f));
-    const Floats weight = xsimd::select(above, job.cosine ? wi.z : Floats(1.0f), Floats(0.0f));
+    const Mask above = (wi.z > Floats(0.0f)) & (wo.z > Floats(0.0f)) & lobes.finite_half_vector;
+    const Floats weight = job.cosine ? wi.z : Floats(1.0f);
     auto masked = [&](const Rgb& c) {
         return Rgb{xsimd::select(above, weight * c.r, Floats(0.0f)), xsimd::select(above, weight * c.g, Floats(0.0f)),
                    xsimd::select(above, weight * c.b, Floats(0.0f))};
@@ -262,28 +286,36 @@ inline void eval_batch(const EvalJob& job, std::int64_t i, const Shading& s) {
     }
 }
 
+// One batch at i; false, with nothing stored, when the fused direction check fails.
+template <Model model, Output output, bool per_element>
+inline bool process_batch(const EvalJob& job, std::int64_t i, const Shading& uniform) {
+    const Vec3 wi = load_vec3(job.wi, i);
+    const Vec3 wo = load_vec3(job.wo, i);
+    if (job.check_directions) {
+        const Mask ok = unit_length(wi, job.length2_lowest, job.length2_highest) &
+                        unit_length(wo, job.length2_lowest, job.length2_highest);
+        if (!xsimd::all(ok)) return false;
+    }
+    if constexpr (per_element) {
+        eval_batch<model, output>(job, i, wi, wo, shading_of(load_material(job, i)));
+    } else {
+        eval_batch<model, output>(job, i, wi, wo, uniform);
+    }
+    return true;
+}
+
+inline std::int64_t first_bad_pair(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i)
+        if (!unit_length(job.wi, i, job.length2_lowest, job.length2_highest) ||
+            !unit_length(job.wo, i, job.length2_lowest, job.length2_highest))
+            return i;
+    return -1;
+}
+
 // The last count < kLanes elements go through padded copies, so the main loop
 // never reads or writes past the end and every element sees the same code.
 template <Model model, Output output, bool per_element>
-void eval_tail(const EvalJob& job, std::int64_t begin, std::int64_t count, const Shading& uniform);
-
-template <Model model, Output output, bool per_element>
-void eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    Shading uniform{};
-    if constexpr (!per_element) uniform = shading_of(load_material(job, 0));
-    std::int64_t i = begin;
-    for (; i + kLanes <= end; i += kLanes) {
-        if constexpr (per_element) {
-            eval_batch<model, output>(job, i, shading_of(load_material(job, i)));
-        } else {
-            eval_batch<model, output>(job, i, uniform);
-        }
-    }
-    if (i < end) eval_tail<model, output, per_element>(job, i, end - i, uniform);
-}
-
-template <Model model, Output output, bool per_element>
-void eval_tail(const EvalJob& job, std::int64_t begin, std::int64_t count, const Shading& uniform) {
+bool eval_tail(const EvalJob& job, std::int64_t begin, std::int64_t count, const Shading& uniform) {
     alignas(64) float wi[3 * kLanes], wo[3 * kLanes];
     alignas(64) float params[kParamSlots][3 * kLanes];
     alignas(64) float out[kLobeCount][3 * kLanes];
@@ -312,18 +344,14 @@ void eval_tail(const EvalJob& job, std::int64_t begin, std::int64_t count, const
             padded.params[s].data = params[s];
         }
         for (std::int64_t j = 0; j < kLanes; ++j) {
-            const std::int64_t e = begin + (j < count ? j : count - 1);  // repeat the last element
+            const std::int64_t e = begin + (j < count ? j : count - 1);
             for (int c = 0; c < slot.stride; ++c) params[s][j * slot.stride + c] = slot.data[e * slot.stride + c];
         }
     }
     const int outputs = output == Output::kLobes ? kLobeCount : 1;
     for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
 
-    if constexpr (per_element) {
-        eval_batch<model, output>(padded, 0, shading_of(load_material(padded, 0)));
-    } else {
-        eval_batch<model, output>(padded, 0, uniform);
-    }
+    if (!process_batch<model, output, per_element>(padded, 0, uniform)) return false;
 
     for (int k = 0; k < outputs; ++k) {
         const MutableVec3Array& to = job.out[k];
@@ -335,26 +363,34 @@ void eval_tail(const EvalJob& job, std::int64_t begin, std::int64_t count, const
             }
         }
     }
+    return true;
+}
+
+template <Model model, Output output, bool per_element>
+std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    Shading uniform{};
+    if constexpr (!per_element) uniform = shading_of(load_material(job, 0));
+    std::int64_t i = begin;
+    for (; i + kLanes <= end; i += kLanes)
+        if (!process_batch<model, output, per_element>(job, i, uniform)) return first_bad_pair(job, i, i + kLanes);
+    if (i < end && !eval_tail<model, output, per_element>(job, i, end - i, uniform)) return first_bad_pair(job, i, end);
+    return -1;
 }
 
 template <Model model, Output output>
-void eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    if (job.uniform_material()) {
-        eval_loop<model, output, false>(job, begin, end);
-    } else {
-        eval_loop<model, output, true>(job, begin, end);
-    }
+std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    return job.uniform_material() ? eval_loop<model, output, false>(job, begin, end)
+                                  : eval_loop<model, output, true>(job, begin, end);
 }
 
-inline void eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     const bool lobes = job.output == Output::kLobes;
     if (job.model == Model::kDisney2012) {
-        lobes ? eval_range_for<Model::kDisney2012, Output::kLobes>(job, begin, end)
-              : eval_range_for<Model::kDisney2012, Output::kTotal>(job, begin, end);
-    } else {
-        lobes ? eval_range_for<Model::kDisney2014, Output::kLobes>(job, begin, end)
-              : eval_range_for<Model::kDisney2014, Output::kTotal>(job, begin, end);
+        return lobes ? eval_range_for<Model::kDisney2012, Output::kLobes>(job, begin, end)
+                     : eval_range_for<Model::kDisney2012, Output::kTotal>(job, begin, end);
     }
+    return lobes ? eval_range_for<Model::kDisney2014, Output::kLobes>(job, begin, end)
+                 : eval_range_for<Model::kDisney2014, Output::kTotal>(job, begin, end);
 }
 
 }  // namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS

@@ -11,8 +11,14 @@ namespace principled_brdf::kernel {
 struct KernelTable {
     const char* isa;  // "sse2", "avx2", "avx512", "neon"
     int float_lanes;
-    // Evaluates elements [begin, end) of job.
-    void (*eval_range)(const EvalJob& job, std::int64_t begin, std::int64_t end);
+    // Evaluates elements [begin, end) of job. With job.check_directions, stops
+    // at the first batch holding a bad direction and returns that element's
+    // index (its batch stays unwritten); else returns -1.
+    std::int64_t (*eval_range)(const EvalJob& job, std::int64_t begin, std::int64_t end);
+    // First i in [begin, end) whose squared length is outside [lowest, highest]
+    // or not finite, else -1.
+    std::int64_t (*first_bad_direction)(const Vec3Array& directions, std::int64_t begin, std::int64_t end,
+                                        float lowest, float highest);
 };
 
 // Defined in kernel_<isa>.cpp, each compiled with its own flags; call one

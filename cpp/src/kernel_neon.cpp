@@ -6,7 +6,8 @@
 namespace principled_brdf::kernel {
 
 const KernelTable& neon_kernels() {
-    static constexpr KernelTable table{"neon", static_cast<int>(neon::kLanes), &neon::eval_range};
+    static constexpr KernelTable table{"neon", static_cast<int>(neon::kLanes), &neon::eval_range,
+                                           &neon::first_bad_direction};
     return table;
 }
 

@@ -33,6 +33,19 @@ struct Interleave3 {
     }
 };
 
+// The permutations as compile-time tables (loaded once, hoisted out of loops).
+template <int L, int k, bool for_store>
+struct Interleave3Permutation {
+    alignas(64) int lanes[L];
+    constexpr Interleave3Permutation() : lanes{} {
+        for (int i = 0; i < L; ++i)
+            lanes[i] = for_store ? Interleave3<L>::element_at_lane(k, i) : Interleave3<L>::lane_of_element(k, i);
+    }
+};
+
+template <int L, int k, bool for_store>
+inline constexpr Interleave3Permutation<L, k, for_store> kInterleave3Permutation{};
+
 #if defined(__AVX512F__)
 
 inline Floats reciprocal(Floats x) {
@@ -50,16 +63,12 @@ inline Floats reciprocal_sqrt(Floats x) {
 
 template <int k>
 inline __m512i interleave_load_permutation() {
-    alignas(64) int indices[16];
-    for (int j = 0; j < 16; ++j) indices[j] = Interleave3<16>::lane_of_element(k, j);
-    return _mm512_load_si512(indices);
+    return _mm512_load_si512(kInterleave3Permutation<16, k, false>.lanes);
 }
 
 template <int k>
 inline __m512i interleave_store_permutation() {
-    alignas(64) int indices[16];
-    for (int lane = 0; lane < 16; ++lane) indices[lane] = Interleave3<16>::element_at_lane(k, lane);
-    return _mm512_load_si512(indices);
+    return _mm512_load_si512(kInterleave3Permutation<16, k, true>.lanes);
 }
 
 template <int k, int r>
@@ -126,16 +135,12 @@ inline Floats reciprocal_sqrt(Floats x) {
 
 template <int k>
 inline __m256i interleave_load_permutation() {
-    alignas(32) int indices[8];
-    for (int j = 0; j < 8; ++j) indices[j] = Interleave3<8>::lane_of_element(k, j);
-    return _mm256_load_si256(reinterpret_cast<const __m256i*>(indices));
+    return _mm256_load_si256(reinterpret_cast<const __m256i*>(kInterleave3Permutation<8, k, false>.lanes));
 }
 
 template <int k>
 inline __m256i interleave_store_permutation() {
-    alignas(32) int indices[8];
-    for (int lane = 0; lane < 8; ++lane) indices[lane] = Interleave3<8>::element_at_lane(k, lane);
-    return _mm256_load_si256(reinterpret_cast<const __m256i*>(indices));
+    return _mm256_load_si256(reinterpret_cast<const __m256i*>(kInterleave3Permutation<8, k, true>.lanes));
 }
 
 template <int k, int r>

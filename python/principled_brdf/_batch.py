@@ -147,8 +147,9 @@ def _run(material, wi, wo, model, cosine, layout, threads, check, isa, outputs_f
     wo_dirs = _Directions("wo", wo, layout)
     leading = broadcast_leading(wi=wi_dirs.leading, wo=wo_dirs.leading, material=material.shape)
     out_shape = leading + (3,) if layout == "aos" else (3,) + leading
-    outputs = outputs_for_shape(out_shape)
-    if check:
+    outputs, fresh = outputs_for_shape(out_shape)
+    if check and not fresh:
+        # The caller's buffer must stay untouched on bad input: check first.
         wi_dirs.check(thread_count)
         wo_dirs.check(thread_count)
     n = int(np.prod(leading, dtype=np.int64))
@@ -156,10 +157,17 @@ def _run(material, wi, wo, model, cosine, layout, threads, check, isa, outputs_f
     wo_flat, wo_code = wo_dirs.flat(leading)
     out_code = _INTERLEAVED if layout == "aos" else _ROWS
     flat_outputs = [o.reshape((n, 3) if layout == "aos" else (3, n)) for o in outputs]
-    _core.batch_eval(
+    # Into fresh outputs the check rides along with the evaluation (one pass
+    # over memory instead of two); on a bad direction the partial result is dropped.
+    fused_tolerance = DIRECTION_LENGTH_TOLERANCE if check and fresh else 0.0
+    bad = _core.batch_eval(
         wi_flat, wi_code, wo_flat, wo_code, _params(material, leading), flat_outputs, out_code, n,
-        model_id, len(outputs) == 4, bool(cosine), thread_count, isa_name,
+        model_id, len(outputs) == 4, bool(cosine), fused_tolerance, thread_count, isa_name,
     )
+    if bad >= 0:
+        wi_dirs.check(thread_count)
+        wo_dirs.check(thread_count)
+        raise RuntimeError("internal error: the kernel rejected a direction the checks accept")
     return outputs
 
 
@@ -172,11 +180,12 @@ def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool 
     material's. Returns ``(..., 3)`` (``(3, ...)`` for ``"soa"``), written into
     ``out`` if given (float32, C-contiguous, exact shape). ``cosine`` multiplies
     by cos θl. ``threads``: default all cores; results are bit-identical for
-    every thread count. ``check=False`` skips the direction checks (then a
-    non-finite direction gives 0, a non-unit one is used as given). ``isa``
+    every thread count. ``check=False`` skips the direction checks for speed:
+    a non-unit direction is then used as given and a non-finite one gives 0. ``isa``
     picks one of ``cpu_info()["available"]`` (for tests and benchmarks).
     """
-    (f,) = _run(material, wi, wo, model, cosine, layout, threads, check, isa, lambda shape: [_output(out, shape)])
+    (f,) = _run(material, wi, wo, model, cosine, layout, threads, check, isa,
+                lambda shape: ([_output(out, shape)], out is None))
     return f
 
 
@@ -185,5 +194,5 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
     """The four lobes (diffuse, sheen, specular, clearcoat) as a :class:`Lobes`
     of float32 arrays, each shaped like :func:`eval`'s result."""
     outputs = _run(material, wi, wo, model, cosine, layout, threads, check, isa,
-                   lambda shape: [np.empty(shape, dtype=np.float32) for _ in range(4)])
+                   lambda shape: ([np.empty(shape, dtype=np.float32) for _ in range(4)], True))
     return Lobes(*outputs)

@@ -52,6 +52,11 @@ struct EvalJob {
     bool cosine = false;  // multiply by cos θl
     // out[0] is f; with Output::kLobes, out[0..3] are the four lobes.
     MutableVec3Array out[kLobeCount];
+    // Direction check fused into the evaluation: squared lengths must lie in
+    // [length2_lowest, length2_highest]. Outputs are then written up to the
+    // first bad element only, so use it on outputs nobody else sees yet.
+    bool check_directions = false;
+    float length2_lowest = 0.0f, length2_highest = 0.0f;
 
     bool uniform_material() const {
         for (const ParamSlot& slot : params)
@@ -70,7 +75,11 @@ int float_lanes(const std::string& isa);
 
 // Evaluates elements [0, n) with `threads` threads (0: all cores) on `isa`
 // ("" for the active one). Results are bit-identical for every thread count.
-void eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa = "");
+// Returns -1, or with job.check_directions an element with a bad direction.
+std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa = "");
+
+// Squared-length bounds for directions within `tolerance` of unit length.
+void set_direction_check(EvalJob& job, float tolerance);
 
 // Index of the first element whose length differs from 1 by more than
 // `tolerance` or which is not finite, or -1 if there is none.

@@ -1,0 +1,191 @@
+// Throughput of the batched evaluator (items = direction pairs), with the
+// yardsticks of DESIGN "Measuring" in the same run: the float64 reference,
+// a -O3 -march=native -ffast-math loop of the same math, and a copy kernel
+// that moves the same bytes as eval (the memory roofline).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "native_loop.hpp"
+#include "principled_brdf/batch.hpp"
+#include "principled_brdf/reference.hpp"
+#include "thread_pool.hpp"
+
+namespace pb = principled_brdf;
+
+namespace {
+
+constexpr std::int64_t kSizes[] = {4096, 65536, 16 << 20};
+
+// Random pairs in the upper hemisphere and random per-element materials, in
+// both layouts, made once per size.
+struct Data {
+    std::int64_t n;
+    std::vector<float> wi_aos, wo_aos, wi_soa, wo_soa, out;
+    std::vector<float> params[pb::kParamSlots];  // per-element, base_color interleaved in slot 0
+};
+
+Data& data_for(std::int64_t n) {
+    static std::map<std::int64_t, std::unique_ptr<Data>> cache;
+    auto& slot = cache[n];
+    if (slot) return *slot;
+    slot = std::make_unique<Data>();
+    Data& d = *slot;
+    d.n = n;
+    std::mt19937_64 rng(1234);
+    std::normal_distribution<float> normal;
+    std::uniform_real_distribution<float> uniform;
+    auto directions = [&](std::vector<float>& aos, std::vector<float>& soa) {
+        aos.resize(3 * n);
+        soa.resize(3 * n);
+        for (std::int64_t i = 0; i < n; ++i) {
+            float x = normal(rng), y = normal(rng), z = std::abs(normal(rng)) + 1e-3f;
+            const float inv = 1.0f / std::sqrt(x * x + y * y + z * z);
+            x *= inv, y *= inv, z *= inv;
+            aos[3 * i] = soa[i] = x;
+            aos[3 * i + 1] = soa[n + i] = y;
+            aos[3 * i + 2] = soa[2 * n + i] = z;
+        }
+    };
+    directions(d.wi_aos, d.wi_soa);
+    directions(d.wo_aos, d.wo_soa);
+    d.out.resize(12 * n);
+    d.params[pb::kBaseColorR].resize(3 * n);
+    for (auto& v : d.params[pb::kBaseColorR]) v = uniform(rng);
+    for (int s = pb::kMetallic; s < pb::kParamSlots; ++s) {
+        d.params[s].resize(n);
+        for (auto& v : d.params[s]) v = uniform(rng);
+    }
+    return d;
+}
+
+pb::EvalJob make_job(Data& d, bool soa, bool per_element) {
+    pb::EvalJob job;
+    const auto layout = soa ? pb::Vec3Layout::kRows : pb::Vec3Layout::kInterleaved;
+    const std::int64_t stride = soa ? d.n : 0;
+    job.wi = {soa ? d.wi_soa.data() : d.wi_aos.data(), layout, stride};
+    job.wo = {soa ? d.wo_soa.data() : d.wo_aos.data(), layout, stride};
+    job.out[0] = {d.out.data(), layout, stride};
+    const float uniform[pb::kParamSlots] = {0.82f, 0.67f, 0.16f, 0.2f, 0.3f, 0.5f, 0.1f, 0.4f, 0.3f, 0.2f, 0.5f, 0.5f, 0.7f};
+    for (int s = 0; s < pb::kParamSlots; ++s) job.params[s].value = uniform[s];
+    if (per_element) {
+        for (int s = 0; s < 3; ++s) job.params[s] = {0.0f, d.params[pb::kBaseColorR].data() + s, 3};
+        for (int s = pb::kMetallic; s < pb::kParamSlots; ++s) job.params[s] = {0.0f, d.params[s].data(), 1};
+    }
+    return job;
+}
+
+int threads_of(const benchmark::State& state) {
+    return state.range(1) == 0 ? pb::hardware_threads() : static_cast<int>(state.range(1));
+}
+
+void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_element) {
+    Data& d = data_for(state.range(0));
+    const pb::EvalJob job = make_job(d, soa, per_element);
+    const int threads = threads_of(state);
+    for (auto _ : state) {
+        pb::eval(job, d.n, threads, isa);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * d.n);
+}
+
+void reference_eval(benchmark::State& state) {
+    Data& d = data_for(state.range(0));
+    pb::reference::Material m;
+    m.roughness = 0.4;
+    m.clearcoat = 0.5;
+    m.sheen = 0.2;
+    for (auto _ : state) {
+        for (std::int64_t i = 0; i < d.n; ++i) {
+            const Eigen::Vector3d wi(d.wi_aos[3 * i], d.wi_aos[3 * i + 1], d.wi_aos[3 * i + 2]);
+            const Eigen::Vector3d wo(d.wo_aos[3 * i], d.wo_aos[3 * i + 1], d.wo_aos[3 * i + 2]);
+            const Eigen::Vector3d f = pb::reference::eval(m, wi, wo);
+            d.out[3 * i] = static_cast<float>(f.x());
+            d.out[3 * i + 1] = static_cast<float>(f.y());
+            d.out[3 * i + 2] = static_cast<float>(f.z());
+        }
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * d.n);
+}
+
+void native_loop(benchmark::State& state, bool soa) {
+    Data& d = data_for(state.range(0));
+    const pb::bench::NativeMaterial m{{0.82f, 0.67f, 0.16f}, 0.2f, 0.3f, 0.5f, 0.1f, 0.4f, 0.3f, 0.2f, 0.5f, 0.5f, 0.7f};
+    for (auto _ : state) {
+        if (soa) {
+            pb::bench::native_eval_rows(m, d.wi_soa.data(), d.wo_soa.data(), d.out.data(), d.n);
+        } else {
+            pb::bench::native_eval_interleaved(m, d.wi_aos.data(), d.wo_aos.data(), d.out.data(), d.n);
+        }
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * d.n);
+}
+
+// Reads wi and wo, writes 3 floats per pair: the bytes eval moves.
+void copy_kernel(benchmark::State& state) {
+    Data& d = data_for(state.range(0));
+    const int threads = threads_of(state);
+    const std::int64_t chunk = (d.n + threads - 1) / threads;
+    const float* wi = d.wi_aos.data();
+    const float* wo = d.wo_aos.data();
+    float* out = d.out.data();
+    for (auto _ : state) {
+        pb::parallel_for(threads, threads, [&](int t) {
+            const std::int64_t begin = 3 * t * chunk, end = 3 * std::min(d.n, (t + 1) * chunk);
+            for (std::int64_t i = begin; i < end; ++i) out[i] = wi[i] + wo[i];
+        });
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * d.n);
+}
+
+void register_all() {
+    const int all = pb::hardware_threads();
+    // The reference is per element and slow: one size in cache, one beyond.
+    for (std::int64_t n : {kSizes[0], kSizes[1]})
+        benchmark::RegisterBenchmark("reference_f64", reference_eval)->Args({n, 1})->Unit(benchmark::kMicrosecond);
+    for (const std::string& isa : pb::available_isas()) {
+        for (std::int64_t n : kSizes) {
+            for (int threads : {1, all}) {
+                if (threads == all && all == 1) continue;
+                for (bool soa : {false, true}) {
+                    for (bool per_element : {false, true}) {
+                        const std::string name = "eval/" + isa + (soa ? "/soa" : "/aos") +
+                                                 (per_element ? "/per_element" : "/uniform");
+                        benchmark::RegisterBenchmark(name.c_str(), simd_eval, isa, soa, per_element)
+                            ->Args({n, threads})
+                            ->UseRealTime()
+                            ->Unit(benchmark::kMicrosecond);
+                    }
+                }
+            }
+        }
+    }
+    for (std::int64_t n : kSizes) {
+        benchmark::RegisterBenchmark("native_loop/aos", native_loop, false)->Args({n, 1})->Unit(benchmark::kMicrosecond);
+        benchmark::RegisterBenchmark("native_loop/soa", native_loop, true)->Args({n, 1})->Unit(benchmark::kMicrosecond);
+        for (int threads : {1, all})
+            benchmark::RegisterBenchmark("copy", copy_kernel)->Args({n, threads})->UseRealTime()->Unit(benchmark::kMicrosecond);
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    register_all();
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
