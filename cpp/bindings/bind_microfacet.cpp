@@ -1,2 +1,199 @@
+// Bindings for the microfacet toolkit (microfacet.hpp) as the submodule
+// principled_brdf._core.microfacet. Each function is a loop over rows: every
+// argument is a C-contiguous float64 array with either N rows or one row that
+// all rows share (scalars (N,) or (1,), directions (N, 3) or (1, 3)). The
+// Python side (principled_brdf/microfacet.py) validates and broadcasts;
+// direction arguments are normalised here before the formulas see them.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
 #include "bindings.hpp"
-namespace principled_brdf::bindings { void bind_microfacet(pybind11::module_&) {} }
+#include "principled_brdf/microfacet.hpp"
+
+namespace py = pybind11;
+
+namespace principled_brdf::bindings {
+
+namespace {
+
+namespace mf = principled_brdf::microfacet;
+
+using Float64Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// One argument: `width` doubles per row, N rows or a single shared row.
+class Column {
+public:
+    Column(const Float64Array& array, int width, const char* name) : data_(array.data()), width_(width) {
+        const bool shape_ok = width == 1 ? array.ndim() == 1 : (array.ndim() == 2 && array.shape(1) == width);
+        if (!shape_ok)
+            throw std::invalid_argument(std::string(name) + ": expected a contiguous " +
+                                        (width == 1 ? "(N,)" : "(N, 3)") + " float64 array");
+        rows_ = array.shape(0);
+        name_ = name;
+    }
+    py::ssize_t rows() const { return rows_; }
+    const char* name() const { return name_; }
+    void bind_rows(py::ssize_t n) {
+        if (rows_ != n && rows_ != 1)
+            throw std::invalid_argument(std::string(name_) + ": expected " + std::to_string(n) + " or 1 rows, got " +
+                                        std::to_string(rows_));
+        stride_ = rows_ == 1 ? 0 : width_;
+    }
+    double scalar(py::ssize_t i) const { return data_[i * stride_]; }
+    mf::Vec3 unit_vector(py::ssize_t i) const {
+        const double* v = data_ + i * stride_;
+        return mf::normalize({v[0], v[1], v[2]});
+    }
+
+private:
+    const double* data_;
+    int width_;
+    py::ssize_t rows_ = 0;
+    py::ssize_t stride_ = 0;
+    const char* name_ = "";
+};
+
+// The common row count of the arguments: the first that is not 1 (the others must match it or be 1).
+py::ssize_t common_rows(std::vector<Column*> columns) {
+    py::ssize_t n = 1;
+    for (const Column* c : columns)
+        if (c->rows() != 1) {
+            n = c->rows();
+            break;
+        }
+    for (Column* c : columns) c->bind_rows(n);
+    return n;
+}
+
+// out[i] = row_function(i) for i < n, with the GIL released around the loop.
+template <class RowFunction>
+py::array_t<double> scalar_rows(py::ssize_t n, RowFunction row_function) {
+    py::array_t<double> out(n);
+    double* out_data = out.mutable_data();
+    {
+        py::gil_scoped_release release;
+        for (py::ssize_t i = 0; i < n; ++i) out_data[i] = row_function(i);
+    }
+    return out;
+}
+
+template <class RowFunction>
+py::array_t<double> vector_rows(py::ssize_t n, RowFunction row_function) {
+    py::array_t<double> out({n, py::ssize_t{3}});
+    double* out_data = out.mutable_data();
+    {
+        py::gil_scoped_release release;
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const mf::Vec3 v = row_function(i);
+            out_data[3 * i + 0] = v.x;
+            out_data[3 * i + 1] = v.y;
+            out_data[3 * i + 2] = v.z;
+        }
+    }
+    return out;
+}
+
+// f(w, alpha_x, alpha_y) -> scalar, for D, pdf, Λ and G1 of GGX and Beckmann.
+template <double (*Formula)(const mf::Vec3&, double, double)>
+py::array_t<double> direction_alphas(const Float64Array& w, const Float64Array& alpha_x, const Float64Array& alpha_y) {
+    Column wc(w, 3, "w"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y");
+    const py::ssize_t n = common_rows({&wc, &ax, &ay});
+    return scalar_rows(n, [&](py::ssize_t i) { return Formula(wc.unit_vector(i), ax.scalar(i), ay.scalar(i)); });
+}
+
+// f(a, b, alpha_x, alpha_y) -> scalar, for G2 and the visible-normal pdf.
+template <double (*Formula)(const mf::Vec3&, const mf::Vec3&, double, double)>
+py::array_t<double> two_directions_alphas(const Float64Array& a, const Float64Array& b, const Float64Array& alpha_x,
+                                          const Float64Array& alpha_y) {
+    Column ac(a, 3, "a"), bc(b, 3, "b"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y");
+    const py::ssize_t n = common_rows({&ac, &bc, &ax, &ay});
+    return scalar_rows(
+        n, [&](py::ssize_t i) { return Formula(ac.unit_vector(i), bc.unit_vector(i), ax.scalar(i), ay.scalar(i)); });
+}
+
+// h = sample(u1, u2, alpha_x, alpha_y), for the GGX and Beckmann distribution samplers.
+template <mf::Vec3 (*Sampler)(double, double, double, double)>
+py::array_t<double> sample_alphas(const Float64Array& u1, const Float64Array& u2, const Float64Array& alpha_x,
+                                  const Float64Array& alpha_y) {
+    Column c1(u1, 1, "u1"), c2(u2, 1, "u2"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y");
+    const py::ssize_t n = common_rows({&c1, &c2, &ax, &ay});
+    return vector_rows(n,
+                       [&](py::ssize_t i) { return Sampler(c1.scalar(i), c2.scalar(i), ax.scalar(i), ay.scalar(i)); });
+}
+
+py::array_t<double> gtr_d(const Float64Array& cos_theta_h, const Float64Array& alpha, const Float64Array& gamma,
+                          bool closed_forms) {
+    Column c(cos_theta_h, 1, "cos_theta_h"), a(alpha, 1, "alpha"), g(gamma, 1, "gamma");
+    const py::ssize_t n = common_rows({&c, &a, &g});
+    return scalar_rows(n,
+                       [&](py::ssize_t i) { return mf::gtr_d(c.scalar(i), a.scalar(i), g.scalar(i), closed_forms); });
+}
+
+py::array_t<double> gtr_pdf(const Float64Array& h, const Float64Array& alpha, const Float64Array& gamma,
+                            bool closed_forms) {
+    Column hc(h, 3, "h"), a(alpha, 1, "alpha"), g(gamma, 1, "gamma");
+    const py::ssize_t n = common_rows({&hc, &a, &g});
+    return scalar_rows(
+        n, [&](py::ssize_t i) { return mf::gtr_pdf_h(hc.unit_vector(i), a.scalar(i), g.scalar(i), closed_forms); });
+}
+
+py::array_t<double> gtr_sample(const Float64Array& u1, const Float64Array& u2, const Float64Array& alpha,
+                               const Float64Array& gamma, bool closed_forms) {
+    Column c1(u1, 1, "u1"), c2(u2, 1, "u2"), a(alpha, 1, "alpha"), g(gamma, 1, "gamma");
+    const py::ssize_t n = common_rows({&c1, &c2, &a, &g});
+    return vector_rows(n, [&](py::ssize_t i) {
+        return mf::gtr_sample_h(c1.scalar(i), c2.scalar(i), a.scalar(i), g.scalar(i), closed_forms);
+    });
+}
+
+py::array_t<double> ggx_sample_visible(const Float64Array& wo, const Float64Array& u1, const Float64Array& u2,
+                                       const Float64Array& alpha_x, const Float64Array& alpha_y) {
+    Column w(wo, 3, "wo"), c1(u1, 1, "u1"), c2(u2, 1, "u2"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y");
+    const py::ssize_t n = common_rows({&w, &c1, &c2, &ax, &ay});
+    return vector_rows(n, [&](py::ssize_t i) {
+        return mf::ggx_sample_visible_h(w.unit_vector(i), c1.scalar(i), c2.scalar(i), ax.scalar(i), ay.scalar(i));
+    });
+}
+
+}  // namespace
+
+void bind_microfacet(py::module_& m) {
+    py::module_ sub = m.def_submodule("microfacet", "Microfacet toolkit (SPEC §4) over packed float64 rows.");
+    const auto closed = py::arg("closed_forms");
+
+    sub.def("gtr_d", &gtr_d, py::arg("cos_theta_h"), py::arg("alpha"), py::arg("gamma"), closed);
+    sub.def("gtr_pdf", &gtr_pdf, py::arg("h"), py::arg("alpha"), py::arg("gamma"), closed);
+    sub.def("gtr_sample", &gtr_sample, py::arg("u1"), py::arg("u2"), py::arg("alpha"), py::arg("gamma"), closed);
+
+    sub.def("ggx_d", &direction_alphas<mf::ggx_d>, py::arg("h"), py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("ggx_pdf", &direction_alphas<mf::ggx_pdf_h>, py::arg("h"), py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("ggx_lambda", &direction_alphas<mf::ggx_lambda>, py::arg("w"), py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("ggx_g1", &direction_alphas<mf::ggx_g1>, py::arg("w"), py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("ggx_g2_separable", &two_directions_alphas<mf::ggx_g2_separable>, py::arg("wi"), py::arg("wo"),
+            py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("ggx_g2_height_correlated", &two_directions_alphas<mf::ggx_g2_height_correlated>, py::arg("wi"),
+            py::arg("wo"), py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("ggx_pdf_visible", &two_directions_alphas<mf::ggx_pdf_visible_h>, py::arg("h"), py::arg("wo"),
+            py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("ggx_sample", &sample_alphas<mf::ggx_sample_h>, py::arg("u1"), py::arg("u2"), py::arg("alpha_x"),
+            py::arg("alpha_y"));
+    sub.def("ggx_sample_visible", &ggx_sample_visible, py::arg("wo"), py::arg("u1"), py::arg("u2"), py::arg("alpha_x"),
+            py::arg("alpha_y"));
+
+    sub.def("beckmann_d", &direction_alphas<mf::beckmann_d>, py::arg("h"), py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("beckmann_pdf", &direction_alphas<mf::beckmann_pdf_h>, py::arg("h"), py::arg("alpha_x"),
+            py::arg("alpha_y"));
+    sub.def("beckmann_lambda", &direction_alphas<mf::beckmann_lambda>, py::arg("w"), py::arg("alpha_x"),
+            py::arg("alpha_y"));
+    sub.def("beckmann_g1", &direction_alphas<mf::beckmann_g1>, py::arg("w"), py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("beckmann_sample", &sample_alphas<mf::beckmann_sample_h>, py::arg("u1"), py::arg("u2"), py::arg("alpha_x"),
+            py::arg("alpha_y"));
+}
+
+}  // namespace principled_brdf::bindings
