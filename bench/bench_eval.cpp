@@ -16,7 +16,6 @@
 #include "native_loop.hpp"
 #include "principled_brdf/batch.hpp"
 #include "principled_brdf/reference.hpp"
-#include "thread_pool.hpp"
 
 namespace pb = principled_brdf;
 
@@ -135,15 +134,8 @@ void native_loop(benchmark::State& state, bool soa) {
 void copy_kernel(benchmark::State& state) {
     Data& d = data_for(state.range(0));
     const int threads = threads_of(state);
-    const std::int64_t chunk = (d.n + threads - 1) / threads;
-    const float* wi = d.wi_aos.data();
-    const float* wo = d.wo_aos.data();
-    float* out = d.out.data();
     for (auto _ : state) {
-        pb::parallel_for(threads, threads, [&](int t) {
-            const std::int64_t begin = 3 * t * chunk, end = 3 * std::min(d.n, (t + 1) * chunk);
-            for (std::int64_t i = begin; i < end; ++i) out[i] = wi[i] + wo[i];
-        });
+        pb::add_pairs(d.wi_aos.data(), d.wo_aos.data(), d.out.data(), d.n, threads);
         benchmark::ClobberMemory();
     }
     state.SetItemsProcessed(state.iterations() * d.n);

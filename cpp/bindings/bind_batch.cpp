@@ -97,6 +97,16 @@ std::int64_t check_directions(const Float32Array& w, int layout, std::int64_t n,
     return first_bad_direction(view, n, tolerance, threads);
 }
 
+void memory_roofline(const Float32Array& wi, const Float32Array& wo, Float32Array& out, int threads) {
+    const std::int64_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
+    vec3_view(wi, 0, n, "wi");
+    vec3_view(wo, 0, n, "wo");
+    output_view(out, 0, n, "out");
+    float* out_data = out.mutable_data();
+    py::gil_scoped_release release;
+    add_pairs(wi.data(), wo.data(), out_data, n, threads);
+}
+
 py::dict cpu_info() {
     py::dict info;
     const std::string isa = active_isa();
@@ -117,6 +127,8 @@ void bind_batch(py::module_& m) {
     m.def("check_directions", &check_directions, py::arg("w"), py::arg("layout"), py::arg("n"),
           py::arg("tolerance"), py::arg("threads"),
           "Index of the first non-finite or non-unit direction, or -1.");
+    m.def("memory_roofline", &memory_roofline, py::arg("wi"), py::arg("wo"), py::arg("out"), py::arg("threads"),
+          "out = wi + wo over (N, 3) float32 arrays: the bytes eval moves, at memory speed.");
     m.def("cpu_info", &cpu_info, "Instruction set in use, the available ones, SIMD width, hardware threads.");
     m.def("float_lanes", &float_lanes, py::arg("isa"));
 }

@@ -68,6 +68,15 @@ std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::st
     return -1;
 }
 
+void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int threads) {
+    const int thread_count = resolve_threads(threads);
+    const Chunks chunks = split(n, thread_count);
+    parallel_for(chunks.count, thread_count, [&](int c) {
+        const std::int64_t begin = 3 * c * chunks.size, end = 3 * std::min(n, (c + 1) * chunks.size);
+        for (std::int64_t i = begin; i < end; ++i) out[i] = wi[i] + wo[i];
+    });
+}
+
 std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_t n, float tolerance, int threads) {
     EvalJob bounds;
     set_direction_check(bounds, tolerance);

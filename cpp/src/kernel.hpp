@@ -137,15 +137,14 @@ inline Shading shading_of(const RawMaterial& m) {
 
 // ---------------------------------------------------------------- the BRDF
 
-// 1 / (n·w + sqrt(q)) = G1(w) / (2 n·w): the Smith factor S of SPEC §3,
-// given q = (w·x ax)² + (w·y ay)² + (n·w)² (or its isotropic form).
-inline Floats smith_s_from_q(Floats cos_theta, Floats q) {
-    return reciprocal(xsimd::fma(q, reciprocal_sqrt(q), cos_theta));
-}
+// n·w + sqrt(q), the denominator of the Smith factor S(w) = G1(w) / (2 n·w)
+// of SPEC §3, given q = (w·x ax)² + (w·y ay)² + (n·w)². Products of these
+// share one reciprocal.
+inline Floats smith_denominator(Floats cos_theta, Floats q) { return xsimd::fma(q, reciprocal_sqrt(q), cos_theta); }
 
-// Isotropic S with alpha² = a2: q = a2 + cos²(1 - a2)
-inline Floats smith_s_iso(Floats cos_theta, Floats a2) {
-    return smith_s_from_q(cos_theta, xsimd::fma(cos_theta * cos_theta, Floats(1.0f) - a2, a2));
+// Isotropic form, alpha² = a2: q = a2 + cos²(1 - a2)
+inline Floats smith_denominator_iso(Floats cos_theta, Floats a2) {
+    return smith_denominator(cos_theta, xsimd::fma(cos_theta * cos_theta, Floats(1.0f) - a2, a2));
 }
 
 struct LobeValues {
@@ -190,28 +189,42 @@ inline LobeValues eval_lobes(const Vec3& wi, const Vec3& wo, const Shading& s) {
     const Floats stretched = xsimd::fma(hx2, s.inv_alpha_x2, xsimd::fma(hy2, s.inv_alpha_y2, hz2));
     const Floats ds_root = h_len2 * reciprocal(stretched);
     const Floats ds = s.ggx_norm * ds_root * ds_root;
-    Floats gs;
+    Floats gs_denominator;
     if constexpr (model == Model::kDisney2012) {
-        gs = smith_s_iso(cos_theta_l, s.alpha_g2) * smith_s_iso(cos_theta_v, s.alpha_g2);
+        gs_denominator = smith_denominator_iso(cos_theta_l, s.alpha_g2) * smith_denominator_iso(cos_theta_v, s.alpha_g2);
     } else {
         const Floats q_l = xsimd::fma(s.alpha_x2, wi.x * wi.x, xsimd::fma(s.alpha_y2, wi.y * wi.y, cos_theta_l * cos_theta_l));
         const Floats q_v = xsimd::fma(s.alpha_x2, wo.x * wo.x, xsimd::fma(s.alpha_y2, wo.y * wo.y, cos_theta_v * cos_theta_v));
-        gs = smith_s_from_q(cos_theta_l, q_l) * smith_s_from_q(cos_theta_v, q_v);
+        gs_denominator = smith_denominator(cos_theta_l, q_l) * smith_denominator(cos_theta_v, q_v);
     }
-    out.specular = (gs * ds) * mix(s.specular_f0, Rgb{one, one, one}, fh);
+    out.specular = (ds * reciprocal(gs_denominator)) * mix(s.specular_f0, Rgb{one, one, one}, fh);
 
-    // GTR1: Dr = (ac² - 1)/(π ln ac²) / (ac² cos²θh + sin²θh); the norm is in clearcoat_scale
-    const Floats dr_shape = h_len2 * reciprocal(xsimd::fma(s.clearcoat_alpha2, hz2, hx2 + hy2));
+    // Clearcoat 0.25 clearcoat Gr Fr Dr with GTR1 Dr = (ac² - 1)/(π ln ac²) / (ac² cos²θh + sin²θh)
+    // (the constants are in clearcoat_scale) and Gr = S(wi) S(wo) at alpha 0.25.
     const Floats fr = xsimd::fma(Floats(0.96f), fh, Floats(0.04f));
     const Floats quarter2 = Floats(0.0625f);
-    const Floats gr = smith_s_iso(cos_theta_l, quarter2) * smith_s_iso(cos_theta_v, quarter2);
-    out.clearcoat = s.clearcoat_scale * gr * fr * dr_shape;
+    const Floats gr_denominator = smith_denominator_iso(cos_theta_l, quarter2) * smith_denominator_iso(cos_theta_v, quarter2);
+    const Floats dr_denominator = xsimd::fma(s.clearcoat_alpha2, hz2, hx2 + hy2);  // |H|² (ac² cos²θh + sin²θh)
+    out.clearcoat = s.clearcoat_scale * fr * h_len2 * reciprocal(dr_denominator * gr_denominator);
     return out;
 }
 
 // ---------------------------------------------------------------- memory
 
+// Every array of a call in one layout lets the loop be compiled for it;
+// kMixedLayouts reads each array's layout at run time.
+enum class Layouts { kInterleaved, kRows, kMixed };
+
+template <Layouts layouts = Layouts::kMixed>
 inline Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
+    if constexpr (layouts == Layouts::kInterleaved) {
+        Vec3 v;
+        load_interleaved(a.data + 3 * i, v.x, v.y, v.z);
+        return v;
+    } else if constexpr (layouts == Layouts::kRows) {
+        return {Floats::load_unaligned(a.data + i), Floats::load_unaligned(a.data + a.row_stride + i),
+                Floats::load_unaligned(a.data + 2 * a.row_stride + i)};
+    }
     switch (a.layout) {
         case Vec3Layout::kInterleaved: {
             Vec3 v;
@@ -226,8 +239,9 @@ inline Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
     }
 }
 
+template <Layouts layouts = Layouts::kMixed>
 inline void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb& c) {
-    if (a.layout == Vec3Layout::kInterleaved) {
+    if (layouts == Layouts::kInterleaved || (layouts == Layouts::kMixed && a.layout == Vec3Layout::kInterleaved)) {
         store_interleaved(a.data + 3 * i, c.r, c.g, c.b);
     } else {
         c.r.store_unaligned(a.data + i);
@@ -263,7 +277,7 @@ inline std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_
 
 // ---------------------------------------------------------------- the loop
 
-template <Model model, Output output>
+template <Model model, Output output, Layouts layouts>
 inline void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const Vec3& wo, const Shading& s) {
     const LobeValues lobes = eval_lobes<model>(wi, wo, s);
 
@@ -277,29 +291,29 @@ inline void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const
     };
     const Rgb clearcoat{lobes.clearcoat, lobes.clearcoat, lobes.clearcoat};
     if constexpr (output == Output::kLobes) {
-        store_rgb(job.out[0], i, masked(lobes.diffuse));
-        store_rgb(job.out[1], i, masked(lobes.sheen));
-        store_rgb(job.out[2], i, masked(lobes.specular));
-        store_rgb(job.out[3], i, masked(clearcoat));
+        store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse));
+        store_rgb<layouts>(job.out[1], i, masked(lobes.sheen));
+        store_rgb<layouts>(job.out[2], i, masked(lobes.specular));
+        store_rgb<layouts>(job.out[3], i, masked(clearcoat));
     } else {
-        store_rgb(job.out[0], i, masked(lobes.diffuse + lobes.sheen + lobes.specular + clearcoat));
+        store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse + lobes.sheen + lobes.specular + clearcoat));
     }
 }
 
 // One batch at i; false, with nothing stored, when the fused direction check fails.
-template <Model model, Output output, bool per_element>
+template <Model model, Output output, bool per_element, Layouts layouts>
 inline bool process_batch(const EvalJob& job, std::int64_t i, const Shading& uniform) {
-    const Vec3 wi = load_vec3(job.wi, i);
-    const Vec3 wo = load_vec3(job.wo, i);
+    const Vec3 wi = load_vec3<layouts>(job.wi, i);
+    const Vec3 wo = load_vec3<layouts>(job.wo, i);
     if (job.check_directions) {
         const Mask ok = unit_length(wi, job.length2_lowest, job.length2_highest) &
                         unit_length(wo, job.length2_lowest, job.length2_highest);
         if (!xsimd::all(ok)) return false;
     }
     if constexpr (per_element) {
-        eval_batch<model, output>(job, i, wi, wo, shading_of(load_material(job, i)));
+        eval_batch<model, output, layouts>(job, i, wi, wo, shading_of(load_material(job, i)));
     } else {
-        eval_batch<model, output>(job, i, wi, wo, uniform);
+        eval_batch<model, output, layouts>(job, i, wi, wo, uniform);
     }
     return true;
 }
@@ -351,7 +365,7 @@ bool eval_tail(const EvalJob& job, std::int64_t begin, std::int64_t count, const
     const int outputs = output == Output::kLobes ? kLobeCount : 1;
     for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
 
-    if (!process_batch<model, output, per_element>(padded, 0, uniform)) return false;
+    if (!process_batch<model, output, per_element, Layouts::kInterleaved>(padded, 0, uniform)) return false;
 
     for (int k = 0; k < outputs; ++k) {
         const MutableVec3Array& to = job.out[k];
@@ -366,21 +380,43 @@ bool eval_tail(const EvalJob& job, std::int64_t begin, std::int64_t count, const
     return true;
 }
 
-template <Model model, Output output, bool per_element>
+template <Model model, Output output, bool per_element, Layouts layouts>
 std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     Shading uniform{};
     if constexpr (!per_element) uniform = shading_of(load_material(job, 0));
     std::int64_t i = begin;
     for (; i + kLanes <= end; i += kLanes)
-        if (!process_batch<model, output, per_element>(job, i, uniform)) return first_bad_pair(job, i, i + kLanes);
+        if (!process_batch<model, output, per_element, layouts>(job, i, uniform)) return first_bad_pair(job, i, i + kLanes);
     if (i < end && !eval_tail<model, output, per_element>(job, i, end - i, uniform)) return first_bad_pair(job, i, end);
     return -1;
 }
 
+inline Layouts layouts_of(const EvalJob& job) {
+    const int outputs = job.output == Output::kLobes ? kLobeCount : 1;
+    for (Vec3Layout layout : {Vec3Layout::kInterleaved, Vec3Layout::kRows}) {
+        bool all = job.wi.layout == layout && job.wo.layout == layout;
+        for (int k = 0; k < outputs; ++k) all = all && job.out[k].layout == layout;
+        if (all) return layout == Vec3Layout::kInterleaved ? Layouts::kInterleaved : Layouts::kRows;
+    }
+    return Layouts::kMixed;
+}
+
+template <Model model, Output output, bool per_element>
+std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    switch (layouts_of(job)) {
+        case Layouts::kInterleaved:
+            return eval_loop<model, output, per_element, Layouts::kInterleaved>(job, begin, end);
+        case Layouts::kRows:
+            return eval_loop<model, output, per_element, Layouts::kRows>(job, begin, end);
+        default:
+            return eval_loop<model, output, per_element, Layouts::kMixed>(job, begin, end);
+    }
+}
+
 template <Model model, Output output>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    return job.uniform_material() ? eval_loop<model, output, false>(job, begin, end)
-                                  : eval_loop<model, output, true>(job, begin, end);
+    return job.uniform_material() ? eval_range_for<model, output, false>(job, begin, end)
+                                  : eval_range_for<model, output, true>(job, begin, end);
 }
 
 inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {

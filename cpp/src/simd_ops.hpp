@@ -55,10 +55,10 @@ inline Floats reciprocal(Floats x) {
 }
 
 inline Floats reciprocal_sqrt(Floats x) {
-    const __m512 estimate = _mm512_rsqrt14_ps(x);
-    // y (1.5 - 0.5 x y²)
-    const __m512 half_x_y2 = _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(0.5f), x), _mm512_mul_ps(estimate, estimate));
-    return _mm512_mul_ps(estimate, _mm512_sub_ps(_mm512_set1_ps(1.5f), half_x_y2));
+    const __m512 estimate = _mm512_rsqrt14_ps(x);  // relative error < 2^-14
+    // One Newton-Raphson step: y + (y / 2) (1 - x y²)
+    const __m512 residual = _mm512_fnmadd_ps(_mm512_mul_ps(x, estimate), estimate, _mm512_set1_ps(1.0f));
+    return _mm512_fmadd_ps(_mm512_mul_ps(_mm512_set1_ps(0.5f), estimate), residual, estimate);
 }
 
 template <int k>
@@ -128,9 +128,10 @@ inline Floats reciprocal(Floats x) {
 }
 
 inline Floats reciprocal_sqrt(Floats x) {
-    const __m256 estimate = _mm256_rsqrt_ps(x);
-    const __m256 half_x_y2 = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), x), _mm256_mul_ps(estimate, estimate));
-    return _mm256_mul_ps(estimate, _mm256_sub_ps(_mm256_set1_ps(1.5f), half_x_y2));
+    const __m256 estimate = _mm256_rsqrt_ps(x);  // relative error < 1.5 * 2^-12
+    // One Newton-Raphson step: y + (y / 2) (1 - x y²)
+    const __m256 residual = _mm256_fnmadd_ps(_mm256_mul_ps(x, estimate), estimate, _mm256_set1_ps(1.0f));
+    return _mm256_fmadd_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), estimate), residual, estimate);
 }
 
 template <int k>

@@ -1,0 +1,69 @@
+"""Lit-sphere pictures computed with the batched kernel.
+
+A unit sphere seen from +z (orthographic), each pixel shaded in its own
+tangent frame (normal n, tangent along the sphere's latitude), lit by one
+directional light plus a constant ambient term. Returns linear RGB; use
+:func:`to_srgb8` for a displayable image.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._batch import eval as _eval
+from .material import Material
+
+DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
+
+
+def sphere_frames(resolution: int):
+    """Per-pixel local directions for a sphere image.
+
+    Returns ``(inside, to_local)``: ``inside`` is the ``(resolution, resolution)``
+    mask of pixels on the sphere, and ``to_local(d)`` maps a camera-space unit
+    vector ``d`` (3,) to each pixel's local shading frame, ``(H, W, 3)`` float32
+    (pixels off the sphere get the normal, so every vector is valid).
+    """
+    if int(resolution) != resolution or resolution < 2:
+        raise ValueError(f"resolution: expected an integer >= 2, got {resolution!r}")
+    coords = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
+    x, y = np.meshgrid(coords, -coords)  # row 0 at the top
+    r2 = x * x + y * y
+    inside = r2 < 1.0
+    z = np.sqrt(np.clip(1.0 - r2, 1e-12, None))
+    normal = np.stack([x, y, z], axis=-1)
+    normal[~inside] = (0.0, 0.0, 1.0)
+    tangent = np.stack([normal[..., 2], np.zeros_like(x), -normal[..., 0]], axis=-1)
+    tangent /= np.linalg.norm(tangent, axis=-1, keepdims=True)
+    bitangent = np.cross(normal, tangent)
+
+    def to_local(direction) -> np.ndarray:
+        d = np.asarray(direction, dtype=np.float64)
+        d = d / np.linalg.norm(d)
+        local = np.stack([tangent @ d, bitangent @ d, normal @ d], axis=-1)
+        local /= np.linalg.norm(local, axis=-1, keepdims=True)
+        return local.astype(np.float32)
+
+    return inside, to_local
+
+
+def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT, light_intensity: float = 3.0,
+                  ambient: float = 0.03, model: str = "disney2014") -> np.ndarray:
+    """Linear RGB ``(resolution, resolution, 3)`` image of ``material`` on a sphere.
+
+    ``material`` may be uniform or per pixel (leading shape ``(resolution, resolution)``,
+    e.g. made by :meth:`Material.mix` with a mask). Background is 0.
+    """
+    inside, to_local = sphere_frames(resolution)
+    wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
+    radiance = light_intensity * _eval(material, wi, wo, cosine=True, model=model)
+    radiance += ambient * np.asarray(material.base_color, dtype=np.float32)
+    radiance[~inside] = 0.0
+    return radiance
+
+
+def to_srgb8(linear: np.ndarray, exposure: float = 1.0) -> np.ndarray:
+    """Linear RGB to 8-bit sRGB (clipped), for saving or showing."""
+    c = np.clip(np.asarray(linear, dtype=np.float64) * exposure, 0.0, 1.0)
+    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+    return np.round(srgb * 255.0).astype(np.uint8)
