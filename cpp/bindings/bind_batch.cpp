@@ -38,7 +38,7 @@ MutableVec3Array output_view(Float32Array& a, int layout, std::int64_t n, const 
 
 // params: 11 entries in the order of kParams, each a number (base_color: a
 // 3-sequence) or a float32 array of n values ((n, 3) for base_color).
-void fill_params(const py::sequence& params, std::int64_t n, EvalJob& job, py::list& keep_alive) {
+void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, py::list& keep_alive) {
     if (static_cast<std::size_t>(py::len(params)) != kParams.size())
         throw std::invalid_argument("params: expected one entry per parameter");
     for (std::size_t p = 0; p < kParams.size(); ++p) {
@@ -51,13 +51,13 @@ void fill_params(const py::sequence& params, std::int64_t n, EvalJob& job, py::l
                                             : (array.ndim() == 1 && array.shape(0) == n);
             if (!ok) throw std::invalid_argument(std::string(info.name) + ": per-element array of the wrong shape");
             for (int s = 0; s < info.slots; ++s)
-                job.params[info.first_slot + s] = ParamSlot{0.0f, array.data() + s, info.slots};
+                slots[info.first_slot + s] = ParamSlot{0.0f, array.data() + s, info.slots};
         } else if (info.slots == 3) {
             auto rgb = py::cast<std::vector<float>>(value);
             if (rgb.size() != 3) throw std::invalid_argument(std::string(info.name) + ": expected 3 values");
-            for (int s = 0; s < 3; ++s) job.params[info.first_slot + s].value = rgb[s];
+            for (int s = 0; s < 3; ++s) slots[info.first_slot + s].value = rgb[s];
         } else {
-            job.params[info.first_slot].value = py::cast<float>(value);
+            slots[info.first_slot].value = py::cast<float>(value);
         }
     }
 }
@@ -71,7 +71,7 @@ std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Arra
     job.wi = vec3_view(wi, wi_layout, n, "wi");
     job.wo = vec3_view(wo, wo_layout, n, "wo");
     py::list keep_alive;
-    fill_params(params, n, job, keep_alive);
+    fill_params(params, n, job.params, keep_alive);
     if (model != 0 && model != 1) throw std::invalid_argument("model: expected 0 (disney2014) or 1 (disney2012)");
     job.model = static_cast<Model>(model);
     job.output = lobes ? Output::kLobes : Output::kTotal;
@@ -89,6 +89,72 @@ std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Arra
     if (n == 0) return -1;
     py::gil_scoped_release release;
     return eval(job, n, threads, isa);
+}
+
+template <class T>
+T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const char* name) {
+    if (a.ndim() != 1 || a.shape(0) != n || !a.writeable())
+        throw std::invalid_argument(std::string(name) + ": expected a writeable array of N elements");
+    return a.mutable_data();
+}
+
+SpecularSampler specular_sampler(int sampler) {
+    if (sampler != 0 && sampler != 1) throw std::invalid_argument("specular_sampler: expected 0 or 1");
+    return static_cast<SpecularSampler>(sampler);
+}
+
+std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                       const py::sequence& params, Float32Array pdf, std::int64_t n, int sampler,
+                       float check_tolerance, int threads, const std::string& isa) {
+    EvalJob job;
+    job.wi = vec3_view(wi, wi_layout, n, "wi");
+    job.wo = vec3_view(wo, wo_layout, n, "wo");
+    py::list keep_alive;
+    fill_params(params, n, job.params, keep_alive);
+    job.output = Output::kPdf;
+    job.sampler = specular_sampler(sampler);
+    job.pdf = scalar_output(pdf, n, "pdf");
+    if (check_tolerance > 0.0f) set_direction_check(job, check_tolerance);
+    if (n == 0) return -1;
+    py::gil_scoped_release release;
+    return eval(job, n, threads, isa);
+}
+
+std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::object& u, int u_layout,
+                          std::uint64_t seed, const py::sequence& params, Float32Array wi, Float32Array weight,
+                          int out_layout, Float32Array pdf, py::array_t<std::int32_t, py::array::c_style> lobe,
+                          std::int64_t n, int model, int sampler, float check_tolerance, int threads,
+                          const std::string& isa) {
+    SampleJob job;
+    job.wo = vec3_view(wo, wo_layout, n, "wo");
+    Float32Array u_array;
+    if (!u.is_none()) {
+        u_array = py::cast<Float32Array>(u);
+        job.u = vec3_view(u_array, u_layout, n, "u");
+    }
+    job.seed = seed;
+    py::list keep_alive;
+    fill_params(params, n, job.params, keep_alive);
+    if (model != 0 && model != 1) throw std::invalid_argument("model: expected 0 (disney2014) or 1 (disney2012)");
+    job.model = static_cast<Model>(model);
+    job.sampler = specular_sampler(sampler);
+    job.wi = output_view(wi, out_layout, n, "wi");
+    job.weight = output_view(weight, out_layout, n, "weight");
+    job.pdf = scalar_output(pdf, n, "pdf");
+    job.lobe = scalar_output(lobe, n, "lobe");
+    if (check_tolerance > 0.0f) set_direction_check(job, check_tolerance);
+    if (n == 0) return -1;
+    py::gil_scoped_release release;
+    return sample(job, n, threads, isa);
+}
+
+py::array_t<float> uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n) {
+    if (n < 0 || first < 0) throw std::invalid_argument("uniforms: expected first >= 0 and n >= 0");
+    py::array_t<float> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
+    float* data = out.mutable_data();
+    py::gil_scoped_release release;
+    counter_uniforms(seed, first, n, data);
+    return out;
 }
 
 std::int64_t check_directions(const Float32Array& w, int layout, std::int64_t n, float tolerance, int threads) {
@@ -124,6 +190,15 @@ void bind_batch(py::module_& m) {
           py::arg("params"), py::arg("outputs"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
           py::arg("lobes"), py::arg("cosine"), py::arg("check_tolerance"), py::arg("threads"), py::arg("isa"),
           "SIMD evaluation into preallocated float32 outputs (validated by the caller).");
+    m.def("batch_pdf", &batch_pdf, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
+          py::arg("params"), py::arg("pdf"), py::arg("n"), py::arg("sampler"), py::arg("check_tolerance"),
+          py::arg("threads"), py::arg("isa"), "SIMD sampling pdf into a preallocated float32 array.");
+    m.def("batch_sample", &batch_sample, py::arg("wo"), py::arg("wo_layout"), py::arg("u"), py::arg("u_layout"),
+          py::arg("seed"), py::arg("params"), py::arg("wi"), py::arg("weight"), py::arg("out_layout"), py::arg("pdf"),
+          py::arg("lobe"), py::arg("n"), py::arg("model"), py::arg("sampler"), py::arg("check_tolerance"),
+          py::arg("threads"), py::arg("isa"), "SIMD sampling into preallocated outputs.");
+    m.def("counter_uniforms", &uniforms, py::arg("seed"), py::arg("first"), py::arg("n"),
+          "The counter-based uniforms (n, 3) that sampling uses for elements first .. first + n - 1.");
     m.def("check_directions", &check_directions, py::arg("w"), py::arg("layout"), py::arg("n"),
           py::arg("tolerance"), py::arg("threads"),
           "Index of the first non-finite or non-unit direction, or -1.");

@@ -4,11 +4,17 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <initializer_list>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "bindings.hpp"
 #include "principled_brdf/params.hpp"
 #include "principled_brdf/reference.hpp"
+#include "principled_brdf/reference_sampling.hpp"
 
 namespace py = pybind11;
 
@@ -72,12 +78,128 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
     return out;
 }
 
+// The sampling functions take each input as N rows or as a single row shared by
+// all N (a uniform material, one view direction): a packed (N, 13) copy of a
+// uniform material would cost more than the samples.
+struct Rows {
+    const double* data;
+    py::ssize_t stride;  // doubles between consecutive rows: columns, or 0 for a shared row
+    const double* row(py::ssize_t i) const { return data + i * stride; }
+};
+
+py::ssize_t common_row_count(std::initializer_list<const Float64Array*> arrays) {
+    py::ssize_t n = 1;
+    for (const Float64Array* a : arrays)
+        if (a->ndim() == 2 && a->shape(0) != 1) n = a->shape(0);
+    return n;
+}
+
+Rows shared_or_rows(const Float64Array& a, py::ssize_t n, py::ssize_t columns, const char* name) {
+    if (a.ndim() != 2 || a.shape(1) != columns || (a.shape(0) != n && a.shape(0) != 1))
+        throw std::invalid_argument(std::string(name) + ": expected a contiguous (N, " + std::to_string(columns) +
+                                    ") or (1, " + std::to_string(columns) + ") float64 array, N = " +
+                                    std::to_string(n));
+    return {a.data(), a.shape(0) == 1 ? 0 : columns};
+}
+
+Model model_from(int model) {
+    if (model != 0 && model != 1) throw std::invalid_argument("model: expected 0 (disney2014) or 1 (disney2012)");
+    return static_cast<Model>(model);
+}
+
+reference::SpecularSampler sampler_from(int sampler) {
+    if (sampler != 0 && sampler != 1)
+        throw std::invalid_argument("specular_sampler: expected 0 (visible normals) or 1 (distribution)");
+    return static_cast<reference::SpecularSampler>(sampler);
+}
+
+// README "Sampling and pdf": wo (N,3), u (N,3) = (u0, u1, u2), params (N,13); each may be one shared row.
+py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const Float64Array& params, int model,
+                           int sampler) {
+    const py::ssize_t n = common_row_count({&wo, &u, &params});
+    const Rows view = shared_or_rows(wo, n, 3, "wo");
+    const Rows uniforms = shared_or_rows(u, n, 3, "u");
+    const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
+    const Model which_model = model_from(model);
+    const reference::SpecularSampler which_sampler = sampler_from(sampler);
+
+    py::array_t<double> wi_out({n, py::ssize_t(3)}), pdf_out(n), weight_out({n, py::ssize_t(3)});
+    py::array_t<std::int32_t> lobe_out(n);
+    double* wi_data = wi_out.mutable_data();
+    double* pdf_data = pdf_out.mutable_data();
+    double* weight_data = weight_out.mutable_data();
+    std::int32_t* lobe_data = lobe_out.mutable_data();
+    {
+        py::gil_scoped_release release;
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const auto material = reference::Material::from_slots(material_rows.row(i));
+            const double* ui = uniforms.row(i);
+            const auto s =
+                reference::sample(material, Eigen::Vector3d(view.row(i)), ui[0], ui[1], ui[2], which_model, which_sampler);
+            Eigen::Map<Eigen::Vector3d>(wi_data + 3 * i) = s.wi;
+            pdf_data[i] = s.pdf;
+            Eigen::Map<Eigen::Vector3d>(weight_data + 3 * i) = s.weight;
+            lobe_data[i] = s.lobe;
+        }
+    }
+    return py::make_tuple(wi_out, pdf_out, weight_out, lobe_out);
+}
+
+// The mixture pdf (N,) of wi (N,3) given wo (N,3); model is checked but does not change it.
+py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
+                                  int model, int sampler) {
+    const py::ssize_t n = common_row_count({&wi, &wo, &params});
+    const Rows in = shared_or_rows(wi, n, 3, "wi");
+    const Rows view = shared_or_rows(wo, n, 3, "wo");
+    const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
+    model_from(model);
+    const reference::SpecularSampler which_sampler = sampler_from(sampler);
+
+    py::array_t<double> out(n);
+    double* out_data = out.mutable_data();
+    {
+        py::gil_scoped_release release;
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const auto material = reference::Material::from_slots(material_rows.row(i));
+            out_data[i] = reference::pdf(material, Eigen::Vector3d(in.row(i)), Eigen::Vector3d(view.row(i)),
+                                         which_sampler);
+        }
+    }
+    return out;
+}
+
+// (P0, P1, P2) (N,3) at wo (N,3).
+py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const Float64Array& params) {
+    const py::ssize_t n = common_row_count({&wo, &params});
+    const Rows view = shared_or_rows(wo, n, 3, "wo");
+    const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
+    py::array_t<double> out({n, py::ssize_t(3)});
+    double* out_data = out.mutable_data();
+    {
+        py::gil_scoped_release release;
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const auto material = reference::Material::from_slots(material_rows.row(i));
+            const auto p = reference::lobe_probabilities(material, Eigen::Vector3d(view.row(i)));
+            std::copy(p.begin(), p.end(), out_data + 3 * i);
+        }
+    }
+    return out;
+}
+
 }  // namespace
 
 void bind_reference(py::module_& m) {
     m.def("reference_eval", &reference_eval, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
           py::arg("lobes"),
           "Float64 reference f (N,3) or lobes (N,4,3) for packed, already validated rows.");
+    m.def("reference_sample", &reference_sample, py::arg("wo"), py::arg("u"), py::arg("params"), py::arg("model"),
+          py::arg("sampler"),
+          "Float64 reference samples (wi (N,3), pdf (N,), weight (N,3), lobe (N,) int32) for validated rows;\n"
+          "each input is N rows or one shared row.");
+    m.def("reference_pdf", &reference_pdf, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
+          py::arg("sampler"), "Float64 reference mixture pdf (N,) for validated rows (N or one shared row each).");
+    m.def("reference_lobe_probabilities", &reference_lobe_probabilities, py::arg("wo"), py::arg("params"),
+          "Lobe probabilities (N,3) at wo for validated rows (N or one shared row each).");
 }
 
 }  // namespace principled_brdf::bindings

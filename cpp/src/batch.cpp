@@ -47,25 +47,43 @@ std::string active_isa() { return kernel::active().isa; }
 
 int float_lanes(const std::string& isa) { return kernel::by_name(isa, "isa").float_lanes; }
 
-void set_direction_check(EvalJob& job, float tolerance) {
-    // |w| within [1 - tol, 1 + tol]  <=>  |w|² within [(1 - tol)², (1 + tol)²]
-    job.check_directions = true;
-    job.length2_lowest = (1.0f - tolerance) * (1.0f - tolerance);
-    job.length2_highest = (1.0f + tolerance) * (1.0f + tolerance);
-}
-
-std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa) {
-    const kernel::KernelTable& kernels = isa.empty() ? kernel::active() : kernel::by_name(isa, "isa");
+// Runs range(begin, end) over per-thread chunks; the first bad element any returned, or -1.
+template <class Range>
+std::int64_t run_chunks(std::int64_t n, int threads, const Range& range) {
     const int thread_count = resolve_threads(threads);
     const Chunks chunks = split(n, thread_count);
     std::vector<std::int64_t> bad(chunks.count, -1);
     parallel_for(chunks.count, thread_count, [&](int c) {
         const std::int64_t begin = c * chunks.size;
-        bad[c] = kernels.eval_range(job, begin, std::min(n, begin + chunks.size));
+        bad[c] = range(begin, std::min(n, begin + chunks.size));
     });
     for (std::int64_t b : bad)
         if (b >= 0) return b;
     return -1;
+}
+
+const kernel::KernelTable& kernels_for(const std::string& isa) {
+    return isa.empty() ? kernel::active() : kernel::by_name(isa, "isa");
+}
+
+std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa) {
+    const kernel::KernelTable& kernels = kernels_for(isa);
+    return run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) { return kernels.eval_range(job, begin, end); });
+}
+
+std::int64_t sample(const SampleJob& job, std::int64_t n, int threads, const std::string& isa) {
+    const kernel::KernelTable& kernels = kernels_for(isa);
+    return run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) { return kernels.sample_range(job, begin, end); });
+}
+
+namespace rng {
+#include "counter_rng.hpp"
+}  // namespace rng
+
+void counter_uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n, float* out) {
+    const rng::CounterKeys keys = rng::counter_keys(seed);
+    for (std::int64_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) out[3 * i + k] = rng::counter_uniform(static_cast<std::uint64_t>(first + i), keys, k);
 }
 
 void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int threads) {
@@ -87,16 +105,9 @@ std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_t n, fl
         const float length2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
         return n > 0 && !(length2 >= lowest && length2 <= highest) ? 0 : -1;
     }
-    const int thread_count = resolve_threads(threads);
-    const Chunks chunks = split(n, thread_count);
-    std::vector<std::int64_t> first_bad(chunks.count, -1);
-    parallel_for(chunks.count, thread_count, [&](int c) {
-        const std::int64_t begin = c * chunks.size;
-        first_bad[c] = kernels.first_bad_direction(directions, begin, std::min(n, begin + chunks.size), lowest, highest);
+    return run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) {
+        return kernels.first_bad_direction(directions, begin, end, lowest, highest);
     });
-    for (std::int64_t bad : first_bad)
-        if (bad >= 0) return bad;
-    return -1;
 }
 
 }  // namespace principled_brdf

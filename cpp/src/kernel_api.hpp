@@ -17,6 +17,8 @@ struct KernelTable {
     std::int64_t (*eval_range)(const EvalJob& job, std::int64_t begin, std::int64_t end);
     // First i in [begin, end) whose squared length is outside [lowest, highest]
     // or not finite, else -1.
+    // As eval_range, for sampling (the check is on wo).
+    std::int64_t (*sample_range)(const SampleJob& job, std::int64_t begin, std::int64_t end);
     std::int64_t (*first_bad_direction)(const Vec3Array& directions, std::int64_t begin, std::int64_t end,
                                         float lowest, float highest);
 };

@@ -7,6 +7,7 @@ namespace principled_brdf::kernel {
 
 const KernelTable& avx2_kernels() {
     static constexpr KernelTable table{"avx2", static_cast<int>(avx2::kLanes), &avx2::eval_range,
+                                           &avx2::sample_range,
                                            &avx2::first_bad_direction};
     return table;
 }

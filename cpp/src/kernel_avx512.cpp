@@ -7,6 +7,7 @@ namespace principled_brdf::kernel {
 
 const KernelTable& avx512_kernels() {
     static constexpr KernelTable table{"avx512", static_cast<int>(avx512::kLanes), &avx512::eval_range,
+                                           &avx512::sample_range,
                                            &avx512::first_bad_direction};
     return table;
 }

@@ -7,6 +7,7 @@ namespace principled_brdf::kernel {
 
 const KernelTable& neon_kernels() {
     static constexpr KernelTable table{"neon", static_cast<int>(neon::kLanes), &neon::eval_range,
+                                           &neon::sample_range,
                                            &neon::first_bad_direction};
     return table;
 }

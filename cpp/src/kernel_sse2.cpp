@@ -7,6 +7,7 @@ namespace principled_brdf::kernel {
 
 const KernelTable& sse2_kernels() {
     static constexpr KernelTable table{"sse2", static_cast<int>(sse2::kLanes), &sse2::eval_range,
+                                           &sse2::sample_range,
                                            &sse2::first_bad_direction};
     return table;
 }

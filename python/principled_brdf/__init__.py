@@ -4,10 +4,10 @@ See the README for the model (SPEC §3) and the API tour.
 """
 
 from . import microfacet, reference
-from ._batch import cpu_info, eval, eval_lobes
+from ._batch import Sample, cpu_info, eval, eval_lobes, pdf, random_uniforms, sample
 from .material import PARAMETERS, Material, gamma22_to_linear
 from .reference import Lobes
 
-__all__ = ["Material", "PARAMETERS", "Lobes", "gamma22_to_linear", "eval", "eval_lobes", "cpu_info",
-           "reference", "microfacet"]
+__all__ = ["Material", "PARAMETERS", "Lobes", "Sample", "gamma22_to_linear", "eval", "eval_lobes", "pdf", "sample",
+           "random_uniforms", "cpu_info", "reference", "microfacet"]
 __version__ = "0.1.0"

@@ -14,18 +14,38 @@ Input handling, once per call:
 from __future__ import annotations
 
 import operator
+from typing import NamedTuple
 
 import numpy as np
 
 from . import _core
-from ._validate import DIRECTION_LENGTH_TOLERANCE, as_real_array, broadcast_leading, element_name, model_index
+from ._validate import (
+    DIRECTION_LENGTH_TOLERANCE,
+    as_real_array,
+    broadcast_leading,
+    element_name,
+    model_index,
+    require_in_domain,
+)
 from .material import PARAMETERS, Material
 from .reference import Lobes
 
-__all__ = ["eval", "eval_lobes", "cpu_info"]
+__all__ = ["eval", "eval_lobes", "pdf", "sample", "random_uniforms", "Sample", "cpu_info"]
 
 _INTERLEAVED, _ROWS, _SINGLE = 0, 1, 2
 _LAYOUTS = ("aos", "soa")
+
+
+_SPECULAR_SAMPLERS = {"visible": 0, "distribution": 1}
+
+
+class Sample(NamedTuple):
+    """What :func:`sample` returns, per element."""
+
+    wi: np.ndarray  # sampled direction towards the light, (..., 3)
+    pdf: np.ndarray  # mixture density in solid angle, (...); 0 below the horizon
+    weight: np.ndarray  # f(wi, wo) cos θl / pdf, (..., 3); 0 below the horizon
+    lobe: np.ndarray  # int32: 0 cosine (diffuse, subsurface, sheen), 1 specular, 2 clearcoat
 
 
 def cpu_info() -> dict:
@@ -50,6 +70,22 @@ def _threads(threads) -> int:
     if count < 1:
         raise ValueError(f"threads: expected at least 1, got {count}")
     return count
+
+
+def _specular_sampler(name) -> int:
+    if name not in _SPECULAR_SAMPLERS:
+        raise ValueError(f"specular_sampler: expected one of {sorted(_SPECULAR_SAMPLERS)}, got {name!r}")
+    return _SPECULAR_SAMPLERS[name]
+
+
+def _seed(seed) -> int:
+    try:
+        value = operator.index(seed)
+    except TypeError:
+        raise TypeError(f"seed: expected an integer, got {type(seed).__name__}") from None
+    if not 0 <= value < 2**64:
+        raise ValueError(f"seed: expected 0 <= seed < 2**64, got {value}")
+    return value
 
 
 def _isa(isa) -> str:
@@ -136,34 +172,53 @@ def _output(out, shape: tuple, name: str = "out") -> np.ndarray:
     return out
 
 
-def _run(material, wi, wo, model, cosine, layout, threads, check, isa, outputs_for_shape):
+def _require_material(material) -> None:
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
-    model_id = model_index(model)
+
+
+def _size(leading: tuple) -> int:
+    return int(np.prod(leading, dtype=np.int64))
+
+
+def _vec3_shape(leading: tuple, layout: str) -> tuple:
+    return leading + (3,) if layout == "aos" else (3,) + leading
+
+
+def _flat_vec3(array: np.ndarray, layout: str) -> tuple:
+    n = _size(array.shape[:-1] if layout == "aos" else array.shape[1:])
+    return (array.reshape(n, 3), _INTERLEAVED) if layout == "aos" else (array.reshape(3, n), _ROWS)
+
+
+def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs_for_shape, pdf_sampler=None):
+    """eval / eval_lobes / pdf: validated arguments in, outputs written."""
+    _require_material(material)
     layout = _layout(layout)
     thread_count = _threads(threads)
     isa_name = _isa(isa)
     wi_dirs = _Directions("wi", wi, layout)
     wo_dirs = _Directions("wo", wo, layout)
     leading = broadcast_leading(wi=wi_dirs.leading, wo=wo_dirs.leading, material=material.shape)
-    out_shape = leading + (3,) if layout == "aos" else (3,) + leading
-    outputs, fresh = outputs_for_shape(out_shape)
+    outputs, fresh = outputs_for_shape(leading, layout)
     if check and not fresh:
         # The caller's buffer must stay untouched on bad input: check first.
         wi_dirs.check(thread_count)
         wo_dirs.check(thread_count)
-    n = int(np.prod(leading, dtype=np.int64))
+    n = _size(leading)
     wi_flat, wi_code = wi_dirs.flat(leading)
     wo_flat, wo_code = wo_dirs.flat(leading)
-    out_code = _INTERLEAVED if layout == "aos" else _ROWS
-    flat_outputs = [o.reshape((n, 3) if layout == "aos" else (3, n)) for o in outputs]
     # Into fresh outputs the check rides along with the evaluation (one pass
     # over memory instead of two); on a bad direction the partial result is dropped.
     fused_tolerance = DIRECTION_LENGTH_TOLERANCE if check and fresh else 0.0
-    bad = _core.batch_eval(
-        wi_flat, wi_code, wo_flat, wo_code, _params(material, leading), flat_outputs, out_code, n,
-        model_id, len(outputs) == 4, bool(cosine), fused_tolerance, thread_count, isa_name,
-    )
+    params = _params(material, leading)
+    if pdf_sampler is not None:
+        bad = _core.batch_pdf(wi_flat, wi_code, wo_flat, wo_code, params, outputs[0].reshape(n), n, pdf_sampler,
+                              fused_tolerance, thread_count, isa_name)
+    else:
+        flat_outputs = [_flat_vec3(o, layout)[0] for o in outputs]
+        bad = _core.batch_eval(wi_flat, wi_code, wo_flat, wo_code, params, flat_outputs,
+                               _INTERLEAVED if layout == "aos" else _ROWS, n, model_id, len(outputs) == 4,
+                               bool(cosine), fused_tolerance, thread_count, isa_name)
     if bad >= 0:
         wi_dirs.check(thread_count)
         wo_dirs.check(thread_count)
@@ -184,8 +239,8 @@ def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool 
     a non-unit direction is then used as given and a non-finite one gives 0. ``isa``
     picks one of ``cpu_info()["available"]`` (for tests and benchmarks).
     """
-    (f,) = _run(material, wi, wo, model, cosine, layout, threads, check, isa,
-                lambda shape: ([_output(out, shape)], out is None))
+    (f,) = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
+                     lambda leading, layout: ([_output(out, _vec3_shape(leading, layout))], out is None))
     return f
 
 
@@ -193,6 +248,72 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
                threads=None, check: bool = True, isa=None) -> Lobes:
     """The four lobes (diffuse, sheen, specular, clearcoat) as a :class:`Lobes`
     of float32 arrays, each shaped like :func:`eval`'s result."""
-    outputs = _run(material, wi, wo, model, cosine, layout, threads, check, isa,
-                   lambda shape: ([np.empty(shape, dtype=np.float32) for _ in range(4)], True))
+    outputs = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
+                        lambda leading, layout: ([np.empty(_vec3_shape(leading, layout), np.float32) for _ in range(4)],
+                                                 True))
     return Lobes(*outputs)
+
+
+def pdf(material: Material, wi, wo, *, specular_sampler: str = "visible", layout: str = "aos", threads=None,
+        check: bool = True, isa=None) -> np.ndarray:
+    """The density (solid angle) with which :func:`sample` draws ``wi`` given ``wo``:
+    the lobe mixture of README "Sampling and pdf", float32 ``(...)``; 0 when
+    either direction is at or below the horizon. It does not depend on the model."""
+    (density,) = _evaluate(material, wi, wo, 0, False, layout, threads, check, isa,
+                           lambda leading, layout: ([np.empty(leading, np.float32)], True),
+                           pdf_sampler=_specular_sampler(specular_sampler))
+    return density
+
+
+def random_uniforms(seed: int, n: int, first: int = 0) -> np.ndarray:
+    """The ``(n, 3)`` uniforms :func:`sample` draws for elements ``first .. first + n - 1``
+    when given ``seed`` and no ``u`` (a counter-based generator keyed by seed and index)."""
+    count, start = operator.index(n), operator.index(first)
+    if count < 0 or start < 0:
+        raise ValueError(f"n, first: expected non-negative integers, got {count}, {start}")
+    return _core.counter_uniforms(_seed(seed), start, count)
+
+
+def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disney2014",
+           specular_sampler: str = "visible", layout: str = "aos", threads=None, check: bool = True,
+           isa=None) -> Sample:
+    """Importance-sample ``wi`` for each ``wo`` (README "Sampling and pdf").
+
+    ``u``: three uniforms in [0, 1] per element, ``(..., 3)`` (``(3, ...)`` for
+    ``layout="soa"``), broadcast with ``wo`` and the material; without it they
+    come from a counter-based generator keyed by ``(seed, element index)``
+    (C order over the broadcast leading shape), independent of ``threads``.
+    Returns a :class:`Sample` of float32 ``wi``, ``pdf``, ``weight`` and int32 ``lobe``.
+    """
+    _require_material(material)
+    model_id = model_index(model)
+    sampler = _specular_sampler(specular_sampler)
+    layout = _layout(layout)
+    thread_count = _threads(threads)
+    isa_name = _isa(isa)
+    seed_value = _seed(seed)
+    wo_dirs = _Directions("wo", wo, layout)
+    shapes = dict(wo=wo_dirs.leading, material=material.shape)
+    uniforms = None
+    if u is not None:
+        uniforms = _Directions("u", u, layout)  # shape and dtype handling of a 3-vector argument
+        require_in_domain("u", uniforms.array, 0.0, 1.0)
+        shapes["u"] = uniforms.leading
+    leading = broadcast_leading(**shapes)
+    n = _size(leading)
+    wi_out = np.empty(_vec3_shape(leading, layout), np.float32)
+    weight_out = np.empty_like(wi_out)
+    pdf_out = np.empty(leading, np.float32)
+    lobe_out = np.empty(leading, np.int32)
+    wo_flat, wo_code = wo_dirs.flat(leading)
+    u_flat, u_code = uniforms.flat(leading) if uniforms is not None else (None, 0)
+    bad = _core.batch_sample(
+        wo_flat, wo_code, u_flat, u_code, seed_value, _params(material, leading), _flat_vec3(wi_out, layout)[0],
+        _flat_vec3(weight_out, layout)[0], _INTERLEAVED if layout == "aos" else _ROWS, pdf_out.reshape(n),
+        lobe_out.reshape(n), n, model_id, sampler, DIRECTION_LENGTH_TOLERANCE if check else 0.0, thread_count,
+        isa_name,
+    )
+    if bad >= 0:
+        wo_dirs.check(thread_count)
+        raise RuntimeError("internal error: the kernel rejected a direction the checks accept")
+    return Sample(wi_out, pdf_out, weight_out, lobe_out)

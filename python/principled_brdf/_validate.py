@@ -43,20 +43,29 @@ def as_real_array(name: str, value) -> np.ndarray:
     return array.astype(np.float64, copy=False)
 
 
+def _not_finite_message(name: str, flat_index: int, array: np.ndarray) -> str:
+    # float() so the message reads "nan", not numpy 2's "np.float64(nan)"
+    return f"{element_name(name, flat_index, array.shape)}: {float(array.ravel()[flat_index])!r} is not a finite number"
+
+
 def require_finite(name: str, array: np.ndarray) -> None:
     bad = ~np.isfinite(array)
     if bad.any():
-        i = first_true(bad)
-        raise ValueError(f"{element_name(name, i, array.shape)}: {array.ravel()[i]!r} is not a finite number")
+        raise ValueError(_not_finite_message(name, first_true(bad), array))
 
 
 def require_in_domain(name: str, array: np.ndarray, lower: float, upper: float) -> None:
-    require_finite(name, array)
-    bad = (array < lower) | (array > upper)
+    not_finite = ~np.isfinite(array)
+    with np.errstate(invalid="ignore"):
+        bad = not_finite | (array < lower) | (array > upper)
     if bad.any():
-        i = first_true(bad)
+        i = first_true(bad)  # the first offending element, whichever the fault
+        if not_finite.ravel()[i]:
+            raise ValueError(_not_finite_message(name, i, array))
         domain = f"[{lower:g}, {'inf' if np.isinf(upper) else f'{upper:g}'}{')' if np.isinf(upper) else ']'}"
-        raise ValueError(f"{element_name(name, i, array.shape)}: {array.ravel()[i]!r} is outside its domain {domain}")
+        raise ValueError(
+            f"{element_name(name, i, array.shape)}: {float(array.ravel()[i])!r} is outside its domain {domain}"
+        )
 
 
 def directions(name: str, value) -> np.ndarray:
@@ -64,11 +73,14 @@ def directions(name: str, value) -> np.ndarray:
     array = as_real_array(name, value)
     if array.ndim == 0 or array.shape[-1] != 3:
         raise ValueError(f"{name}: expected shape (..., 3) with unit 3-vectors on the last axis, got {array.shape}")
-    require_finite(name, array)
-    length = np.sqrt(np.einsum("...i,...i->...", array, array))
-    bad = np.abs(length - 1.0) > DIRECTION_LENGTH_TOLERANCE
+    not_finite = ~np.isfinite(array)
+    with np.errstate(invalid="ignore", over="ignore"):
+        length = np.sqrt(np.einsum("...i,...i->...", array, array))
+        bad = not_finite.any(axis=-1) | (np.abs(length - 1.0) > DIRECTION_LENGTH_TOLERANCE)
     if bad.any():
-        i = first_true(bad)
+        i = first_true(bad)  # the first offending vector, whichever the fault
+        if not_finite.reshape(-1, 3)[i].any():
+            raise ValueError(_not_finite_message(name, 3 * i + first_true(not_finite.reshape(-1, 3)[i]), array))
         raise ValueError(
             f"{element_name(name, i, length.shape)}: length {length.ravel()[i]:.6g} is not 1 "
             f"(within {DIRECTION_LENGTH_TOLERANCE:g})"

@@ -61,6 +61,9 @@ class Material:
     def __setattr__(self, name, value):
         raise AttributeError("Material is immutable; build a new one (or use Material.replace)")
 
+    def __delattr__(self, name):
+        raise AttributeError("Material is immutable; build a new one (or use Material.replace)")
+
     @property
     def shape(self) -> tuple:
         """Leading shape the per-element parameters broadcast to (``()`` if all uniform)."""

@@ -7,10 +7,13 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
-from ._validate import broadcast_leading, directions, model_index
+from ._validate import as_real_array, broadcast_leading, directions, model_index, require_in_domain
 from .material import Material
 
-__all__ = ["eval", "eval_lobes", "Lobes"]
+__all__ = ["eval", "eval_lobes", "Lobes", "sample", "pdf", "lobe_probabilities", "Sample", "SPECULAR_SAMPLERS"]
+
+# README "Sampling and pdf": how the primary specular lobe draws its half vector.
+SPECULAR_SAMPLERS = {"visible": 0, "distribution": 1}
 
 
 class Lobes(NamedTuple):
@@ -52,3 +55,107 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
     if cosine:
         lobes *= np.maximum(wi_rows[:, None, 2:3], 0.0)
     return Lobes(*(lobes[:, k, :].reshape(shape + (3,)) for k in range(4)))
+
+
+# --------------------------------------------------------------------------
+# sampling (README "Sampling and pdf")
+
+
+class Sample(NamedTuple):
+    """What ``sample`` returns (the SIMD ``pb.sample`` returns the same type)."""
+
+    wi: np.ndarray  # (..., 3) drawn direction towards the light
+    pdf: np.ndarray  # (...) mixture density in solid angle; 0 at or below the horizon
+    weight: np.ndarray  # (..., 3) f(wi, wo) cos θl / pdf; 0 where pdf is 0
+    lobe: np.ndarray  # (...) int32: 0 cosine, 1 primary specular, 2 clearcoat
+
+
+def specular_sampler_index(specular_sampler) -> int:
+    if not isinstance(specular_sampler, str) or specular_sampler not in SPECULAR_SAMPLERS:
+        raise ValueError(f"specular_sampler: expected one of {sorted(SPECULAR_SAMPLERS)}, got {specular_sampler!r}")
+    return SPECULAR_SAMPLERS[specular_sampler]
+
+
+def uniforms(name: str, value) -> np.ndarray:
+    """A float64 ``(..., 3)`` array of numbers in [0, 1], checked (SPEC §7)."""
+    array = as_real_array(name, value)
+    if array.ndim == 0 or array.shape[-1] != 3:
+        raise ValueError(f"{name}: expected shape (..., 3) with (u0, u1, u2) on the last axis, got {array.shape}")
+    require_in_domain(name, array, 0.0, 1.0)
+    return array
+
+
+def _shared_or_rows(array: np.ndarray, shape: tuple, columns: int) -> np.ndarray:
+    """``(1, columns)`` when the argument is one row for every element, else ``(N, columns)`` rows."""
+    if array.size == columns:
+        return np.ascontiguousarray(array.reshape(1, columns))
+    return np.ascontiguousarray(np.broadcast_to(array, shape + (columns,)).reshape(-1, columns))
+
+
+def _material_rows(material: Material, shape: tuple) -> np.ndarray:
+    return material.packed(()) if material.is_uniform else material.packed(shape)
+
+
+def _check_material(material) -> None:
+    if not isinstance(material, Material):
+        raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
+
+
+def sample(material: Material, wo, u, *, model: str = "disney2014", specular_sampler: str = "visible") -> Sample:
+    """Draws ``wi`` for each ``wo`` from the three-lobe mixture of README "Sampling and pdf".
+
+    ``u`` holds three uniforms in [0, 1] per element, ``(u0, u1, u2)`` on the last
+    axis: ``u0`` chooses the lobe, ``u1, u2`` the direction. ``material``, ``wo``
+    and ``u`` broadcast over their leading shapes. Returns a :class:`Sample` of
+    float64 arrays (``lobe`` int32); ``pdf`` is the mixture density, the number
+    :func:`pdf` gives for the returned pair, and ``weight = f cos θl / pdf``;
+    both are 0 when ``wi`` or ``wo`` is at or below the horizon.
+    """
+    _check_material(material)
+    model_id = model_index(model)
+    sampler_id = specular_sampler_index(specular_sampler)
+    wo = directions("wo", wo)
+    u = uniforms("u", u)
+    shape = broadcast_leading(wo=wo.shape[:-1], u=u.shape[:-1], material=material.shape)
+    if int(np.prod(shape, dtype=np.int64)) == 0:
+        return Sample(np.zeros(shape + (3,)), np.zeros(shape), np.zeros(shape + (3,)), np.zeros(shape, np.int32))
+    wi, density, weight, lobe = _core.reference_sample(
+        _shared_or_rows(wo, shape, 3), _shared_or_rows(u, shape, 3), _material_rows(material, shape),
+        model_id, sampler_id)
+    if wi.shape[0] != int(np.prod(shape, dtype=np.int64)):  # every argument was a single row
+        wi, density, weight, lobe = (np.broadcast_to(a, (int(np.prod(shape, dtype=np.int64)),) + a.shape[1:]).copy()
+                                     for a in (wi, density, weight, lobe))
+    return Sample(wi.reshape(shape + (3,)), density.reshape(shape), weight.reshape(shape + (3,)), lobe.reshape(shape))
+
+
+def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampler: str = "visible") -> np.ndarray:
+    """The mixture density ``P0 pdf0 + P1 pdf1 + P2 pdf2`` of ``wi`` given ``wo``, float64 ``(...)``.
+
+    0 unless both directions lie strictly above the horizon. It does not depend on
+    ``model`` (accepted for symmetry with :func:`sample`; only the weights do).
+    """
+    _check_material(material)
+    model_id = model_index(model)
+    sampler_id = specular_sampler_index(specular_sampler)
+    wi = directions("wi", wi)
+    wo = directions("wo", wo)
+    shape = broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
+    n = int(np.prod(shape, dtype=np.int64))
+    if n == 0:
+        return np.zeros(shape)
+    density = _core.reference_pdf(_shared_or_rows(wi, shape, 3), _shared_or_rows(wo, shape, 3),
+                                  _material_rows(material, shape), model_id, sampler_id)
+    return np.broadcast_to(density, (n,)).reshape(shape).copy() if density.shape[0] != n else density.reshape(shape)
+
+
+def lobe_probabilities(material: Material, wo) -> np.ndarray:
+    """``(P0, P1, P2)`` on the last axis, ``(..., 3)``: the chances of the cosine, primary
+    specular and clearcoat lobes at ``wo`` (README "Lobe probabilities")."""
+    _check_material(material)
+    wo = directions("wo", wo)
+    shape = broadcast_leading(wo=wo.shape[:-1], material=material.shape)
+    n = int(np.prod(shape, dtype=np.int64))
+    if n == 0:
+        return np.zeros(shape + (3,))
+    p = _core.reference_lobe_probabilities(_shared_or_rows(wo, shape, 3), _material_rows(material, shape))
+    return (np.broadcast_to(p, (n, 3)).copy() if p.shape[0] != n else p).reshape(shape + (3,))

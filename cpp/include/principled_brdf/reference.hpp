@@ -1,8 +1,11 @@
 // Float64 reference of the Disney principled BRDF (SPEC §3), one function per
 // lobe, then their sum. Plain on purpose: this is the yardstick the SIMD kernel
-// is measured against, so it reads like the spec. The one liberty taken is to
-// write sin²θh from the components of H = wi + wo instead of 1 - cos²θh, which
-// keeps the narrow GTR1 peak (alpha down to 0.001) accurate to the last digits.
+// is measured against, so it reads like the spec. Two liberties keep it
+// accurate to the last digits where the literal form cancels, both exact for
+// unit vectors: sin²θh from the components of H = wi + wo instead of
+// 1 - cos²θh (the GTR1 peak, alpha down to 0.001), and cos θd = |H| / 2 with
+// 1 - cos θd = |wi - wo|² / (4 (1 + cos θd)) (Schlick's (1 - cos θd)^5 as
+// wi -> wo). The latter also makes f exactly reciprocal.
 #pragma once
 
 #include <Eigen/Core>
@@ -64,7 +67,8 @@ struct Geometry {
     Vector3d h;           // normalize(wi + wo)
     double cos2_theta_h;  // (n·h)²
     double sin2_theta_h;  // 1 - (n·h)², from the tangential part of H
-    double cos_theta_d;   // wi·h
+    double cos_theta_d;   // wi·h = wo·h = |H| / 2
+    double one_minus_cos_theta_d;
 
     static Geometry from(const Vector3d& wi, const Vector3d& wo) {
         Geometry g;
@@ -75,7 +79,8 @@ struct Geometry {
         g.h = half_sum * std::sqrt(inv_len2);
         g.cos2_theta_h = half_sum.z() * half_sum.z() * inv_len2;
         g.sin2_theta_h = (half_sum.x() * half_sum.x() + half_sum.y() * half_sum.y()) * inv_len2;
-        g.cos_theta_d = wi.dot(g.h);
+        g.cos_theta_d = 0.5 * std::sqrt(half_sum.squaredNorm());
+        g.one_minus_cos_theta_d = (wi - wo).squaredNorm() / (4.0 * (1.0 + g.cos_theta_d));
         return g;
     }
 };
@@ -83,11 +88,13 @@ struct Geometry {
 inline double mix(double a, double b, double t) { return a + (b - a) * t; }
 inline Vector3d mix(const Vector3d& a, const Vector3d& b, double t) { return a + (b - a) * t; }
 
-// Schlick(u) = clamp(1 - u, 0, 1)^5
-inline double schlick_weight(double u) {
-    const double m = std::clamp(1.0 - u, 0.0, 1.0);
+// Schlick(u) = clamp(1 - u, 0, 1)^5, given 1 - u
+inline double schlick_weight_of_complement(double one_minus_u) {
+    const double m = std::clamp(one_minus_u, 0.0, 1.0);
     return m * m * m * m * m;
 }
+
+inline double schlick_weight(double u) { return schlick_weight_of_complement(1.0 - u); }
 
 // Hue and saturation of the base colour at unit luminance (Ctint).
 inline Vector3d tint(const Vector3d& base_color) {
@@ -128,7 +135,7 @@ inline Vector3d diffuse_lobe(const Material& m, const Geometry& g) {
 // Sheen: FH sheen Csheen (1 - metallic).
 inline Vector3d sheen_lobe(const Material& m, const Geometry& g) {
     const Vector3d sheen_color = mix(Vector3d::Ones(), tint(m.base_color), m.sheen_tint);
-    return schlick_weight(g.cos_theta_d) * m.sheen * sheen_color * (1.0 - m.metallic);
+    return schlick_weight_of_complement(g.one_minus_cos_theta_d) * m.sheen * sheen_color * (1.0 - m.metallic);
 }
 
 // Anisotropic GTR2 (GGX), seed 000 eq. 13.
@@ -159,7 +166,7 @@ inline Vector3d specular_lobe(const Material& m, const Vector3d& wi, const Vecto
     double alpha_x, alpha_y;
     specular_alphas(m, alpha_x, alpha_y);
     const double ds = gtr2_aniso_d(g, alpha_x, alpha_y);
-    const Vector3d fs = mix(specular_f0(m), Vector3d::Ones(), schlick_weight(g.cos_theta_d));
+    const Vector3d fs = mix(specular_f0(m), Vector3d::Ones(), schlick_weight_of_complement(g.one_minus_cos_theta_d));
     double gs;
     if (model == Model::kDisney2012) {
         const double alpha_g = (0.5 + 0.5 * m.roughness) * (0.5 + 0.5 * m.roughness);
@@ -180,7 +187,7 @@ inline double gtr1_d(const Geometry& g, double alpha) {
 // Clearcoat 0.25 clearcoat Gr Fr Dr, alpha = mix(0.1, 0.001, clearcoat_gloss).
 inline Vector3d clearcoat_lobe(const Material& m, const Geometry& g) {
     const double dr = gtr1_d(g, mix(0.1, 0.001, m.clearcoat_gloss));
-    const double fr = mix(0.04, 1.0, schlick_weight(g.cos_theta_d));
+    const double fr = mix(0.04, 1.0, schlick_weight_of_complement(g.one_minus_cos_theta_d));
     const double gr = smith_ggx_iso_s(g.cos_theta_l, 0.25) * smith_ggx_iso_s(g.cos_theta_v, 0.25);
     return Vector3d::Constant(0.25 * m.clearcoat * gr * fr * dr);
 }

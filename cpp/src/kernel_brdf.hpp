@@ -1,0 +1,143 @@
+// Part of kernel.hpp, included inside the per-arch namespace: the lobes of SPEC §3 on the unnormalised half vector.
+#pragma once  // (per translation unit)
+
+// n·w + sqrt(q), the denominator of the Smith factor S(w) = G1(w) / (2 n·w)
+// of SPEC §3, given q = (w·x ax)² + (w·y ay)² + (n·w)². Products of these
+// share one reciprocal.
+inline Floats smith_denominator(Floats cos_theta, Floats q) { return xsimd::fma(q, reciprocal_sqrt(q), cos_theta); }
+
+// Isotropic form, alpha² = a2: q = a2 + cos²(1 - a2)
+inline Floats smith_denominator_iso(Floats cos_theta, Floats a2) {
+    return smith_denominator(cos_theta, xsimd::fma(cos_theta * cos_theta, Floats(1.0f) - a2, a2));
+}
+
+struct LobeValues {
+    Rgb diffuse, sheen, specular;
+    Floats clearcoat;
+    Mask finite_half_vector;  // false where a direction held NaN or infinity (checks off)
+};
+
+// What every lobe and pdf needs of a pair (wi, wo), through the unnormalised
+// half vector H = wi + wo.
+struct Geometry {
+    Vec3 wi, wo;
+    Floats hx2, hy2, hz, hz2;
+    Floats h_len2;       // |H|²
+    Floats cos_theta_d;  // |H| / 2 (= wi·h = wo·h for unit vectors)
+    Floats one_minus_cos_theta_d;  // |wi - wo|² / (4 (1 + cos θd)): no cancellation as wi -> wo
+    Mask finite;         // false where a direction held NaN or infinity (checks off)
+};
+
+inline Geometry geometry_of(const Vec3& wi, const Vec3& wo) {
+    Geometry g;
+    g.wi = wi;
+    g.wo = wo;
+    const Floats hx = wi.x + wo.x, hy = wi.y + wo.y;
+    g.hz = wi.z + wo.z;
+    g.hx2 = hx * hx;
+    g.hy2 = hy * hy;
+    g.hz2 = g.hz * g.hz;
+    g.h_len2 = g.hx2 + g.hy2 + g.hz2;
+    g.finite = g.h_len2 <= Floats(std::numeric_limits<float>::max());
+    g.cos_theta_d = 0.5f * g.h_len2 * reciprocal_sqrt(g.h_len2);
+    const Floats dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
+    const Floats d_len2 = xsimd::fma(dx, dx, xsimd::fma(dy, dy, dz * dz));
+    g.one_minus_cos_theta_d = d_len2 * reciprocal(4.0f + 4.0f * g.cos_theta_d);
+    return g;
+}
+
+// GTR2 aniso: Ds = 1/(π ax ay (hx²/ax² + hy²/ay² + hz²)²), with h = H/|H|
+inline Floats gtr2_aniso_d(const Geometry& g, const Shading& s) {
+    const Floats stretched = xsimd::fma(g.hx2, s.inv_alpha_x2, xsimd::fma(g.hy2, s.inv_alpha_y2, g.hz2));
+    const Floats ds_root = g.h_len2 * reciprocal(stretched);
+    return s.ggx_norm * ds_root * ds_root;
+}
+
+// |H|² (ac² cos²θh + sin²θh): GTR1 is gtr1_norm |H|² over this
+inline Floats gtr1_denominator(const Geometry& g, const Shading& s) {
+    return xsimd::fma(s.clearcoat_alpha2, g.hz2, g.hx2 + g.hy2);
+}
+
+// Smith denominator of the 2014 model for w: n·w + sqrt((w·x ax)² + (w·y ay)² + (n·w)²)
+inline Floats smith_denominator_aniso(const Vec3& w, const Shading& s) {
+    return smith_denominator(w.z, xsimd::fma(s.alpha_x2, w.x * w.x, xsimd::fma(s.alpha_y2, w.y * w.y, w.z * w.z)));
+}
+
+template <Model model>
+inline LobeValues eval_lobes(const Geometry& g, const Shading& s) {
+    const Floats one(1.0f);
+    const Vec3& wi = g.wi;
+    const Vec3& wo = g.wo;
+    const Floats cos_theta_l = wi.z, cos_theta_v = wo.z;
+    const Floats cos2_theta_d = 0.25f * g.h_len2;
+    LobeValues out;
+    out.finite_half_vector = g.finite;
+
+    const Floats fl = schlick_weight(cos_theta_l);
+    const Floats fv = schlick_weight(cos_theta_v);
+    const Floats fh = schlick_weight_of_complement(g.one_minus_cos_theta_d);
+
+    // Diffuse: Fd = mix(1, Fd90, FL) mix(1, Fd90, FV), Fd90 = 0.5 + 2 roughness cos²θd
+    const Floats fd90_minus_1 = xsimd::fma(2.0f * s.roughness, cos2_theta_d, Floats(-0.5f));
+    const Floats fd = xsimd::fma(fd90_minus_1, fl, one) * xsimd::fma(fd90_minus_1, fv, one);
+    // Subsurface: ss = 1.25 (Fss (1/(cos θl + cos θv) - 0.5) + 0.5), Fss90 = roughness cos²θd
+    const Floats fss90_minus_1 = xsimd::fms(s.roughness, cos2_theta_d, one);
+    const Floats fss = xsimd::fma(fss90_minus_1, fl, one) * xsimd::fma(fss90_minus_1, fv, one);
+    const Floats inv_cos_sum = reciprocal(cos_theta_l + cos_theta_v);
+    const Floats ss = 1.25f * xsimd::fma(fss, inv_cos_sum - 0.5f, Floats(0.5f));
+    out.diffuse = mix(fd, ss, s.subsurface) * s.diffuse_color;
+
+    out.sheen = fh * s.sheen_color;
+
+    const Floats ds = gtr2_aniso_d(g, s);
+    Floats gs_denominator;
+    if constexpr (model == Model::kDisney2012) {
+        gs_denominator = smith_denominator_iso(cos_theta_l, s.alpha_g2) * smith_denominator_iso(cos_theta_v, s.alpha_g2);
+    } else {
+        gs_denominator = smith_denominator_aniso(wi, s) * smith_denominator_aniso(wo, s);
+    }
+    out.specular = (ds * reciprocal(gs_denominator)) * mix(s.specular_f0, Rgb{one, one, one}, fh);
+
+    // Clearcoat 0.25 clearcoat Gr Fr Dr with GTR1 Dr = (ac² - 1)/(π ln ac²) / (ac² cos²θh + sin²θh)
+    // (the constants are in clearcoat_scale) and Gr = S(wi) S(wo) at alpha 0.25.
+    const Floats fr = xsimd::fma(Floats(0.96f), fh, Floats(0.04f));
+    const Floats quarter2 = Floats(0.0625f);
+    const Floats gr_denominator = smith_denominator_iso(cos_theta_l, quarter2) * smith_denominator_iso(cos_theta_v, quarter2);
+    out.clearcoat = s.clearcoat_scale * fr * g.h_len2 * reciprocal(gtr1_denominator(g, s) * gr_denominator);
+    return out;
+}
+
+
+// ---------------------------------------------------------------- pdf
+// README "Sampling and pdf": the mixture of the cosine lobe, the primary
+// specular and the clearcoat, with probabilities from the albedo estimates.
+
+struct LobeProbabilities {
+    Floats cosine, specular, clearcoat;
+};
+
+// w0 = (1 - metallic)(Cdlum + 0.1 sheen lum(Csheen)), w1 = max(lum(mix(Cspec0, 1, FV)), 0.02),
+// w2 = 0.25 clearcoat mix(0.04, 1, FV); P_k = w_k / Σ w.
+inline LobeProbabilities lobe_probabilities(Floats cos_theta_v, const Shading& s) {
+    const Floats fv = schlick_weight(cos_theta_v);
+    const Floats w0 = s.cosine_lobe_weight;
+    const Floats w1 = xsimd::max(mix(s.specular_f0_luminance, Floats(1.0f), fv), Floats(0.02f));
+    const Floats w2 = s.clearcoat_lobe_weight * xsimd::fma(Floats(0.96f), fv, Floats(0.04f));
+    const Floats inv_total = Floats(1.0f) / (w0 + w1 + w2);
+    return {w0 * inv_total, w1 * inv_total, w2 * inv_total};
+}
+
+// Σ P_k pdf_k(wi), before the horizon test:
+//   pdf0 = cos θl / π
+//   pdf1 = G1(wo) Ds / (4 cos θv) = Ds / (2 (cos θv + sqrt(q_v)))   (visible normals)
+//        = Ds cos θh / (4 cos θd) = Ds Hz / (2 |H|²)                (distribution)
+//   pdf2 = Dr cos θh / (4 cos θd) = gtr1_norm Hz / (2 gtr1_denominator)
+// with cos θh = Hz / |H| and cos θd = |H| / 2.
+inline Floats mixture_pdf(const Geometry& g, const Shading& s, const LobeProbabilities& p, SpecularSampler sampler) {
+    const Floats ds = gtr2_aniso_d(g, s);
+    const Floats pdf1 = sampler == SpecularSampler::kDistribution
+                            ? ds * g.hz * reciprocal(2.0f * g.h_len2)
+                            : ds * reciprocal(2.0f * smith_denominator_aniso(g.wo, s));
+    const Floats pdf2 = s.gtr1_norm * g.hz * reciprocal(2.0f * gtr1_denominator(g, s));
+    return xsimd::fma(p.cosine, kInvPi * g.wi.z, xsimd::fma(p.specular, pdf1, p.clearcoat * pdf2));
+}

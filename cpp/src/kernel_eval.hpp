@@ -1,0 +1,130 @@
+// Part of kernel.hpp, included inside the per-arch namespace: the evaluation
+// loop (f, the lobes, or the sampling pdf) over a range of elements.
+#pragma once  // (per translation unit)
+
+template <Model model, Output output, Layouts layouts>
+inline void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const Vec3& wo, const Shading& s) {
+    const Geometry g = geometry_of(wi, wo);
+    // 0 unless both directions are strictly above the surface (SPEC §1);
+    // select also discards whatever the formulas gave there (H may be 0).
+    const Mask above = (wi.z > Floats(0.0f)) & (wo.z > Floats(0.0f)) & g.finite;
+
+    if constexpr (output == Output::kPdf) {
+        const Floats pdf = mixture_pdf(g, s, lobe_probabilities(wo.z, s), job.sampler);
+        xsimd::select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
+    } else {
+        const LobeValues lobes = eval_lobes<model>(g, s);
+        const Floats weight = job.cosine ? wi.z : Floats(1.0f);
+        auto masked = [&](const Rgb& c) {
+            return Rgb{xsimd::select(above, weight * c.r, Floats(0.0f)), xsimd::select(above, weight * c.g, Floats(0.0f)),
+                       xsimd::select(above, weight * c.b, Floats(0.0f))};
+        };
+        const Rgb clearcoat{lobes.clearcoat, lobes.clearcoat, lobes.clearcoat};
+        if constexpr (output == Output::kLobes) {
+            store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse));
+            store_rgb<layouts>(job.out[1], i, masked(lobes.sheen));
+            store_rgb<layouts>(job.out[2], i, masked(lobes.specular));
+            store_rgb<layouts>(job.out[3], i, masked(clearcoat));
+        } else {
+            store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse + lobes.sheen + lobes.specular + clearcoat));
+        }
+    }
+}
+
+// One batch at i; false, with nothing stored, when the fused direction check fails.
+template <Model model, Output output, bool per_element, Layouts layouts>
+inline bool eval_one_batch(const EvalJob& job, std::int64_t i, const Shading& uniform) {
+    const Vec3 wi = load_vec3<layouts>(job.wi, i);
+    const Vec3 wo = load_vec3<layouts>(job.wo, i);
+    if (job.check_directions) {
+        const Mask ok = unit_length(wi, job.length2_lowest, job.length2_highest) &
+                        unit_length(wo, job.length2_lowest, job.length2_highest);
+        if (!xsimd::all(ok)) return false;
+    }
+    if constexpr (per_element) {
+        eval_batch<model, output, layouts>(job, i, wi, wo, shading_of(load_material(job.params, i)));
+    } else {
+        eval_batch<model, output, layouts>(job, i, wi, wo, uniform);
+    }
+    return true;
+}
+
+inline std::int64_t first_bad_pair(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i)
+        if (!unit_length(job.wi, i, job.length2_lowest, job.length2_highest) ||
+            !unit_length(job.wo, i, job.length2_lowest, job.length2_highest))
+            return i;
+    return -1;
+}
+
+template <Model model, Output output, bool per_element>
+bool eval_tail(const EvalJob& job, const Padding& pad, const Shading& uniform) {
+    alignas(64) PadBuffer wi, wo, params[kParamSlots], out[kLobeCount];
+    alignas(64) float pdf[kLanes];
+    EvalJob padded = job;
+    padded.wi = pad_vec3(job.wi, pad, wi);
+    padded.wo = pad_vec3(job.wo, pad, wo);
+    pad_params(job.params, padded.params, pad, params);
+    const int outputs = output == Output::kLobes ? kLobeCount : output == Output::kTotal ? 1 : 0;
+    for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
+    padded.pdf = pdf;
+
+    if (!eval_one_batch<model, output, per_element, Layouts::kInterleaved>(padded, 0, uniform)) return false;
+
+    for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
+    if (output == Output::kPdf) unpad_scalars(job.pdf, pad, pdf);
+    return true;
+}
+
+template <Model model, Output output, bool per_element, Layouts layouts>
+std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    Shading uniform{};
+    if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
+    std::int64_t i = begin;
+    for (; i + kLanes <= end; i += kLanes)
+        if (!eval_one_batch<model, output, per_element, layouts>(job, i, uniform)) return first_bad_pair(job, i, i + kLanes);
+    if (i < end && !eval_tail<model, output, per_element>(job, Padding{i, end - i}, uniform))
+        return first_bad_pair(job, i, end);
+    return -1;
+}
+
+inline Layouts layouts_of(const EvalJob& job) {
+    const int outputs = job.output == Output::kLobes ? kLobeCount : job.output == Output::kTotal ? 1 : 0;
+    for (Vec3Layout layout : {Vec3Layout::kInterleaved, Vec3Layout::kRows}) {
+        bool all = job.wi.layout == layout && job.wo.layout == layout;
+        for (int k = 0; k < outputs; ++k) all = all && job.out[k].layout == layout;
+        if (all) return layout == Vec3Layout::kInterleaved ? Layouts::kInterleaved : Layouts::kRows;
+    }
+    return Layouts::kMixed;
+}
+
+template <Model model, Output output, bool per_element>
+std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    switch (layouts_of(job)) {
+        case Layouts::kInterleaved:
+            return eval_loop<model, output, per_element, Layouts::kInterleaved>(job, begin, end);
+        case Layouts::kRows:
+            return eval_loop<model, output, per_element, Layouts::kRows>(job, begin, end);
+        default:
+            return eval_loop<model, output, per_element, Layouts::kMixed>(job, begin, end);
+    }
+}
+
+template <Model model, Output output>
+std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    return job.uniform_material() ? eval_range_for<model, output, false>(job, begin, end)
+                                  : eval_range_for<model, output, true>(job, begin, end);
+}
+
+inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    switch (job.output) {
+        case Output::kPdf:  // the pdf does not depend on the model
+            return eval_range_for<Model::kDisney2014, Output::kPdf>(job, begin, end);
+        case Output::kLobes:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kLobes>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kLobes>(job, begin, end);
+        default:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kTotal>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kTotal>(job, begin, end);
+    }
+}

@@ -1,0 +1,119 @@
+// Part of kernel.hpp, included inside the per-arch namespace: loads and stores in the three layouts, direction checks.
+#pragma once  // (per translation unit)
+
+// Every array of a call in one layout lets the loop be compiled for it;
+// kMixedLayouts reads each array's layout at run time.
+enum class Layouts { kInterleaved, kRows, kMixed };
+
+template <Layouts layouts = Layouts::kMixed>
+inline Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
+    if constexpr (layouts == Layouts::kInterleaved) {
+        Vec3 v;
+        load_interleaved(a.data + 3 * i, v.x, v.y, v.z);
+        return v;
+    } else if constexpr (layouts == Layouts::kRows) {
+        return {Floats::load_unaligned(a.data + i), Floats::load_unaligned(a.data + a.row_stride + i),
+                Floats::load_unaligned(a.data + 2 * a.row_stride + i)};
+    }
+    switch (a.layout) {
+        case Vec3Layout::kInterleaved: {
+            Vec3 v;
+            load_interleaved(a.data + 3 * i, v.x, v.y, v.z);
+            return v;
+        }
+        case Vec3Layout::kRows:
+            return {Floats::load_unaligned(a.data + i), Floats::load_unaligned(a.data + a.row_stride + i),
+                    Floats::load_unaligned(a.data + 2 * a.row_stride + i)};
+        default:
+            return {Floats(a.data[0]), Floats(a.data[1]), Floats(a.data[2])};
+    }
+}
+
+template <Layouts layouts = Layouts::kMixed>
+inline void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb& c) {
+    if (layouts == Layouts::kInterleaved || (layouts == Layouts::kMixed && a.layout == Vec3Layout::kInterleaved)) {
+        store_interleaved(a.data + 3 * i, c.r, c.g, c.b);
+    } else {
+        c.r.store_unaligned(a.data + i);
+        c.g.store_unaligned(a.data + a.row_stride + i);
+        c.b.store_unaligned(a.data + 2 * a.row_stride + i);
+    }
+}
+
+// SPEC §7: squared length within [lowest, highest]; a NaN fails both
+// comparisons and an infinity the second.
+inline Mask unit_length(const Vec3& w, float lowest, float highest) {
+    const Floats length2 = w.x * w.x + w.y * w.y + w.z * w.z;
+    return (length2 >= Floats(lowest)) & (length2 <= Floats(highest));
+}
+
+inline bool unit_length(const Vec3Array& a, std::int64_t i, float lowest, float highest) {
+    const float* p = a.layout == Vec3Layout::kSingle ? a.data : a.layout == Vec3Layout::kRows ? a.data + i : a.data + 3 * i;
+    const std::int64_t stride = a.layout == Vec3Layout::kRows ? a.row_stride : 1;
+    const float length2 = p[0] * p[0] + p[stride] * p[stride] + p[2 * stride] * p[2 * stride];
+    return length2 >= lowest && length2 <= highest;
+}
+
+inline std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_t begin, std::int64_t end,
+                                        float lowest, float highest) {
+    std::int64_t i = begin;
+    while (i + kLanes <= end && xsimd::all(unit_length(load_vec3(directions, i), lowest, highest))) i += kLanes;
+    for (; i < end; ++i)
+        if (!unit_length(directions, i, lowest, highest)) return i;
+    return -1;
+}
+
+
+// ---------------------------------------------------------------- tails
+// The last count < kLanes elements of a range are copied into padded buffers
+// (the last element repeated), so every load and store stays in bounds and
+// every element goes through the same lane-wise code as the others.
+
+struct Padding {
+    std::int64_t begin, count;
+    std::int64_t source(std::int64_t lane) const { return begin + (lane < count ? lane : count - 1); }
+};
+
+using PadBuffer = float[3 * kLanes];
+
+inline Vec3Array pad_vec3(const Vec3Array& from, const Padding& pad, float* buffer) {
+    if (from.layout == Vec3Layout::kSingle) return from;
+    for (std::int64_t j = 0; j < kLanes; ++j) {
+        const std::int64_t e = pad.source(j);
+        for (int k = 0; k < 3; ++k)
+            buffer[3 * j + k] = from.layout == Vec3Layout::kInterleaved ? from.data[3 * e + k]
+                                                                        : from.data[k * from.row_stride + e];
+    }
+    return Vec3Array{buffer, Vec3Layout::kInterleaved, 0};
+}
+
+inline void pad_params(const ParamSlot* from, ParamSlot* to, const Padding& pad, PadBuffer* buffers) {
+    for (int s = 0; s < kParamSlots; ++s) {
+        const ParamSlot& slot = from[s];
+        if (!slot.per_element()) continue;
+        if (slot.stride == 3) {
+            // Interleaved base_color: the R slot's copy holds all three channels.
+            to[s].data = buffers[kBaseColorR] + (s - kBaseColorR);
+            if (s != kBaseColorR) continue;
+        } else {
+            to[s].data = buffers[s];
+        }
+        for (std::int64_t j = 0; j < kLanes; ++j)
+            for (int c = 0; c < slot.stride; ++c) buffers[s][j * slot.stride + c] = slot.data[pad.source(j) * slot.stride + c];
+    }
+}
+
+inline void unpad_vec3(const MutableVec3Array& to, const Padding& pad, const float* buffer) {
+    for (std::int64_t j = 0; j < pad.count; ++j) {
+        for (int c = 0; c < 3; ++c) {
+            const std::int64_t index = to.layout == Vec3Layout::kInterleaved ? 3 * (pad.begin + j) + c
+                                                                             : c * to.row_stride + pad.begin + j;
+            to.data[index] = buffer[3 * j + c];
+        }
+    }
+}
+
+template <class T>
+inline void unpad_scalars(T* to, const Padding& pad, const T* buffer) {
+    for (std::int64_t j = 0; j < pad.count; ++j) to[pad.begin + j] = buffer[j];
+}

@@ -1,0 +1,104 @@
+// Part of kernel.hpp, included inside the per-arch namespace: drawing wi from
+// the three lobes exactly as README "Sampling and pdf" defines it, branch-free
+// (every lane computes every lobe's candidate, then selects), and the
+// counter-based uniforms.
+#pragma once  // (per translation unit)
+
+using UInts = xsimd::batch<std::uint32_t, Arch>;
+
+// Low 32 bits of a 32 x 32-bit product (xsimd 8.1 has no native one for AVX-512).
+#if defined(__AVX512F__)
+inline UInts multiply_low(UInts a, std::uint32_t b) { return _mm512_mullo_epi32(a, _mm512_set1_epi32(static_cast<int>(b))); }
+#elif defined(__AVX2__)
+inline UInts multiply_low(UInts a, std::uint32_t b) { return _mm256_mullo_epi32(a, _mm256_set1_epi32(static_cast<int>(b))); }
+#else
+inline UInts multiply_low(UInts a, std::uint32_t b) { return a * UInts(b); }
+#endif
+
+#include "counter_rng.hpp"
+
+constexpr float kTwoPi = 6.28318530717958647692f;
+
+struct Uniforms {
+    Floats u0, u1, u2;
+};
+
+// u_k for elements first + 0 .. first + kLanes - 1; first is a multiple of
+// kLanes, so the low 32 bits never carry into the high ones within a batch.
+inline Uniforms counter_uniforms(std::uint64_t first, const CounterKeys& keys) {
+    alignas(64) std::uint32_t lane_index[kLanes];
+    for (std::int64_t j = 0; j < kLanes; ++j) lane_index[j] = static_cast<std::uint32_t>(j);
+    const UInts index_low = UInts::load_aligned(lane_index) + UInts(static_cast<std::uint32_t>(first));
+    const auto high = static_cast<std::uint32_t>(first >> 32);
+    Floats u[3];
+    for (int k = 0; k < 3; ++k) {
+        const UInts bits = counter_bits(index_low, high, keys, k) >> 8;
+        u[k] = xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int32_t, Arch>>(bits)) * 0x1p-24f;
+    }
+    return {u[0], u[1], u[2]};
+}
+
+struct LobeChoice {
+    Mask cosine, specular;  // clearcoat otherwise
+};
+
+// Lobe 0 if u0 < P0, else 1 if u0 < P0 + P1, else 2.
+inline LobeChoice choose_lobe(Floats u0, const LobeProbabilities& p) {
+    const Mask cosine = u0 < p.cosine;
+    return {cosine, (u0 < p.cosine + p.specular) & !cosine};
+}
+
+inline Vec3 normalized(const Vec3& v) {
+    const Floats inv_length = reciprocal_sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    return {v.x * inv_length, v.y * inv_length, v.z * inv_length};
+}
+
+inline Vec3 select(const Mask& m, const Vec3& a, const Vec3& b) {
+    return {xsimd::select(m, a.x, b.x), xsimd::select(m, a.y, b.y), xsimd::select(m, a.z, b.z)};
+}
+
+// Primary specular half vector, unnormalised. Visible normals by spherical
+// caps (Dupuy & Benyoub 2023): v = normalize(ax wo.x, ay wo.y, wo.z),
+// z = (1 - u2)(1 + v.z) - v.z, m = (s cos φ, s sin φ, z) + v,
+// h ∝ (ax m.x, ay m.y, m.z). Distribution (eq. 14-15):
+// h ∝ (sqrt(u2) ax cos φ, sqrt(u2) ay sin φ, sqrt(1 - u2)).
+inline Vec3 specular_half_vector(const Vec3& wo, Floats u2, Floats cos_phi, Floats sin_phi, const Shading& s,
+                                 SpecularSampler sampler) {
+    if (sampler == SpecularSampler::kDistribution) {
+        const Floats radius = xsimd::sqrt(u2);
+        return {radius * s.alpha_x * cos_phi, radius * s.alpha_y * sin_phi, xsimd::sqrt(Floats(1.0f) - u2)};
+    }
+    const Vec3 v = normalized({s.alpha_x * wo.x, s.alpha_y * wo.y, wo.z});
+    const Floats z = xsimd::fms(Floats(1.0f) - u2, Floats(1.0f) + v.z, v.z);
+    const Floats sin_theta = xsimd::sqrt(xsimd::max(xsimd::fnma(z, z, Floats(1.0f)), Floats(0.0f)));
+    return {s.alpha_x * xsimd::fma(sin_theta, cos_phi, v.x), s.alpha_y * xsimd::fma(sin_theta, sin_phi, v.y), z + v.z};
+}
+
+// Clearcoat (GTR1, a = ac) half vector: sin²θh = a² (a^(-2 u2) - 1) / (1 - a²)
+// through expm1, which keeps the narrow peak (u2 -> 0) accurate.
+inline Vec3 clearcoat_half_vector(Floats u2, Floats cos_phi, Floats sin_phi, const Shading& s) {
+    const Floats sin2 = xsimd::min(s.clearcoat_sin2_scale * xsimd::expm1(-u2 * s.clearcoat_log_alpha2), Floats(1.0f));
+    const Floats sin_theta = xsimd::sqrt(sin2);
+    return {sin_theta * cos_phi, sin_theta * sin_phi, xsimd::sqrt(Floats(1.0f) - sin2)};
+}
+
+// wi for the chosen lobes; wo must be above the horizon for the reflected lobes
+// to mean anything (the caller reports pdf 0 otherwise).
+inline Vec3 sample_direction(const Vec3& wo, const Uniforms& u, const LobeChoice& lobe, const Shading& s,
+                             SpecularSampler sampler) {
+    // φ = 2π u2 for the cosine lobe, 2π u1 for the others: one sincos for all
+    const auto [sin_phi, cos_phi] = xsimd::sincos(kTwoPi * xsimd::select(lobe.cosine, u.u2, u.u1));
+
+    // Cosine lobe: r = sqrt(u1), wi = (r cos φ, r sin φ, sqrt(1 - u1))
+    const Floats radius = xsimd::sqrt(u.u1);
+    const Vec3 cosine{radius * cos_phi, radius * sin_phi, xsimd::sqrt(xsimd::max(Floats(1.0f) - u.u1, Floats(0.0f)))};
+
+    Vec3 h = select(lobe.specular, specular_half_vector(wo, u.u2, cos_phi, sin_phi, s, sampler),
+                    clearcoat_half_vector(u.u2, cos_phi, sin_phi, s));
+    const Floats h_len2 = h.x * h.x + h.y * h.y + h.z * h.z;
+    h = select(h_len2 > Floats(0.0f), normalized(h), Vec3{Floats(0.0f), Floats(0.0f), Floats(1.0f)});
+    // wi = 2 (wo·h) h - wo
+    const Floats twice_cos = 2.0f * (wo.x * h.x + wo.y * h.y + wo.z * h.z);
+    const Vec3 reflected{xsimd::fms(twice_cos, h.x, wo.x), xsimd::fms(twice_cos, h.y, wo.y), xsimd::fms(twice_cos, h.z, wo.z)};
+    return select(lobe.cosine | (wo.z <= Floats(0.0f)), cosine, reflected);
+}
