@@ -42,7 +42,9 @@ struct Rgb {
 inline Rgb operator*(Floats s, const Rgb& c) { return {s * c.r, s * c.g, s * c.b}; }
 inline Rgb operator+(const Rgb& a, const Rgb& b) { return {a.r + b.r, a.g + b.g, a.b + b.b}; }
 
-inline Floats mix(Floats a, Floats b, Floats t) { return xsimd::fma(b - a, t, a); }
+// mix(a, b, t) = a (1 - t) + b t: for a, b >= 0 nothing cancels (a + (b - a) t
+// loses b's digits when b << a and t -> 1, e.g. Csheen of a saturated colour).
+inline Floats mix(Floats a, Floats b, Floats t) { return xsimd::fma(b, t, a * (Floats(1.0f) - t)); }
 inline Rgb mix(const Rgb& a, const Rgb& b, Floats t) { return {mix(a.r, b.r, t), mix(a.g, b.g, t), mix(a.b, b.b, t)}; }
 
 // Schlick(u) = clamp(1 - u, 0, 1)^5, given 1 - u

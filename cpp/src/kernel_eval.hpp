@@ -69,7 +69,7 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const Shading& uniform) {
     for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
     padded.pdf = pdf;
 
-    if (!eval_one_batch<model, output, per_element, Layouts::kInterleaved>(padded, 0, uniform)) return false;
+    if (!eval_one_batch<model, output, per_element, Layouts::kMixed>(padded, 0, uniform)) return false;
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf) unpad_scalars(job.pdf, pad, pdf);
