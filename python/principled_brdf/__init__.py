@@ -5,9 +5,10 @@ See the README for the model (SPEC §3) and the API tour.
 
 from . import microfacet, reference
 from ._batch import Sample, cpu_info, eval, eval_lobes, pdf, random_uniforms, sample
+from .albedo import Albedo, albedo
 from .material import PARAMETERS, Material, gamma22_to_linear
 from .reference import Lobes
 
-__all__ = ["Material", "PARAMETERS", "Lobes", "Sample", "gamma22_to_linear", "eval", "eval_lobes", "pdf", "sample",
+__all__ = ["Material", "PARAMETERS", "Lobes", "Sample", "Albedo", "albedo", "gamma22_to_linear", "eval", "eval_lobes", "pdf", "sample",
            "random_uniforms", "cpu_info", "reference", "microfacet"]
 __version__ = "0.1.0"

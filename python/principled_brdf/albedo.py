@@ -1,0 +1,115 @@
+"""Directional albedo by importance sampling: the fraction of light arriving
+from everywhere that leaves towards wo, ∫ f(wi, wo) cos θl dωi, per lobe and
+in total, with its Monte Carlo standard error."""
+
+from __future__ import annotations
+
+import operator
+from typing import NamedTuple
+
+import numpy as np
+
+from ._batch import _seed, eval_lobes, random_uniforms, sample
+from ._validate import as_real_array, broadcast_leading, require_in_domain
+from .material import PARAMETERS, Material
+from .reference import Lobes
+
+__all__ = ["Albedo", "albedo"]
+
+# Elements per kernel call: bounds the memory of one chunk (about 150 bytes each).
+_CHUNK_ELEMENTS = 1 << 22
+
+
+class Albedo(NamedTuple):
+    """Directional albedo at each cos θo, RGB ``(..., 3)``, with standard errors."""
+
+    total: np.ndarray
+    lobes: Lobes  # diffuse, sheen, specular, clearcoat
+    total_error: np.ndarray  # standard error of the mean
+    lobe_errors: Lobes
+
+
+def _with_sample_axis(material: Material, leading: tuple) -> Material:
+    """The material broadcast to ``leading`` with a trailing axis of length 1 for the samples."""
+    params = {}
+    for name, info in PARAMETERS.items():
+        value = getattr(material, name)
+        if info.slots == 3:
+            params[name] = value if value.shape == (3,) else np.broadcast_to(value, leading + (3,))[..., None, :]
+        else:
+            params[name] = value if value.ndim == 0 else np.broadcast_to(value, leading)[..., None]
+    return Material(**params)
+
+
+def albedo(material: Material, cos_theta_o, *, samples: int = 1 << 16, seed: int = 0, model: str = "disney2014",
+           specular_sampler: str = "visible", threads=None) -> Albedo:
+    """Directional albedo ``E(wo) = ∫ f(wi, wo) cos θl dωi`` for ``wo = (sin θo, 0, cos θo)``.
+
+    ``cos_theta_o`` in (0, 1], any shape, broadcast with the material's
+    leading shape. Each albedo is the mean of ``samples`` importance-sampled
+    weights (``pb.sample``, seeded, so the call is reproducible); errors are
+    the standard errors of those means.
+    """
+    if not isinstance(material, Material):
+        raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
+    cos_o = as_real_array("cos_theta_o", cos_theta_o)
+    require_in_domain("cos_theta_o", cos_o, 0.0, 1.0)
+    if np.any(cos_o == 0.0):
+        raise ValueError("cos_theta_o: the albedo is defined for cos θo > 0")
+    count = operator.index(samples)
+    if count < 2:
+        raise ValueError(f"samples: expected at least 2, got {count}")
+    seed_value = _seed(seed)
+    leading = broadcast_leading(cos_theta_o=cos_o.shape, material=material.shape)
+    expanded = _with_sample_axis(material, leading)
+    cos_flat = np.broadcast_to(cos_o, leading).reshape(-1)
+    m = cos_flat.size
+
+    sums = np.zeros((5, m, 3))  # total, then the four lobes
+    squares = np.zeros((5, m, 3))
+    per_chunk = max(1, _CHUNK_ELEMENTS // count)
+    flat_material = _flatten(expanded, leading)
+    for start in range(0, m, per_chunk):
+        stop = min(m, start + per_chunk)
+        cos = cos_flat[start:stop]
+        wo = np.stack([np.sqrt(1.0 - cos * cos), np.zeros_like(cos), cos], axis=-1).astype(np.float32)
+        wo = np.broadcast_to(wo[:, None, :], (stop - start, count, 3))
+        chunk_material = _slice(flat_material, start, stop)
+        u = random_uniforms(seed_value, (stop - start) * count, first=start * count).reshape(stop - start, count, 3)
+        drawn = sample(chunk_material, wo, u=u, model=model, specular_sampler=specular_sampler, threads=threads,
+                       check=False)
+        values = eval_lobes(chunk_material, drawn.wi, wo, model=model, cosine=True, threads=threads, check=False)
+        inv_pdf = np.divide(1.0, drawn.pdf, out=np.zeros_like(drawn.pdf), where=drawn.pdf > 0)[..., None]
+        for k, lobe in enumerate(values):
+            weight = lobe.astype(np.float64) * inv_pdf
+            sums[k + 1, start:stop] = weight.sum(axis=1)
+            squares[k + 1, start:stop] = np.square(weight).sum(axis=1)
+        total = drawn.weight.astype(np.float64)
+        sums[0, start:stop] = total.sum(axis=1)
+        squares[0, start:stop] = np.square(total).sum(axis=1)
+
+    mean = sums / count
+    variance = np.maximum(squares / count - mean * mean, 0.0) * count / (count - 1)
+    error = np.sqrt(variance / count)
+    shape = leading + (3,)
+    return Albedo(
+        total=mean[0].reshape(shape),
+        lobes=Lobes(*(mean[k].reshape(shape) for k in range(1, 5))),
+        total_error=error[0].reshape(shape),
+        lobe_errors=Lobes(*(error[k].reshape(shape) for k in range(1, 5))),
+    )
+
+
+def _flatten(material: Material, leading: tuple) -> dict:
+    """Per-element parameters of a sample-axis material as flat (M, 1[, 3]) arrays; uniform ones as they are."""
+    flat = {}
+    for name, info in PARAMETERS.items():
+        value = getattr(material, name)
+        uniform = value.shape == ((3,) if info.slots == 3 else ())
+        flat[name] = value if uniform else value.reshape((-1, 1, 3) if info.slots == 3 else (-1, 1))
+    return flat
+
+
+def _slice(flat: dict, start: int, stop: int) -> Material:
+    return Material(**{name: (v if v.ndim <= 1 and (v.shape in ((), (3,))) else v[start:stop])
+                       for name, v in flat.items()})

@@ -1,0 +1,148 @@
+"""SIMD sampling and pdf (pb.sample, pb.pdf, pb.random_uniforms): internal
+consistency, the generator's reproducibility, the horizon rules, bad input.
+Agreement with the float64 reference and the statistics are in
+test_simd_sampling_vs_reference.py."""
+
+import numpy as np
+import pytest
+
+import principled_brdf as pb
+from conftest import random_directions, random_material_arrays, seeded_rng
+
+ISAS = pb.cpu_info()["available"]
+SAMPLERS = ("visible", "distribution")
+
+
+def random_case(name, n, min_cos=1e-4):
+    rng = seeded_rng("simd-sampling", name)
+    material = pb.Material(**random_material_arrays(rng, n))
+    wo = random_directions(rng, n, min_cos=min_cos).astype(np.float32)
+    return material, wo
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("sampler", SAMPLERS)
+@pytest.mark.parametrize("model", ("disney2014", "disney2012"))
+def test_sample_agrees_with_pdf_and_eval(isa, sampler, model):
+    n = 200_000
+    material, wo = random_case(f"consistency-{isa}-{sampler}-{model}", n)
+    s = pb.sample(material, wo, seed=11, model=model, specular_sampler=sampler, isa=isa)
+    assert s.wi.shape == (n, 3) and s.pdf.shape == (n,) and s.weight.shape == (n, 3) and s.lobe.shape == (n,)
+    assert s.wi.dtype == np.float32 and s.lobe.dtype == np.int32
+    for array in s[:3]:
+        assert np.all(np.isfinite(array))
+    assert set(np.unique(s.lobe)) <= {0, 1, 2}
+
+    above = s.wi[:, 2] > 0
+    np.testing.assert_array_equal(s.pdf[~above], 0.0)
+    np.testing.assert_array_equal(s.weight[~above], 0.0)
+    assert np.all(s.pdf[above] > 0)
+
+    density = pb.pdf(material, s.wi, wo, specular_sampler=sampler, isa=isa, check=False)
+    np.testing.assert_allclose(s.pdf, density, rtol=1e-6, atol=0)
+    f_cos = pb.eval(material, s.wi, wo, model=model, cosine=True, isa=isa, check=False).astype(np.float64)
+    expected = f_cos[above] / s.pdf[above, None]
+    relative = np.abs(s.weight[above] - expected) / np.maximum(np.abs(expected), 1e-6)
+    assert relative.max() <= 1e-5, relative.max()
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_generator_is_keyed_by_seed_and_index_only(isa):
+    n = 100_003
+    material, wo = random_case("generator", n)
+    drawn = pb.sample(material, wo, seed=2024, isa=isa, threads=2)
+    single = pb.sample(material, wo, seed=2024, isa=isa, threads=1)
+    for a, b in zip(drawn, single):
+        np.testing.assert_array_equal(a, b)
+    given = pb.sample(material, wo, u=pb.random_uniforms(2024, n), isa=isa)
+    for a, b in zip(drawn, given):
+        np.testing.assert_array_equal(a, b)
+    # the numbers depend on the element index, not on where a call starts
+    uniform = pb.Material(roughness=0.3, clearcoat=1.0)
+    whole = pb.sample(uniform, wo, seed=7, isa=isa)
+    part = pb.sample(uniform, wo[n - 1000:], u=pb.random_uniforms(7, 1000, first=n - 1000), isa=isa)
+    for a, b in zip(part, whole):
+        np.testing.assert_array_equal(a, b[n - 1000:])
+    other = pb.sample(material, wo, seed=2025, isa=isa)
+    assert np.mean(other.lobe == drawn.lobe) < 0.99 and not np.array_equal(other.wi, drawn.wi)
+
+
+def test_generator_is_the_same_on_every_isa():
+    material, wo = random_case("isas", 5000)
+    lobes = [pb.sample(material, wo, seed=5, isa=isa).lobe for isa in ISAS]
+    for lobe in lobes[1:]:
+        assert np.mean(lobe == lobes[0]) > 0.999  # only float rounding at a lobe boundary may differ
+
+
+def test_random_uniforms_are_uniform():
+    u = pb.random_uniforms(99, 1 << 20).astype(np.float64)
+    assert u.shape == (1 << 20, 3) and u.min() >= 0.0 and u.max() < 1.0
+    np.testing.assert_allclose(u.mean(axis=0), 0.5, atol=5 * 0.2887 / 1024)
+    np.testing.assert_allclose(np.corrcoef(u.T)[np.triu_indices(3, 1)], 0.0, atol=5 / 1024)
+    counts = np.histogram(u[:, 0], bins=256, range=(0, 1))[0]
+    from scipy import stats
+
+    assert stats.chisquare(counts).pvalue > 1e-4
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_grazing_views_and_mirror_materials_stay_finite(isa):
+    rng = seeded_rng("grazing", isa)
+    n = 50_000
+    wo = random_directions(rng, n, min_cos=1e-4, grazing_fraction=1.0, grazing_cos=1e-3).astype(np.float32)
+    for params in (dict(roughness=0.0), dict(roughness=0.0, anisotropic=1.0, metallic=1.0),
+                   dict(clearcoat=2.0, clearcoat_gloss=1.0, roughness=0.0), dict(roughness=1.0, sheen=2.0)):
+        for sampler in SAMPLERS:
+            s = pb.sample(pb.Material(**params), wo, seed=3, specular_sampler=sampler, isa=isa)
+            for array in s[:3]:
+                assert np.all(np.isfinite(array)), (params, sampler)
+            assert np.all(s.pdf >= 0) and np.all(s.weight >= 0)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_view_below_the_horizon_gives_zero(isa):
+    wo = np.array([[0.6, 0.0, -0.8], [1.0, 0.0, 0.0]], np.float32)
+    s = pb.sample(pb.Material(clearcoat=1.0), wo, seed=1, isa=isa)
+    assert np.all(np.isfinite(s.wi))
+    np.testing.assert_array_equal(s.pdf, 0.0)
+    np.testing.assert_array_equal(s.weight, 0.0)
+    np.testing.assert_array_equal(pb.pdf(pb.Material(), s.wi, wo, isa=isa), 0.0)
+
+
+def test_broadcasting_soa_and_single_view():
+    rng = seeded_rng("sample-shapes")
+    u = rng.random((4, 5, 3))
+    wo = np.array([0.0, 0.6, 0.8])
+    s = pb.sample(pb.Material(roughness=np.linspace(0, 1, 5)), wo, u=u)
+    assert s.wi.shape == (4, 5, 3) and s.pdf.shape == (4, 5) and s.lobe.shape == (4, 5)
+    soa = pb.sample(pb.Material(roughness=np.linspace(0, 1, 5)), wo, u=np.moveaxis(u, -1, 0), layout="soa")
+    np.testing.assert_array_equal(np.moveaxis(soa.wi, 0, -1), s.wi)
+    np.testing.assert_array_equal(soa.pdf, s.pdf)
+    np.testing.assert_array_equal(np.moveaxis(soa.weight, 0, -1), s.weight)
+
+
+@pytest.mark.parametrize(
+    "kwargs, error, message",
+    [
+        (dict(u=np.array([[0.5, 1.5, 0.2]])), ValueError, r"u\[0, 1\]: 1.5 is outside its domain \[0, 1\]"),
+        (dict(u=np.array([[0.5, np.nan, 0.2]])), ValueError, r"u\[0, 1\]: nan is not a finite number"),
+        (dict(u=np.zeros((1, 2))), ValueError, r"u: expected shape \(\.\.\., 3\)"),
+        (dict(u=np.zeros((2, 3))), ValueError, "leading shapes do not broadcast"),
+        (dict(seed=-1), ValueError, "seed: expected 0 <= seed < 2\\*\\*64"),
+        (dict(seed=1.5), TypeError, "seed: expected an integer"),
+        (dict(specular_sampler="vndf"), ValueError, "specular_sampler: expected one of"),
+        (dict(model="disney2099"), ValueError, "model: expected one of"),
+    ],
+)
+def test_bad_sample_arguments(kwargs, error, message):
+    wo = np.array([[0.0, 0.6, 0.8], [0.0, 0.0, 1.0], [0.6, 0.0, 0.8]])
+    with pytest.raises(error, match=message):
+        pb.sample(pb.Material(), wo, **kwargs)
+
+
+def test_bad_view_direction_is_named():
+    wo = np.array([[0.0, 0.6, 0.8], [0.0, 0.0, 1.1]], np.float32)
+    with pytest.raises(ValueError, match=r"wo\[1\]: length 1.1 is not 1"):
+        pb.sample(pb.Material(), wo)
+    with pytest.raises(ValueError, match=r"wi\[1\]: length 1.1 is not 1"):
+        pb.pdf(pb.Material(), wo, wo[:1])
