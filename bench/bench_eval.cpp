@@ -96,6 +96,28 @@ void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_elem
     state.SetItemsProcessed(state.iterations() * d.n);
 }
 
+// Importance sampling with the counter-based generator: wi, pdf, weight, lobe per element.
+void simd_sample(benchmark::State& state, std::string isa, bool soa, bool per_element) {
+    Data& d = data_for(state.range(0));
+    const pb::EvalJob eval_job = make_job(d, soa, per_element);
+    pb::SampleJob job;
+    job.wo = eval_job.wo;
+    job.seed = 7;
+    for (int s = 0; s < pb::kParamSlots; ++s) job.params[s] = eval_job.params[s];
+    job.wi = eval_job.out[0];
+    job.weight = {d.out.data() + 3 * d.n, eval_job.out[0].layout, eval_job.out[0].row_stride};
+    std::vector<float> pdf(d.n);
+    std::vector<std::int32_t> lobe(d.n);
+    job.pdf = pdf.data();
+    job.lobe = lobe.data();
+    const int threads = threads_of(state);
+    for (auto _ : state) {
+        pb::sample(job, d.n, threads, isa);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * d.n);
+}
+
 void reference_eval(benchmark::State& state) {
     Data& d = data_for(state.range(0));
     pb::reference::Material m;
@@ -158,6 +180,14 @@ void register_all() {
                             ->Args({n, threads})
                             ->UseRealTime()
                             ->Unit(benchmark::kMicrosecond);
+                        if (n == kSizes[0] && threads == 1 && !soa) {
+                            const std::string sample_name = "sample/" + isa + "/aos" +
+                                                            (per_element ? "/per_element" : "/uniform");
+                            benchmark::RegisterBenchmark(sample_name.c_str(), simd_sample, isa, soa, per_element)
+                                ->Args({n, threads})
+                                ->UseRealTime()
+                                ->Unit(benchmark::kMicrosecond);
+                        }
                     }
                 }
             }

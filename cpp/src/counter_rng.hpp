@@ -19,7 +19,7 @@ struct CounterKeys {
 inline std::uint32_t multiply_low(std::uint32_t a, std::uint32_t b) { return a * b; }
 
 template <class U>
-inline U lowbias32(U x) {
+PB_KERNEL_INLINE U lowbias32(U x) {
     x = x ^ (x >> 16);
     x = multiply_low(x, 0x7feb352du);
     x = x ^ (x >> 15);
@@ -38,7 +38,7 @@ inline CounterKeys counter_keys(std::uint64_t seed) {
 
 // x of the header comment for element indices whose low and high 32-bit halves are given.
 template <class U>
-inline U counter_bits(U index_low, std::uint32_t index_high, const CounterKeys& keys, int k) {
+PB_KERNEL_INLINE U counter_bits(U index_low, std::uint32_t index_high, const CounterKeys& keys, int k) {
     return lowbias32(lowbias32(index_low ^ U(keys.low[k])) + U(index_high ^ keys.high[k]));
 }
 

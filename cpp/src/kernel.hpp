@@ -39,22 +39,22 @@ struct Rgb {
     Floats r, g, b;
 };
 
-inline Rgb operator*(Floats s, const Rgb& c) { return {s * c.r, s * c.g, s * c.b}; }
-inline Rgb operator+(const Rgb& a, const Rgb& b) { return {a.r + b.r, a.g + b.g, a.b + b.b}; }
+PB_KERNEL_INLINE Rgb operator*(Floats s, const Rgb& c) { return {s * c.r, s * c.g, s * c.b}; }
+PB_KERNEL_INLINE Rgb operator+(const Rgb& a, const Rgb& b) { return {a.r + b.r, a.g + b.g, a.b + b.b}; }
 
 // mix(a, b, t) = a (1 - t) + b t: for a, b >= 0 nothing cancels (a + (b - a) t
 // loses b's digits when b << a and t -> 1, e.g. Csheen of a saturated colour).
-inline Floats mix(Floats a, Floats b, Floats t) { return xsimd::fma(b, t, a * (Floats(1.0f) - t)); }
-inline Rgb mix(const Rgb& a, const Rgb& b, Floats t) { return {mix(a.r, b.r, t), mix(a.g, b.g, t), mix(a.b, b.b, t)}; }
+PB_KERNEL_INLINE Floats mix(Floats a, Floats b, Floats t) { return xsimd::fma(b, t, a * (Floats(1.0f) - t)); }
+PB_KERNEL_INLINE Rgb mix(const Rgb& a, const Rgb& b, Floats t) { return {mix(a.r, b.r, t), mix(a.g, b.g, t), mix(a.b, b.b, t)}; }
 
 // Schlick(u) = clamp(1 - u, 0, 1)^5, given 1 - u
-inline Floats schlick_weight_of_complement(Floats one_minus_u) {
+PB_KERNEL_INLINE Floats schlick_weight_of_complement(Floats one_minus_u) {
     const Floats m = xsimd::min(xsimd::max(one_minus_u, Floats(0.0f)), Floats(1.0f));
     const Floats m2 = m * m;
     return m2 * m2 * m;
 }
 
-inline Floats schlick_weight(Floats u) { return schlick_weight_of_complement(Floats(1.0f) - u); }
+PB_KERNEL_INLINE Floats schlick_weight(Floats u) { return schlick_weight_of_complement(Floats(1.0f) - u); }
 
 #include "kernel_material.hpp"
 #include "kernel_brdf.hpp"

@@ -6,6 +6,10 @@
 
 #include "principled_brdf/batch.hpp"
 
+// The kernels' small functions pass batches of registers around; GCC's
+// heuristics leave some of them out of line, which spills every argument.
+#define PB_KERNEL_INLINE inline __attribute__((always_inline))
+
 namespace principled_brdf::kernel {
 
 struct KernelTable {

@@ -4,10 +4,10 @@
 // n·w + sqrt(q), the denominator of the Smith factor S(w) = G1(w) / (2 n·w)
 // of SPEC §3, given q = (w·x ax)² + (w·y ay)² + (n·w)². Products of these
 // share one reciprocal.
-inline Floats smith_denominator(Floats cos_theta, Floats q) { return xsimd::fma(q, reciprocal_sqrt(q), cos_theta); }
+PB_KERNEL_INLINE Floats smith_denominator(Floats cos_theta, Floats q) { return xsimd::fma(q, reciprocal_sqrt(q), cos_theta); }
 
 // Isotropic form, alpha² = a2: q = a2 + cos²(1 - a2)
-inline Floats smith_denominator_iso(Floats cos_theta, Floats a2) {
+PB_KERNEL_INLINE Floats smith_denominator_iso(Floats cos_theta, Floats a2) {
     return smith_denominator(cos_theta, xsimd::fma(cos_theta * cos_theta, Floats(1.0f) - a2, a2));
 }
 
@@ -28,7 +28,7 @@ struct Geometry {
     Mask finite;         // false where a direction held NaN or infinity (checks off)
 };
 
-inline Geometry geometry_of(const Vec3& wi, const Vec3& wo) {
+PB_KERNEL_INLINE Geometry geometry_of(const Vec3& wi, const Vec3& wo) {
     Geometry g;
     g.wi = wi;
     g.wo = wo;
@@ -47,24 +47,24 @@ inline Geometry geometry_of(const Vec3& wi, const Vec3& wo) {
 }
 
 // GTR2 aniso: Ds = 1/(π ax ay (hx²/ax² + hy²/ay² + hz²)²), with h = H/|H|
-inline Floats gtr2_aniso_d(const Geometry& g, const Shading& s) {
+PB_KERNEL_INLINE Floats gtr2_aniso_d(const Geometry& g, const Shading& s) {
     const Floats stretched = xsimd::fma(g.hx2, s.inv_alpha_x2, xsimd::fma(g.hy2, s.inv_alpha_y2, g.hz2));
     const Floats ds_root = g.h_len2 * reciprocal(stretched);
     return s.ggx_norm * ds_root * ds_root;
 }
 
 // |H|² (ac² cos²θh + sin²θh): GTR1 is gtr1_norm |H|² over this
-inline Floats gtr1_denominator(const Geometry& g, const Shading& s) {
+PB_KERNEL_INLINE Floats gtr1_denominator(const Geometry& g, const Shading& s) {
     return xsimd::fma(s.clearcoat_alpha2, g.hz2, g.hx2 + g.hy2);
 }
 
 // Smith denominator of the 2014 model for w: n·w + sqrt((w·x ax)² + (w·y ay)² + (n·w)²)
-inline Floats smith_denominator_aniso(const Vec3& w, const Shading& s) {
+PB_KERNEL_INLINE Floats smith_denominator_aniso(const Vec3& w, const Shading& s) {
     return smith_denominator(w.z, xsimd::fma(s.alpha_x2, w.x * w.x, xsimd::fma(s.alpha_y2, w.y * w.y, w.z * w.z)));
 }
 
 template <Model model>
-inline LobeValues eval_lobes(const Geometry& g, const Shading& s) {
+PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s) {
     const Floats one(1.0f);
     const Vec3& wi = g.wi;
     const Vec3& wo = g.wo;
@@ -118,12 +118,12 @@ struct LobeProbabilities {
 
 // w0 = (1 - metallic)(Cdlum + 0.1 sheen lum(Csheen)), w1 = max(lum(mix(Cspec0, 1, FV)), 0.02),
 // w2 = 0.25 clearcoat mix(0.04, 1, FV); P_k = w_k / Σ w.
-inline LobeProbabilities lobe_probabilities(Floats cos_theta_v, const Shading& s) {
+PB_KERNEL_INLINE LobeProbabilities lobe_probabilities(Floats cos_theta_v, const Shading& s) {
     const Floats fv = schlick_weight(cos_theta_v);
     const Floats w0 = s.cosine_lobe_weight;
     const Floats w1 = xsimd::max(mix(s.specular_f0_luminance, Floats(1.0f), fv), Floats(0.02f));
     const Floats w2 = s.clearcoat_lobe_weight * xsimd::fma(Floats(0.96f), fv, Floats(0.04f));
-    const Floats inv_total = Floats(1.0f) / (w0 + w1 + w2);
+    const Floats inv_total = reciprocal(w0 + w1 + w2);
     return {w0 * inv_total, w1 * inv_total, w2 * inv_total};
 }
 
@@ -133,7 +133,7 @@ inline LobeProbabilities lobe_probabilities(Floats cos_theta_v, const Shading& s
 //        = Ds cos θh / (4 cos θd) = Ds Hz / (2 |H|²)                (distribution)
 //   pdf2 = Dr cos θh / (4 cos θd) = gtr1_norm Hz / (2 gtr1_denominator)
 // with cos θh = Hz / |H| and cos θd = |H| / 2.
-inline Floats mixture_pdf(const Geometry& g, const Shading& s, const LobeProbabilities& p, SpecularSampler sampler) {
+PB_KERNEL_INLINE Floats mixture_pdf(const Geometry& g, const Shading& s, const LobeProbabilities& p, SpecularSampler sampler) {
     const Floats ds = gtr2_aniso_d(g, s);
     const Floats pdf1 = sampler == SpecularSampler::kDistribution
                             ? ds * g.hz * reciprocal(2.0f * g.h_len2)

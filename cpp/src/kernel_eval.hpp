@@ -3,7 +3,7 @@
 #pragma once  // (per translation unit)
 
 template <Model model, Output output, Layouts layouts>
-inline void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const Vec3& wo, const Shading& s) {
+PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const Vec3& wo, const Shading& s) {
     const Geometry g = geometry_of(wi, wo);
     // 0 unless both directions are strictly above the surface (SPEC §1);
     // select also discards whatever the formulas gave there (H may be 0).
@@ -33,7 +33,7 @@ inline void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const
 
 // One batch at i; false, with nothing stored, when the fused direction check fails.
 template <Model model, Output output, bool per_element, Layouts layouts>
-inline bool eval_one_batch(const EvalJob& job, std::int64_t i, const Shading& uniform) {
+PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const Shading& uniform) {
     const Vec3 wi = load_vec3<layouts>(job.wi, i);
     const Vec3 wo = load_vec3<layouts>(job.wo, i);
     if (job.check_directions) {

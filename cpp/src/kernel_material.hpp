@@ -6,7 +6,7 @@ struct RawMaterial {
     Floats slot[kParamSlots];
 };
 
-inline RawMaterial load_material(const ParamSlot* params, std::int64_t i) {
+PB_KERNEL_INLINE RawMaterial load_material(const ParamSlot* params, std::int64_t i) {
     RawMaterial m;
     const ParamSlot& red = params[kBaseColorR];
     if (red.per_element() && red.stride == 3) {
@@ -47,9 +47,9 @@ struct Shading {
     Floats clearcoat_lobe_weight;      // 0.25 clearcoat
 };
 
-inline Floats luminance_of(const Rgb& c) { return 0.3f * c.r + 0.6f * c.g + 0.1f * c.b; }
+PB_KERNEL_INLINE Floats luminance_of(const Rgb& c) { return 0.3f * c.r + 0.6f * c.g + 0.1f * c.b; }
 
-inline Shading shading_of(const RawMaterial& m) {
+PB_KERNEL_INLINE Shading shading_of(const RawMaterial& m) {
     const Floats* p = m.slot;
     const Floats one(1.0f);
     const Rgb base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};

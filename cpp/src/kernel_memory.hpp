@@ -6,7 +6,7 @@
 enum class Layouts { kInterleaved, kRows, kMixed };
 
 template <Layouts layouts = Layouts::kMixed>
-inline Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
+PB_KERNEL_INLINE Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
     if constexpr (layouts == Layouts::kInterleaved) {
         Vec3 v;
         load_interleaved(a.data + 3 * i, v.x, v.y, v.z);
@@ -30,7 +30,7 @@ inline Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
 }
 
 template <Layouts layouts = Layouts::kMixed>
-inline void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb& c) {
+PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb& c) {
     if (layouts == Layouts::kInterleaved || (layouts == Layouts::kMixed && a.layout == Vec3Layout::kInterleaved)) {
         store_interleaved(a.data + 3 * i, c.r, c.g, c.b);
     } else {
@@ -42,12 +42,12 @@ inline void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb& c) {
 
 // SPEC §7: squared length within [lowest, highest]; a NaN fails both
 // comparisons and an infinity the second.
-inline Mask unit_length(const Vec3& w, float lowest, float highest) {
+PB_KERNEL_INLINE Mask unit_length(const Vec3& w, float lowest, float highest) {
     const Floats length2 = w.x * w.x + w.y * w.y + w.z * w.z;
     return (length2 >= Floats(lowest)) & (length2 <= Floats(highest));
 }
 
-inline bool unit_length(const Vec3Array& a, std::int64_t i, float lowest, float highest) {
+PB_KERNEL_INLINE bool unit_length(const Vec3Array& a, std::int64_t i, float lowest, float highest) {
     const float* p = a.layout == Vec3Layout::kSingle ? a.data : a.layout == Vec3Layout::kRows ? a.data + i : a.data + 3 * i;
     const std::int64_t stride = a.layout == Vec3Layout::kRows ? a.row_stride : 1;
     const float length2 = p[0] * p[0] + p[stride] * p[stride] + p[2 * stride] * p[2 * stride];
@@ -76,7 +76,7 @@ struct Padding {
 
 using PadBuffer = float[3 * kLanes];
 
-inline Vec3Array pad_vec3(const Vec3Array& from, const Padding& pad, float* buffer) {
+PB_KERNEL_INLINE Vec3Array pad_vec3(const Vec3Array& from, const Padding& pad, float* buffer) {
     if (from.layout == Vec3Layout::kSingle) return from;
     for (std::int64_t j = 0; j < kLanes; ++j) {
         const std::int64_t e = pad.source(j);
@@ -87,7 +87,7 @@ inline Vec3Array pad_vec3(const Vec3Array& from, const Padding& pad, float* buff
     return Vec3Array{buffer, Vec3Layout::kInterleaved, 0};
 }
 
-inline void pad_params(const ParamSlot* from, ParamSlot* to, const Padding& pad, PadBuffer* buffers) {
+PB_KERNEL_INLINE void pad_params(const ParamSlot* from, ParamSlot* to, const Padding& pad, PadBuffer* buffers) {
     for (int s = 0; s < kParamSlots; ++s) {
         const ParamSlot& slot = from[s];
         if (!slot.per_element()) continue;
@@ -103,7 +103,7 @@ inline void pad_params(const ParamSlot* from, ParamSlot* to, const Padding& pad,
     }
 }
 
-inline void unpad_vec3(const MutableVec3Array& to, const Padding& pad, const float* buffer) {
+PB_KERNEL_INLINE void unpad_vec3(const MutableVec3Array& to, const Padding& pad, const float* buffer) {
     for (std::int64_t j = 0; j < pad.count; ++j) {
         for (int c = 0; c < 3; ++c) {
             const std::int64_t index = to.layout == Vec3Layout::kInterleaved ? 3 * (pad.begin + j) + c
@@ -114,6 +114,6 @@ inline void unpad_vec3(const MutableVec3Array& to, const Padding& pad, const flo
 }
 
 template <class T>
-inline void unpad_scalars(T* to, const Padding& pad, const T* buffer) {
+PB_KERNEL_INLINE void unpad_scalars(T* to, const Padding& pad, const T* buffer) {
     for (std::int64_t j = 0; j < pad.count; ++j) to[pad.begin + j] = buffer[j];
 }

@@ -4,7 +4,7 @@
 #pragma once  // (per translation unit)
 
 template <Model model, bool per_element, Layouts layouts>
-inline bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterKeys& keys) {
+PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterKeys& keys) {
     const Vec3 wo = load_vec3<layouts>(job.wo, i);
     if (job.check_directions && !xsimd::all(unit_length(wo, job.length2_lowest, job.length2_highest))) return false;
     Shading per_batch;

@@ -48,13 +48,13 @@ inline constexpr Interleave3Permutation<L, k, for_store> kInterleave3Permutation
 
 #if defined(__AVX512F__)
 
-inline Floats reciprocal(Floats x) {
+PB_KERNEL_INLINE Floats reciprocal(Floats x) {
     const __m512 estimate = _mm512_rcp14_ps(x);  // relative error < 2^-14
     // One Newton-Raphson step: y (2 - x y)
     return _mm512_mul_ps(estimate, _mm512_fnmadd_ps(x, estimate, _mm512_set1_ps(2.0f)));
 }
 
-inline Floats reciprocal_sqrt(Floats x) {
+PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
     const __m512 estimate = _mm512_rsqrt14_ps(x);  // relative error < 2^-14
     // One Newton-Raphson step: y + (y / 2) (1 - x y²)
     const __m512 residual = _mm512_fnmadd_ps(_mm512_mul_ps(x, estimate), estimate, _mm512_set1_ps(1.0f));
@@ -62,12 +62,12 @@ inline Floats reciprocal_sqrt(Floats x) {
 }
 
 template <int k>
-inline __m512i interleave_load_permutation() {
+PB_KERNEL_INLINE __m512i interleave_load_permutation() {
     return _mm512_load_si512(kInterleave3Permutation<16, k, false>.lanes);
 }
 
 template <int k>
-inline __m512i interleave_store_permutation() {
+PB_KERNEL_INLINE __m512i interleave_store_permutation() {
     return _mm512_load_si512(kInterleave3Permutation<16, k, true>.lanes);
 }
 
@@ -80,13 +80,13 @@ constexpr __mmask16 lanes_from_register() {
 }
 
 template <int k>
-inline Floats gather_component(__m512 a, __m512 b, __m512 c) {
+PB_KERNEL_INLINE Floats gather_component(__m512 a, __m512 b, __m512 c) {
     __m512 blended = _mm512_mask_blend_ps(lanes_from_register<k, 1>(), a, b);
     blended = _mm512_mask_blend_ps(lanes_from_register<k, 2>(), blended, c);
     return _mm512_permutexvar_ps(interleave_load_permutation<k>(), blended);
 }
 
-inline void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
+PB_KERNEL_INLINE void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
     const __m512 a = _mm512_loadu_ps(p), b = _mm512_loadu_ps(p + 16), c = _mm512_loadu_ps(p + 32);
     x = gather_component<0>(a, b, c);
     y = gather_component<1>(a, b, c);
@@ -94,7 +94,7 @@ inline void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
 }
 
 template <int r>
-inline __m512 scatter_register(__m512 px, __m512 py, __m512 pz) {
+PB_KERNEL_INLINE __m512 scatter_register(__m512 px, __m512 py, __m512 pz) {
     // lane l of register r holds component (16 r + l) % 3
     constexpr __mmask16 from_y = [] {
         unsigned mask = 0;
@@ -111,7 +111,7 @@ inline __m512 scatter_register(__m512 px, __m512 py, __m512 pz) {
     return _mm512_mask_blend_ps(from_z, _mm512_mask_blend_ps(from_y, px, py), pz);
 }
 
-inline void store_interleaved(float* p, Floats x, Floats y, Floats z) {
+PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) {
     const __m512 px = _mm512_permutexvar_ps(interleave_store_permutation<0>(), x);
     const __m512 py = _mm512_permutexvar_ps(interleave_store_permutation<1>(), y);
     const __m512 pz = _mm512_permutexvar_ps(interleave_store_permutation<2>(), z);
@@ -122,12 +122,12 @@ inline void store_interleaved(float* p, Floats x, Floats y, Floats z) {
 
 #elif defined(__AVX2__)
 
-inline Floats reciprocal(Floats x) {
+PB_KERNEL_INLINE Floats reciprocal(Floats x) {
     const __m256 estimate = _mm256_rcp_ps(x);  // relative error < 1.5 * 2^-12
     return _mm256_mul_ps(estimate, _mm256_fnmadd_ps(x, estimate, _mm256_set1_ps(2.0f)));
 }
 
-inline Floats reciprocal_sqrt(Floats x) {
+PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
     const __m256 estimate = _mm256_rsqrt_ps(x);  // relative error < 1.5 * 2^-12
     // One Newton-Raphson step: y + (y / 2) (1 - x y²)
     const __m256 residual = _mm256_fnmadd_ps(_mm256_mul_ps(x, estimate), estimate, _mm256_set1_ps(1.0f));
@@ -135,12 +135,12 @@ inline Floats reciprocal_sqrt(Floats x) {
 }
 
 template <int k>
-inline __m256i interleave_load_permutation() {
+PB_KERNEL_INLINE __m256i interleave_load_permutation() {
     return _mm256_load_si256(reinterpret_cast<const __m256i*>(kInterleave3Permutation<8, k, false>.lanes));
 }
 
 template <int k>
-inline __m256i interleave_store_permutation() {
+PB_KERNEL_INLINE __m256i interleave_store_permutation() {
     return _mm256_load_si256(reinterpret_cast<const __m256i*>(kInterleave3Permutation<8, k, true>.lanes));
 }
 
@@ -153,13 +153,13 @@ constexpr int lanes_from_register() {
 }
 
 template <int k>
-inline Floats gather_component(__m256 a, __m256 b, __m256 c) {
+PB_KERNEL_INLINE Floats gather_component(__m256 a, __m256 b, __m256 c) {
     __m256 blended = _mm256_blend_ps(a, b, lanes_from_register<k, 1>());
     blended = _mm256_blend_ps(blended, c, lanes_from_register<k, 2>());
     return _mm256_permutevar8x32_ps(blended, interleave_load_permutation<k>());
 }
 
-inline void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
+PB_KERNEL_INLINE void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
     const __m256 a = _mm256_loadu_ps(p), b = _mm256_loadu_ps(p + 8), c = _mm256_loadu_ps(p + 16);
     x = gather_component<0>(a, b, c);
     y = gather_component<1>(a, b, c);
@@ -175,11 +175,11 @@ constexpr int lanes_of_component() {
 }
 
 template <int r>
-inline __m256 scatter_register(__m256 px, __m256 py, __m256 pz) {
+PB_KERNEL_INLINE __m256 scatter_register(__m256 px, __m256 py, __m256 pz) {
     return _mm256_blend_ps(_mm256_blend_ps(px, py, lanes_of_component<r, 1>()), pz, lanes_of_component<r, 2>());
 }
 
-inline void store_interleaved(float* p, Floats x, Floats y, Floats z) {
+PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) {
     const __m256 px = _mm256_permutevar8x32_ps(x, interleave_store_permutation<0>());
     const __m256 py = _mm256_permutevar8x32_ps(y, interleave_store_permutation<1>());
     const __m256 pz = _mm256_permutevar8x32_ps(z, interleave_store_permutation<2>());
@@ -190,10 +190,10 @@ inline void store_interleaved(float* p, Floats x, Floats y, Floats z) {
 
 #else  // SSE2, NEON: exact division and square root, transposes through memory
 
-inline Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
-inline Floats reciprocal_sqrt(Floats x) { return Floats(1.0f) / xsimd::sqrt(x); }
+PB_KERNEL_INLINE Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
+PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) { return Floats(1.0f) / xsimd::sqrt(x); }
 
-inline void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
+PB_KERNEL_INLINE void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
     alignas(64) float xs[Floats::size], ys[Floats::size], zs[Floats::size];
     for (std::size_t j = 0; j < Floats::size; ++j) {
         xs[j] = p[3 * j];
@@ -205,7 +205,7 @@ inline void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
     z = Floats::load_aligned(zs);
 }
 
-inline void store_interleaved(float* p, Floats x, Floats y, Floats z) {
+PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) {
     alignas(64) float xs[Floats::size], ys[Floats::size], zs[Floats::size];
     x.store_aligned(xs);
     y.store_aligned(ys);
