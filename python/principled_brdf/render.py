@@ -8,6 +8,9 @@ directional light plus a constant ambient term. Returns linear RGB; use
 
 from __future__ import annotations
 
+import struct
+import zlib
+
 import numpy as np
 
 from ._batch import eval as _eval
@@ -67,3 +70,20 @@ def to_srgb8(linear: np.ndarray, exposure: float = 1.0) -> np.ndarray:
     c = np.clip(np.asarray(linear, dtype=np.float64) * exposure, 0.0, 1.0)
     srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
     return np.round(srgb * 255.0).astype(np.uint8)
+
+
+def write_png(path: str, image: np.ndarray) -> None:
+    """Write an 8-bit RGB ``(H, W, 3)`` image as PNG (no dependency beyond zlib)."""
+    pixels = np.ascontiguousarray(image, dtype=np.uint8)
+    if pixels.ndim != 3 or pixels.shape[2] != 3:
+        raise ValueError(f"image: expected an (H, W, 3) uint8 array, got shape {pixels.shape}")
+    height, width, _ = pixels.shape
+    rows = np.concatenate([np.zeros((height, 1), np.uint8), pixels.reshape(height, width * 3)], axis=1)
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)  # 8-bit RGB
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
+                + chunk(b"IEND", b""))

@@ -1,0 +1,154 @@
+"""``python -m principled_brdf``: demo, render, bench, info.
+
+Every subcommand has ``--help``; bad arguments print a one-line error and
+exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import sys
+import time
+
+import numpy as np
+
+from .material import PARAMETERS, Material
+
+
+class _Progress:
+    """Prints what is being done, with the time since the command started."""
+
+    def __init__(self, quiet: bool = False):
+        self.start = time.perf_counter()
+        self.quiet = quiet
+
+    def __call__(self, message: str) -> None:
+        if not self.quiet:
+            print(f"[{time.perf_counter() - self.start:6.1f}s] {message}" if message.endswith("...") else message,
+                  flush=True)
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
+    return value
+
+
+def _vector(text: str) -> tuple:
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected three comma-separated numbers, got {text!r}") from None
+    if len(values) != 3 or not np.all(np.isfinite(values)) or np.linalg.norm(values) == 0:
+        raise argparse.ArgumentTypeError(f"expected three finite comma-separated numbers, not all 0, got {text!r}")
+    return values
+
+
+def _parameter(text: str) -> tuple:
+    name, sep, value = text.partition("=")
+    if not sep or name not in PARAMETERS:
+        raise argparse.ArgumentTypeError(
+            f"expected NAME=VALUE with NAME one of {', '.join(PARAMETERS)}, got {text!r}")
+    try:
+        parsed = tuple(float(v) for v in value.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{name}: expected a number (base_color: R,G,B), got {value!r}") from None
+    expected = PARAMETERS[name].slots
+    if len(parsed) != expected:
+        raise argparse.ArgumentTypeError(f"{name}: expected {expected} comma-separated number(s), got {value!r}")
+    return name, parsed if expected == 3 else parsed[0]
+
+
+def _demo(args, report) -> None:
+    from .demo import run
+
+    run(pairs=args.pairs, output=args.output, repeats=args.repeats, report=report)
+
+
+def _render(args, report) -> None:
+    from . import presets
+    from .render import render_sphere, to_srgb8, write_png
+
+    params = presets.parameters(args.preset) if args.preset else {}
+    params.update(dict(args.param or []))
+    material = Material(**params)
+    report(f"rendering {material} at {args.resolution}x{args.resolution} ...")
+    image = render_sphere(material, resolution=args.resolution, light=args.light, model=args.model)
+    write_png(args.output, to_srgb8(image, exposure=args.exposure))
+    report(f"wrote {args.output}")
+
+
+def _bench(args, report) -> None:
+    from .benchmark import compare_with_numpy
+
+    compare_with_numpy(pairs=args.pairs, repeats=args.repeats, report=report)
+
+
+def _info(args, report) -> None:
+    from . import __version__
+    from ._batch import cpu_info
+
+    info = cpu_info()
+    report(f"principled-brdf {__version__}")
+    report(f"instruction set: {info['isa']} ({info['float_lanes']} float lanes); "
+           f"available: {', '.join(info['available'])} (force one with PRINCIPLED_BRDF_ISA)")
+    report(f"threads: {info['threads']}")
+    report(f"python {platform.python_version()}, numpy {np.__version__}, {platform.machine()}, {platform.system()}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m principled_brdf",
+                                     description="Disney principled BRDF: SIMD evaluation and sampling.")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    demo = commands.add_parser("demo", help="evaluate and sample millions of pairs, print throughput, write a picture",
+                               description="The README's main job: evaluate and sample millions of random pairs, "
+                                           "print throughput beside the memory roofline, write a picture.")
+    demo.add_argument("--pairs", type=_positive_int, default=1 << 22, help="pairs to evaluate (default 4194304)")
+    demo.add_argument("--repeats", type=_positive_int, default=5, help="timed runs, best kept (default 5)")
+    demo.add_argument("--output", default="principled_brdf_demo.png", help="picture to write (PNG)")
+    demo.set_defaults(run=_demo)
+
+    render = commands.add_parser("render", help="render a preset or parameters on a lit sphere to PNG",
+                                 description="Render a material on a sphere lit by one directional light.")
+    from . import presets
+
+    render.add_argument("--preset", choices=presets.names(), help="start from a named preset")
+    render.add_argument("--param", action="append", type=_parameter, metavar="NAME=VALUE",
+                        help="set a parameter (repeatable), e.g. roughness=0.3 or base_color=0.9,0.6,0.2")
+    render.add_argument("--resolution", type=_positive_int, default=512, help="image size in pixels (default 512)")
+    render.add_argument("--light", type=_vector, default=(-0.5, 0.6, 0.75),
+                        help="direction towards the light, camera space x,y,z (default -0.5,0.6,0.75)")
+    render.add_argument("--exposure", type=float, default=1.0, help="scale before tone mapping (default 1)")
+    render.add_argument("--model", choices=("disney2014", "disney2012"), default="disney2014")
+    render.add_argument("--output", required=True, help="PNG file to write")
+    render.set_defaults(run=_render)
+
+    bench = commands.add_parser("bench", help="compare pb.eval with a numpy float32 implementation",
+                                description="Time pb.eval against a straightforward numpy float32 implementation "
+                                            "of the model on the same pairs.")
+    bench.add_argument("--pairs", type=_positive_int, default=1 << 22, help="pairs (default 4194304)")
+    bench.add_argument("--repeats", type=_positive_int, default=5, help="timed runs, best kept (default 5)")
+    bench.set_defaults(run=_bench)
+
+    info = commands.add_parser("info", help="instruction set, threads and versions",
+                               description="Show the instruction set in use, threads and versions.")
+    info.set_defaults(run=_info)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    report = _Progress()
+    try:
+        args.run(args, report)
+    except (ValueError, TypeError, OSError) as error:
+        print(f"{parser.prog} {args.command}: error: {error}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,114 @@
+"""python -m principled_brdf: every subcommand, --help, and bad arguments."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import principled_brdf as pb
+from principled_brdf.cli import main
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "principled_brdf", *args], capture_output=True, text=True,
+                          timeout=300)
+
+
+def read_png_size(path):
+    with open(path, "rb") as f:
+        header = f.read(24)
+    assert header[:8] == b"\x89PNG\r\n\x1a\n"
+    return int.from_bytes(header[16:20], "big"), int.from_bytes(header[20:24], "big")
+
+
+@pytest.mark.parametrize("command", ["demo", "render", "bench", "info"])
+def test_every_subcommand_has_help(command):
+    result = run(command, "--help")
+    assert result.returncode == 0
+    assert "usage:" in result.stdout and command in result.stdout
+
+
+def test_top_level_help_lists_the_commands():
+    result = run("--help")
+    assert result.returncode == 0
+    for command in ("demo", "render", "bench", "info"):
+        assert command in result.stdout
+
+
+def test_info(capsys):
+    assert main(["info"]) == 0
+    out = capsys.readouterr().out
+    assert pb.cpu_info()["isa"] in out and "threads" in out and "numpy" in out
+
+
+def test_demo_writes_a_picture_and_reports_throughput(tmp_path):
+    output = tmp_path / "demo.png"
+    result = run("demo", "--pairs", "200000", "--repeats", "1", "--output", str(output))
+    assert result.returncode == 0, result.stderr
+    for phrase in ("M pairs/s", "roofline", "sample", "float64 reference", "max relative error"):
+        assert phrase in result.stdout
+    width, height = read_png_size(output)
+    assert width == 6 * 160 and height == 2 * 160
+
+
+def test_render_preset_with_parameters(tmp_path, capsys):
+    output = tmp_path / "gold.png"
+    assert main(["render", "--preset", "gold", "--param", "roughness=0.2", "--param", "base_color=1,0.8,0.3",
+                 "--resolution", "64", "--output", str(output)]) == 0
+    assert read_png_size(output) == (64, 64)
+    assert "roughness=0.2" in capsys.readouterr().out
+
+
+def test_bench_compares_with_numpy(capsys):
+    assert main(["bench", "--pairs", "20000", "--repeats", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "numpy float32" in out and "x numpy" in out
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["render", "--output", "x.png", "--param", "roughnes=0.3"], "expected NAME=VALUE"),
+        (["render", "--output", "x.png", "--param", "base_color=1,2"], "base_color: expected 3"),
+        (["render", "--output", "x.png", "--param", "roughness=-1"], "roughness: -1.0 is outside its domain"),
+        (["render", "--output", "x.png", "--preset", "unobtainium"], "invalid choice"),
+        (["render", "--output", "x.png", "--light", "0,0"], "three finite comma-separated numbers"),
+        (["render", "--output", "x.png", "--resolution", "0"], "expected a positive integer"),
+        (["render"], "--output"),
+        (["demo", "--pairs", "many"], "expected a positive integer"),
+        (["frobnicate"], "invalid choice"),
+        ([], "required"),
+    ],
+)
+def test_bad_arguments_give_a_clear_message_and_nonzero_exit(args, message):
+    result = run(*args)
+    assert result.returncode != 0
+    assert message in result.stderr, result.stderr
+
+
+def test_render_to_an_unwritable_path_fails_cleanly(tmp_path):
+    result = run("render", "--resolution", "8", "--output", str(tmp_path / "missing" / "x.png"))
+    assert result.returncode == 2
+    assert "error:" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_presets_are_inside_the_domains():
+    for name in pb.presets.names():
+        material = pb.presets.get(name)  # Material checks every domain
+        assert material.is_uniform
+    assert {"gold", "chrome", "blue_rubber", "car_paint", "satin_cloth", "brushed_metal"} <= set(pb.presets.names())
+    assert pb.presets.get("car_paint").clearcoat > 0 and pb.presets.get("satin_cloth").sheen > 0
+    assert pb.presets.get("brushed_metal").anisotropic > 0
+    with pytest.raises(ValueError, match="unknown preset 'nope'"):
+        pb.presets.get("nope")
+
+
+def test_write_png_round_trips_through_matplotlib(tmp_path):
+    image = np.zeros((4, 5, 3), np.uint8)
+    image[1, 2] = (255, 128, 0)
+    pb.render.write_png(str(tmp_path / "x.png"), image)
+    import matplotlib.image
+
+    read = matplotlib.image.imread(str(tmp_path / "x.png"))
+    np.testing.assert_allclose(read[..., :3] * 255, image, atol=0.6)
