@@ -59,7 +59,7 @@ PB_KERNEL_INLINE Shading shading_of(const RawMaterial& m) {
     // Ctint: hue and saturation at unit luminance (1 where the luminance is 0)
     const Floats luminance = luminance_of(base);
     const Mask has_luminance = luminance > Floats(0.0f);
-    const Floats inv_luminance = one / xsimd::select(has_luminance, luminance, one);
+    const Floats inv_luminance = reciprocal(xsimd::select(has_luminance, luminance, one));
     const Rgb tint{xsimd::select(has_luminance, base.r * inv_luminance, one),
                    xsimd::select(has_luminance, base.g * inv_luminance, one),
                    xsimd::select(has_luminance, base.b * inv_luminance, one)};
@@ -74,15 +74,17 @@ PB_KERNEL_INLINE Shading shading_of(const RawMaterial& m) {
     s.specular_f0 = mix((p[kSpecular] * 0.08f) * mix(white, tint, p[kSpecularTint]), base, metallic);
 
     // 2014 addenda: aspect = sqrt(1 - 0.9 anisotropic), alpha = roughness²
-    const Floats aspect = xsimd::sqrt(one - 0.9f * p[kAnisotropic]);
+    const Floats aspect2 = one - 0.9f * p[kAnisotropic];  // in [0.1, 1]
+    const Floats inv_aspect = reciprocal_sqrt(aspect2);
+    const Floats aspect = aspect2 * inv_aspect;
     const Floats alpha = p[kRoughness] * p[kRoughness];
-    const Floats alpha_x = xsimd::max(Floats(0.001f), alpha / aspect);
+    const Floats alpha_x = xsimd::max(Floats(0.001f), alpha * inv_aspect);
     const Floats alpha_y = xsimd::max(Floats(0.001f), alpha * aspect);
     s.alpha_x2 = alpha_x * alpha_x;
     s.alpha_y2 = alpha_y * alpha_y;
-    s.inv_alpha_x2 = one / s.alpha_x2;
-    s.inv_alpha_y2 = one / s.alpha_y2;
-    s.ggx_norm = kInvPi / (alpha_x * alpha_y);
+    s.inv_alpha_x2 = reciprocal(s.alpha_x2);
+    s.inv_alpha_y2 = reciprocal(s.alpha_y2);
+    s.ggx_norm = kInvPi * reciprocal(alpha_x * alpha_y);
     const Floats alpha_g = 0.5f + 0.5f * p[kRoughness];
     s.alpha_g2 = (alpha_g * alpha_g) * (alpha_g * alpha_g);
 
@@ -90,9 +92,9 @@ PB_KERNEL_INLINE Shading shading_of(const RawMaterial& m) {
     const Floats clearcoat_alpha = mix(Floats(0.1f), Floats(0.001f), p[kClearcoatGloss]);
     s.clearcoat_alpha2 = clearcoat_alpha * clearcoat_alpha;
     s.clearcoat_log_alpha2 = xsimd::log(s.clearcoat_alpha2);
-    s.gtr1_norm = kInvPi * (s.clearcoat_alpha2 - one) / s.clearcoat_log_alpha2;
+    s.gtr1_norm = kInvPi * (s.clearcoat_alpha2 - one) * reciprocal(s.clearcoat_log_alpha2);
     s.clearcoat_scale = 0.25f * p[kClearcoat] * s.gtr1_norm;
-    s.clearcoat_sin2_scale = s.clearcoat_alpha2 / (one - s.clearcoat_alpha2);
+    s.clearcoat_sin2_scale = s.clearcoat_alpha2 * reciprocal(one - s.clearcoat_alpha2);
 
     s.alpha_x = alpha_x;
     s.alpha_y = alpha_y;
