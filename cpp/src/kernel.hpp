@@ -1,6 +1,6 @@
 // The SIMD kernel: SPEC §3 over xsimd::batch<float, Arch>, branch-free.
 //
-// Included exactly once by each kernel_<isa>.cpp, after it defines
+// Included exactly once by each kernel_<isa>.cpp (which is nothing else), after it defines
 // PRINCIPLED_BRDF_ARCH (the xsimd arch tag) and PRINCIPLED_BRDF_ARCH_NS (a
 // namespace name). Everything here lives in that per-arch namespace, so code
 // compiled with one instruction set's flags is never linked into another's.
@@ -64,3 +64,20 @@ PB_KERNEL_INLINE Floats schlick_weight(Floats u) { return schlick_weight_of_comp
 #include "kernel_sample.hpp"
 
 }  // namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS
+
+// The table dispatch.cpp reads: <ns>_kernels() of kernel_api.hpp.
+#define PRINCIPLED_BRDF_JOIN2(a, b) a##b
+#define PRINCIPLED_BRDF_JOIN(a, b) PRINCIPLED_BRDF_JOIN2(a, b)
+#define PRINCIPLED_BRDF_QUOTE2(a) #a
+#define PRINCIPLED_BRDF_QUOTE(a) PRINCIPLED_BRDF_QUOTE2(a)
+
+namespace principled_brdf::kernel {
+
+const KernelTable& PRINCIPLED_BRDF_JOIN(PRINCIPLED_BRDF_ARCH_NS, _kernels)() {
+    namespace isa = PRINCIPLED_BRDF_ARCH_NS;
+    static constexpr KernelTable table{PRINCIPLED_BRDF_QUOTE(PRINCIPLED_BRDF_ARCH_NS), static_cast<int>(isa::kLanes),
+                                       &isa::eval_range, &isa::sample_range, &isa::first_bad_direction};
+    return table;
+}
+
+}  // namespace principled_brdf::kernel
