@@ -48,10 +48,11 @@ struct LobeChoice {
     Mask cosine, specular;  // clearcoat otherwise
 };
 
-// Lobe 0 if u0 < P0, else 1 if u0 < P0 + P1, else 2.
+// Lobe 0 if u0 < P0, else 1 if u0 < P0 + P1, else 2; never 2 when P2 = 0
+// (P0 + P1 may round below 1 while u0 reaches 1 - 2^-24, or 1 if passed).
 PB_KERNEL_INLINE LobeChoice choose_lobe(Floats u0, const LobeProbabilities& p) {
     const Mask cosine = u0 < p.cosine;
-    return {cosine, (u0 < p.cosine + p.specular) & !cosine};
+    return {cosine, ((u0 < p.cosine + p.specular) | (p.clearcoat <= Floats(0.0f))) & !cosine};
 }
 
 // (sin 2πu, cos 2πu) for u in [0, 1]: reduced to a quarter turn, q = round(4u),
@@ -124,28 +125,29 @@ PB_KERNEL_INLINE Vec3 clearcoat_half_vector(Floats u2, Floats cos_phi, Floats si
     return {sin_theta * cos_phi, sin_theta * sin_phi, fast_sqrt(Floats(1.0f) - sin2)};
 }
 
-// wi for the chosen lobes; wo must be above the horizon for the reflected lobes
-// to mean anything (the caller reports pdf 0 otherwise). Every lane computes
-// the candidates of the lobes chosen in the batch and selects its own; a
-// candidate no lane chose is skipped, which changes no result.
+// wi for the chosen lobes. Every lane computes the candidates of the lobes
+// chosen in the batch and selects its own; a candidate no lane chose is
+// skipped, which changes no result. A half vector of length 0 (u2 = 1 at
+// special angles) gives h = 0, so wi = -wo: below the horizon like every
+// other u2 = 1 sample of the reflected lobes.
 PB_KERNEL_INLINE Vec3 sample_direction(const Vec3& wo, const Uniforms& u, const LobeChoice& lobe, const Shading& s,
-                             SpecularSampler sampler) {
+                                       SpecularSampler sampler) {
     // φ = 2π u2 for the cosine lobe, 2π u1 for the others: one sincos for all
     const auto [sin_phi, cos_phi] = sincos_turns(xsimd::select(lobe.cosine, u.u2, u.u1));
 
     // Cosine lobe: r = sqrt(u1), wi = (r cos φ, r sin φ, sqrt(1 - u1))
     const Floats radius = fast_sqrt(u.u1);
     const Vec3 cosine{radius * cos_phi, radius * sin_phi, fast_sqrt(Floats(1.0f) - u.u1)};
-    const Mask reflected_lanes = !lobe.cosine & (wo.z > Floats(0.0f));
-    if (!xsimd::any(reflected_lanes)) return cosine;
+    if (xsimd::all(lobe.cosine)) return cosine;
 
     const Mask clearcoat = !lobe.cosine & !lobe.specular;
     Vec3 h = xsimd::any(lobe.specular) ? specular_half_vector(wo, u.u2, cos_phi, sin_phi, s, sampler) : cosine;
     if (xsimd::any(clearcoat)) h = select(clearcoat, clearcoat_half_vector(u.u2, cos_phi, sin_phi, s), h);
     const Floats h_len2 = h.x * h.x + h.y * h.y + h.z * h.z;
-    h = select(h_len2 > Floats(0.0f), normalized(h), Vec3{Floats(0.0f), Floats(0.0f), Floats(1.0f)});
+    const Floats zero(0.0f);
+    h = select(h_len2 > zero, normalized(h), Vec3{zero, zero, zero});
     // wi = 2 (wo·h) h - wo
     const Floats twice_cos = 2.0f * (wo.x * h.x + wo.y * h.y + wo.z * h.z);
     const Vec3 reflected{xsimd::fms(twice_cos, h.x, wo.x), xsimd::fms(twice_cos, h.y, wo.y), xsimd::fms(twice_cos, h.z, wo.z)};
-    return select(reflected_lanes, reflected, cosine);
+    return select(lobe.cosine, cosine, reflected);
 }

@@ -14,7 +14,6 @@ Input handling, once per call:
 from __future__ import annotations
 
 import operator
-from typing import NamedTuple
 
 import numpy as np
 
@@ -28,7 +27,7 @@ from ._validate import (
     require_in_domain,
 )
 from .material import PARAMETERS, Material
-from .reference import Lobes
+from .reference import Lobes, Sample
 
 __all__ = ["eval", "eval_lobes", "pdf", "sample", "random_uniforms", "Sample", "cpu_info"]
 
@@ -37,15 +36,6 @@ _LAYOUTS = ("aos", "soa")
 
 
 _SPECULAR_SAMPLERS = {"visible": 0, "distribution": 1}
-
-
-class Sample(NamedTuple):
-    """What :func:`sample` returns, per element."""
-
-    wi: np.ndarray  # sampled direction towards the light, (..., 3)
-    pdf: np.ndarray  # mixture density in solid angle, (...); 0 below the horizon
-    weight: np.ndarray  # f(wi, wo) cos θl / pdf, (..., 3); 0 below the horizon
-    lobe: np.ndarray  # int32: 0 cosine (diffuse, subsurface, sheen), 1 specular, 2 clearcoat
 
 
 def cpu_info() -> dict:

@@ -96,6 +96,15 @@ def _material_rows(material: Material, shape: tuple) -> np.ndarray:
     return material.packed(()) if material.is_uniform else material.packed(shape)
 
 
+def _to_shape(rows: np.ndarray, shape: tuple, trailing: tuple = ()) -> np.ndarray:
+    """The binding's output rows as ``shape + trailing``; a single row (every input was
+    one shared row) is repeated."""
+    n = int(np.prod(shape, dtype=np.int64))
+    if rows.shape[0] != n:
+        rows = np.repeat(rows, n, axis=0)
+    return rows.reshape(shape + trailing)
+
+
 def _check_material(material) -> None:
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
@@ -122,10 +131,8 @@ def sample(material: Material, wo, u, *, model: str = "disney2014", specular_sam
     wi, density, weight, lobe = _core.reference_sample(
         _shared_or_rows(wo, shape, 3), _shared_or_rows(u, shape, 3), _material_rows(material, shape),
         model_id, sampler_id)
-    if wi.shape[0] != int(np.prod(shape, dtype=np.int64)):  # every argument was a single row
-        wi, density, weight, lobe = (np.broadcast_to(a, (int(np.prod(shape, dtype=np.int64)),) + a.shape[1:]).copy()
-                                     for a in (wi, density, weight, lobe))
-    return Sample(wi.reshape(shape + (3,)), density.reshape(shape), weight.reshape(shape + (3,)), lobe.reshape(shape))
+    return Sample(_to_shape(wi, shape, (3,)), _to_shape(density, shape), _to_shape(weight, shape, (3,)),
+                  _to_shape(lobe, shape))
 
 
 def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampler: str = "visible") -> np.ndarray:
@@ -140,12 +147,11 @@ def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampl
     wi = directions("wi", wi)
     wo = directions("wo", wo)
     shape = broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
-    n = int(np.prod(shape, dtype=np.int64))
-    if n == 0:
+    if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape)
     density = _core.reference_pdf(_shared_or_rows(wi, shape, 3), _shared_or_rows(wo, shape, 3),
                                   _material_rows(material, shape), model_id, sampler_id)
-    return np.broadcast_to(density, (n,)).reshape(shape).copy() if density.shape[0] != n else density.reshape(shape)
+    return _to_shape(density, shape)
 
 
 def lobe_probabilities(material: Material, wo) -> np.ndarray:
@@ -154,8 +160,7 @@ def lobe_probabilities(material: Material, wo) -> np.ndarray:
     _check_material(material)
     wo = directions("wo", wo)
     shape = broadcast_leading(wo=wo.shape[:-1], material=material.shape)
-    n = int(np.prod(shape, dtype=np.int64))
-    if n == 0:
+    if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape + (3,))
     p = _core.reference_lobe_probabilities(_shared_or_rows(wo, shape, 3), _material_rows(material, shape))
-    return (np.broadcast_to(p, (n, 3)).copy() if p.shape[0] != n else p).reshape(shape + (3,))
+    return _to_shape(p, shape, (3,))
