@@ -61,29 +61,38 @@ PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
     return _mm512_fmadd_ps(_mm512_mul_ps(_mm512_set1_ps(0.5f), estimate), residual, estimate);
 }
 
-template <int k>
-PB_KERNEL_INLINE __m512i interleave_load_permutation() {
-    return _mm512_load_si512(kInterleave3Permutation<16, k, false>.lanes);
-}
+// Two-source permutes (vpermt2ps): a component of 16 elements comes from the
+// three registers in two steps: first from (a, b), then the rest from c.
+template <int step, int k, bool for_store>
+struct Permute2Table {
+    alignas(64) int lanes[16];
+    constexpr Permute2Table() : lanes{} {
+        for (int i = 0; i < 16; ++i) {
+            if (!for_store) {
+                const int flat = 3 * i + k;  // element i of component k
+                lanes[i] = step == 0 ? (flat < 32 ? flat : 0) : (flat < 32 ? i : 16 + flat - 32);
+            } else {
+                const int flat = 16 * k + i;  // lane i of output register k
+                const int component = flat % 3, element = flat / 3;
+                lanes[i] = step == 0 ? (component == 0 ? element : component == 1 ? 16 + element : 0)
+                                     : (component == 2 ? 16 + element : i);
+            }
+        }
+    }
+};
 
-template <int k>
-PB_KERNEL_INLINE __m512i interleave_store_permutation() {
-    return _mm512_load_si512(kInterleave3Permutation<16, k, true>.lanes);
-}
+template <int step, int k, bool for_store>
+inline constexpr Permute2Table<step, k, for_store> kPermute2{};
 
-template <int k, int r>
-constexpr __mmask16 lanes_from_register() {
-    unsigned mask = 0;
-    for (int lane = 0; lane < 16; ++lane)
-        if (Interleave3<16>::source_register(k, lane) == r) mask |= 1u << lane;
-    return static_cast<__mmask16>(mask);
+template <int step, int k, bool for_store>
+PB_KERNEL_INLINE __m512i permute2_indices() {
+    return _mm512_load_si512(kPermute2<step, k, for_store>.lanes);
 }
 
 template <int k>
 PB_KERNEL_INLINE Floats gather_component(__m512 a, __m512 b, __m512 c) {
-    __m512 blended = _mm512_mask_blend_ps(lanes_from_register<k, 1>(), a, b);
-    blended = _mm512_mask_blend_ps(lanes_from_register<k, 2>(), blended, c);
-    return _mm512_permutexvar_ps(interleave_load_permutation<k>(), blended);
+    const __m512 from_ab = _mm512_permutex2var_ps(a, permute2_indices<0, k, false>(), b);
+    return _mm512_permutex2var_ps(from_ab, permute2_indices<1, k, false>(), c);
 }
 
 PB_KERNEL_INLINE void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
@@ -94,30 +103,15 @@ PB_KERNEL_INLINE void load_interleaved(const float* p, Floats& x, Floats& y, Flo
 }
 
 template <int r>
-PB_KERNEL_INLINE __m512 scatter_register(__m512 px, __m512 py, __m512 pz) {
-    // lane l of register r holds component (16 r + l) % 3
-    constexpr __mmask16 from_y = [] {
-        unsigned mask = 0;
-        for (int lane = 0; lane < 16; ++lane)
-            if ((16 * r + lane) % 3 == 1) mask |= 1u << lane;
-        return static_cast<__mmask16>(mask);
-    }();
-    constexpr __mmask16 from_z = [] {
-        unsigned mask = 0;
-        for (int lane = 0; lane < 16; ++lane)
-            if ((16 * r + lane) % 3 == 2) mask |= 1u << lane;
-        return static_cast<__mmask16>(mask);
-    }();
-    return _mm512_mask_blend_ps(from_z, _mm512_mask_blend_ps(from_y, px, py), pz);
+PB_KERNEL_INLINE __m512 scatter_register(__m512 x, __m512 y, __m512 z) {
+    const __m512 from_xy = _mm512_permutex2var_ps(x, permute2_indices<0, r, true>(), y);
+    return _mm512_permutex2var_ps(from_xy, permute2_indices<1, r, true>(), z);
 }
 
 PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) {
-    const __m512 px = _mm512_permutexvar_ps(interleave_store_permutation<0>(), x);
-    const __m512 py = _mm512_permutexvar_ps(interleave_store_permutation<1>(), y);
-    const __m512 pz = _mm512_permutexvar_ps(interleave_store_permutation<2>(), z);
-    _mm512_storeu_ps(p, scatter_register<0>(px, py, pz));
-    _mm512_storeu_ps(p + 16, scatter_register<1>(px, py, pz));
-    _mm512_storeu_ps(p + 32, scatter_register<2>(px, py, pz));
+    _mm512_storeu_ps(p, scatter_register<0>(x, y, z));
+    _mm512_storeu_ps(p + 16, scatter_register<1>(x, y, z));
+    _mm512_storeu_ps(p + 32, scatter_register<2>(x, y, z));
 }
 
 #elif defined(__AVX2__)
