@@ -300,3 +300,11 @@ def test_gamma22_to_linear_rejects_bad_colours():
         pb.gamma22_to_linear([0.5, 0.1, np.nan])
     with pytest.raises(TypeError, match="color"):
         pb.gamma22_to_linear("red")
+
+
+def test_material_pickles_for_multiprocessing():
+    import pickle
+
+    m = pb.Material(roughness=np.array([0.1, 0.9]), base_color=(0.2, 0.3, 0.4), clearcoat=1.0)
+    copy = pickle.loads(pickle.dumps(m))
+    assert copy == m and copy.shape == (2,)

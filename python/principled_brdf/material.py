@@ -133,6 +133,10 @@ class Material:
             self._float32_cache[key] = cached
         return cached
 
+    def __reduce__(self):
+        # pickling (multiprocessing, dask): rebuild through __init__, which re-checks
+        return (Material, tuple(getattr(self, name) for name in PARAMETERS))
+
     def __eq__(self, other):
         if not isinstance(other, Material):
             return NotImplemented
