@@ -3,12 +3,12 @@
 See the README for the model (SPEC §3) and the API tour.
 """
 
-from . import microfacet, presets, reference, render
+from . import microfacet, plot, presets, reference, render
 from ._batch import Sample, cpu_info, eval, eval_lobes, pdf, random_uniforms, sample
 from .albedo import Albedo, albedo
 from .material import PARAMETERS, Material, gamma22_to_linear
 from .reference import Lobes
 
 __all__ = ["Material", "PARAMETERS", "Lobes", "Sample", "Albedo", "albedo", "gamma22_to_linear", "eval", "eval_lobes", "pdf", "sample",
-           "random_uniforms", "cpu_info", "reference", "microfacet", "presets", "render"]
+           "random_uniforms", "cpu_info", "reference", "microfacet", "presets", "render", "plot"]
 __version__ = "0.1.0"

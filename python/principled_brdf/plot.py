@@ -1,0 +1,589 @@
+"""Matplotlib pictures of the model for notebooks (optional extra ``plot``).
+
+    import principled_brdf as pb
+    import principled_brdf.plot as pbplot
+
+    pbplot.brdf_slice(pb.presets.get("car_paint"))          # (θh, θd) image slice, Axes
+    pbplot.polar_lobes(pb.Material(roughness=0.3), 45)      # f in the plane of incidence, polar Axes
+    pbplot.lit_sphere(pb.presets.get("gold"), environment=True)   # Axes
+    pbplot.albedo_curves(pb.presets.get("skin"))            # E(θo) per lobe, Axes
+    pbplot.parameter_sweep()                                # Burley 2012 figure 16, Figure
+    pbplot.blend_demo("gold", "blue_rubber")                # Material.mix with a mask, Axes
+
+Every function that draws one panel takes ``ax=`` (an existing Axes to draw
+into; a new figure is made when it is None) and returns that Axes;
+:func:`parameter_sweep` draws many panels and returns the Figure. A material
+argument is a :class:`~principled_brdf.Material` or the name of a preset
+(``pb.presets.names()``). All numbers come from the batched kernel
+(``pb.eval``, ``pb.eval_lobes``, ``pb.sample``, ``pb.albedo``,
+``pb.render``) in a few vectorised calls.
+
+Scalar pictures show one channel of the RGB result: ``"luminance"`` (Rec. 709
+weights of linear RGB, 0.2126 R + 0.7152 G + 0.0722 B), or ``"r"``, ``"g"``,
+``"b"``. matplotlib is imported on the first call, so ``import principled_brdf``
+(and ``import principled_brdf.plot``) work without it.
+"""
+
+from __future__ import annotations
+
+import numbers
+import operator
+
+import numpy as np
+
+from . import presets as _presets
+from ._batch import eval as _eval
+from ._batch import eval_lobes as _eval_lobes
+from ._batch import random_uniforms as _random_uniforms
+from ._batch import sample as _sample
+from ._validate import model_index
+from .albedo import albedo as _albedo
+from .material import PARAMETERS, Material
+from .render import DEFAULT_LIGHT, render_sphere, sphere_frames, to_srgb8
+
+__all__ = ["brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves", "parameter_sweep", "blend_demo",
+           "sky_environment", "slice_directions", "SCALAR_PARAMETERS", "CHANNELS"]
+
+#: The ten scalar parameters of SPEC §2, in the library's order.
+SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items() if info.slots == 1)
+
+#: Channel names accepted by the scalar plots and their weights on linear RGB.
+CHANNELS = {
+    "luminance": (0.2126, 0.7152, 0.0722),
+    "r": (1.0, 0.0, 0.0),
+    "g": (0.0, 1.0, 0.0),
+    "b": (0.0, 0.0, 1.0),
+}
+
+LOBE_NAMES = ("diffuse", "sheen", "specular", "clearcoat")
+_LOBE_COLORS = {"diffuse": "tab:orange", "sheen": "tab:purple", "specular": "tab:blue", "clearcoat": "tab:green",
+                "total": "black"}
+
+# Shading of render_sphere (pb.render), used where many spheres are shaded in one kernel call.
+_LIGHT_INTENSITY = 3.0
+_AMBIENT = 0.03
+_BACKGROUND = "0.75"  # masked (undefined) pixels
+
+
+# --------------------------------------------------------------------------
+# argument checks
+
+
+def _pyplot():
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as error:  # pragma: no cover - depends on the environment
+        raise ImportError("principled_brdf.plot needs matplotlib: pip install 'principled-brdf[plot]'") from error
+    return plt
+
+
+def _material(name: str, value) -> Material:
+    """A Material from a Material or a preset name; TypeError naming ``name`` otherwise."""
+    if isinstance(value, Material):
+        return value
+    if isinstance(value, str):
+        try:
+            return _presets.get(value)
+        except ValueError as error:
+            raise ValueError(f"{name}: {error}") from None
+    raise TypeError(f"{name}: expected a principled_brdf.Material or a preset name, got {type(value).__name__}")
+
+
+def _uniform_material(name: str, value) -> Material:
+    material = _material(name, value)
+    if not material.is_uniform:
+        raise ValueError(f"{name}: expected a uniform material (one value per parameter), "
+                         f"got per-element parameters of shape {material.shape}")
+    return material
+
+
+def _resolution(value, name: str = "resolution", minimum: int = 2) -> int:
+    if isinstance(value, bool):
+        raise TypeError(f"{name}: expected an integer, got bool")
+    try:
+        count = operator.index(value)
+    except TypeError:
+        raise TypeError(f"{name}: expected an integer, got {type(value).__name__}") from None
+    if count < minimum:
+        raise ValueError(f"{name}: expected an integer >= {minimum}, got {count}")
+    return count
+
+
+def _real(name: str, value, lower=-np.inf, upper=np.inf, open_upper: bool = False, open_lower: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name}: expected a real number, got {type(value).__name__}")
+    x = float(value)
+    bad = not np.isfinite(x) or x < lower or x > upper or (open_upper and x == upper) or (open_lower and x == lower)
+    if bad:
+        lo = "(" if open_lower else "["
+        hi = ")" if open_upper else "]"
+        raise ValueError(f"{name}: {x!r} is outside {lo}{lower:g}, {upper:g}{hi}")
+    return x
+
+
+def _channel(value) -> np.ndarray:
+    if not isinstance(value, str) or value not in CHANNELS:
+        raise ValueError(f"channel: expected one of {', '.join(repr(c) for c in CHANNELS)}, got {value!r}")
+    return np.asarray(CHANNELS[value], dtype=np.float64)
+
+
+def _axes(ax, polar: bool = False):
+    """``ax`` checked, or a new Axes (polar if asked) on a new figure."""
+    plt = _pyplot()
+    if ax is None:
+        fig = plt.figure()
+        return fig.add_subplot(projection="polar" if polar else None)
+    from matplotlib.axes import Axes
+
+    if not isinstance(ax, Axes):
+        raise TypeError(f"ax: expected a matplotlib Axes, got {type(ax).__name__}")
+    if polar and ax.name != "polar":
+        raise ValueError("ax: expected a polar Axes (e.g. plt.subplot(projection='polar'))")
+    return ax
+
+
+def _project(rgb: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    return np.asarray(rgb, dtype=np.float64) @ weights
+
+
+def _rgba(linear: np.ndarray, inside: np.ndarray, exposure: float) -> np.ndarray:
+    """8-bit sRGB with alpha 0 off the sphere, ``(..., R, R, 4)``."""
+    rgb = to_srgb8(linear, exposure)
+    alpha = np.broadcast_to(np.where(inside, 255, 0).astype(np.uint8), rgb.shape[:-1])
+    return np.concatenate([rgb, alpha[..., None]], axis=-1)
+
+
+def _sphere_axes(ax, title: str) -> None:
+    ax.set_xticks([])
+    ax.set_yticks([])
+    for spine in ax.spines.values():
+        spine.set_visible(False)
+    ax.set_title(title)
+
+
+# --------------------------------------------------------------------------
+# 1. BRDF image slice
+
+
+def slice_directions(resolution: int, phi_d: float = 90.0):
+    """``(theta_h, theta_d, wi, wo)`` of the (θh, θd) slice at ``phi_d`` (degrees).
+
+    ``theta_h``, ``theta_d``: pixel-centre angles in degrees, ``(resolution,)``
+    each, from 0 to 90; ``wi``, ``wo``: float64 ``(resolution, resolution, 3)``
+    indexed ``[θd, θh]``. Rusinkiewicz's half/difference parametrisation with
+    φh = 0: ``h = (sin θh, 0, cos θh)``, ``wi = Ry(θh) d`` and ``wo = Ry(θh) d'``
+    with ``d = (sin θd cos φd, sin θd sin φd, cos θd)`` and ``d'`` its
+    reflection about z (so ``h`` is their half vector and ``cos θd = wi·h``).
+    """
+    n = _resolution(resolution)
+    phi = np.radians(_real("phi_d", phi_d))
+    theta = (np.arange(n) + 0.5) * (90.0 / n)
+    th, td = np.meshgrid(np.radians(theta), np.radians(theta))  # [θd, θh]
+    sd, cd = np.sin(td), np.cos(td)
+    dx, dy = sd * np.cos(phi), sd * np.sin(phi)
+    sh, ch = np.sin(th), np.cos(th)
+
+    def rotate(x, y, z):  # rotation by θh about y: z -> h
+        return np.stack([x * ch + z * sh, y, z * ch - x * sh], axis=-1)
+
+    return theta, theta.copy(), rotate(dx, dy, cd), rotate(-dx, -dy, cd)
+
+
+def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
+               log: bool = True, model: str = "disney2014", vmin=None, vmax=None, cmap: str = "inferno",
+               colorbar: bool = True, ax=None):
+    """The BRDF image slice f(θh, θd) at azimuth ``phi_d`` (Burley 2012, figures 3, 4 and 17).
+
+    θh (half-vector angle from the normal, degrees) runs left to right from 0
+    to 90, θd (difference angle, between the light and the half vector) bottom
+    to top from 0 to 90, φh = 0 (see :func:`slice_directions`); the specular
+    peak is the left edge, grazing (Fresnel, sheen) the top, retro-reflection
+    the bottom right. Pixels where the light or the view is at or below the
+    horizon are masked (drawn in grey; NaN-free data underneath).
+
+    ``channel``: one of :data:`CHANNELS` (a colorbar in 1/sr), or ``"rgb"``:
+    the colour of f, with ``log`` mapping the luminance logarithmically and
+    keeping each pixel's chromaticity. ``log``: logarithmic colour scale over
+    ``[vmin, vmax]`` (default: the largest value and at most 6 decades below
+    it). Returns the Axes; the image is ``ax.images[-1]`` (``get_array()``
+    gives the plotted values, indexed ``[θd, θh]`` with row 0 at θd ≈ 0).
+    """
+    material = _uniform_material("material", material)
+    n = _resolution(resolution)
+    rgb_mode = channel == "rgb"
+    weights = None if rgb_mode else _channel(channel)
+    model_index(model)
+    for name, value in (("vmin", vmin), ("vmax", vmax)):
+        if value is not None and _real(name, value, 0.0) <= 0.0 and log:
+            raise ValueError(f"{name}: a logarithmic scale needs a positive value, got {value!r}")
+    ax = _axes(ax)
+    from matplotlib import colors
+
+    theta_h, theta_d, wi, wo = slice_directions(n, phi_d)
+    f = _eval(material, wi, wo, model=model).astype(np.float64)
+    valid = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
+    luminance = _project(f, np.asarray(CHANNELS["luminance"]) if rgb_mode else weights)
+    shown = luminance[valid]
+    top = float(vmax) if vmax is not None else (float(shown.max()) if shown.size else 0.0)
+    if top <= 0.0:
+        top = 1.0
+    if vmin is not None:
+        bottom = float(vmin)
+    elif log:
+        positive = shown[shown > 0.0]
+        bottom = max(float(positive.min()) if positive.size else top * 1e-6, top * 1e-6)
+        bottom = min(bottom, top * 0.5)
+    else:
+        bottom = 0.0
+    extent = (0.0, 90.0, 0.0, 90.0)
+    title = f"BRDF slice, φd = {float(phi_d):g}°"
+
+    if rgb_mode:
+        if log:
+            level = np.clip((np.log(np.maximum(luminance, bottom)) - np.log(bottom)) / np.log(top / bottom), 0.0, 1.0)
+            scale = np.divide(level, luminance, out=np.zeros_like(luminance), where=luminance > 0.0)
+            color = f * scale[..., None]
+        else:
+            color = to_srgb8(f / top).astype(np.float64) / 255.0
+        color = color / np.maximum(1.0, color.max(axis=-1, keepdims=True))  # keep the hue where it clips
+        image = np.empty(color.shape[:-1] + (4,))
+        image[..., :3] = np.where(valid[..., None], color, colors.to_rgb(_BACKGROUND))
+        image[..., 3] = 1.0
+        ax.imshow(image, origin="lower", extent=extent, interpolation="nearest")
+        ax.set_title(title + (" (log luminance)" if log else ""))
+    else:
+        data = np.ma.masked_array(np.where(valid, np.maximum(luminance, bottom if log else 0.0), bottom),
+                                  mask=~valid)
+        norm = colors.LogNorm(vmin=bottom, vmax=top) if log else colors.Normalize(vmin=bottom, vmax=top)
+        colormap = _pyplot().get_cmap(cmap).with_extremes(bad=_BACKGROUND)
+        image = ax.imshow(data, origin="lower", extent=extent, interpolation="nearest", norm=norm, cmap=colormap)
+        if colorbar:
+            ax.figure.colorbar(image, ax=ax, label=f"f, {channel} (1/sr)")
+        ax.set_title(title)
+    ax.set_xlabel("θh (degrees)")
+    ax.set_ylabel("θd (degrees)")
+    ax.set_xticks([0, 30, 60, 90])
+    ax.set_yticks([0, 30, 60, 90])
+    return ax
+
+
+# --------------------------------------------------------------------------
+# 2. polar plot in the plane of incidence
+
+
+def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = False, model: str = "disney2014",
+                resolution: int = 721, channel: str = "luminance", legend: bool = True, ax=None):
+    """f(wi, wo) in the plane of incidence, per lobe and in total, on a polar Axes.
+
+    ``wo = (sin θo, 0, cos θo)`` (``theta_o`` in degrees, in (-90, 90)), ``wi =
+    (sin t, 0, cos t)`` for t from -90 to 90 degrees in ``resolution`` steps;
+    the angle of the plot is t (0 at the top = the normal, positive to the
+    right, the side of wo), the radius is f in 1/sr (``cosine``: f cos θl).
+    ``lobes``: also draw the four lobes (lobes that are zero everywhere are
+    left out); their sum is the ``"total"`` line. The view direction is drawn
+    as a grey dashed line labelled ``"wo"``. ``ax`` must be a polar Axes.
+    Returns the polar Axes; lines carry labels ``"total"``, ``"diffuse"``, ...
+    """
+    material = _uniform_material("material", material)
+    theta = _real("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
+    n = _resolution(resolution)
+    weights = _channel(channel)
+    model_index(model)
+    ax = _axes(ax, polar=True)
+
+    t = np.radians(np.linspace(-90.0, 90.0, n))
+    wi = np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
+    wi[[0, -1], 2] = 0.0  # exactly on the horizon (cos(±π/2) is 6e-17)
+    wo = np.array([np.sin(np.radians(theta)), 0.0, np.cos(np.radians(theta))])
+    values = _eval_lobes(material, wi, wo, cosine=cosine, model=model)
+    curves = {name: _project(v, weights) for name, v in zip(LOBE_NAMES, values)}
+    total = sum(curves.values())
+
+    if lobes:
+        for name, curve in curves.items():
+            if np.any(curve > 0.0):
+                ax.plot(t, curve, color=_LOBE_COLORS[name], lw=1.2, label=name)
+    ax.plot(t, total, color=_LOBE_COLORS["total"], lw=1.8, label="total")
+    top = float(total.max()) if total.max() > 0 else 1.0
+    ax.plot([np.radians(theta)] * 2, [0.0, top], color="0.5", ls="--", lw=1.0, label="wo")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(-90)
+    ax.set_thetamax(90)
+    ax.set_ylim(0.0, top * 1.05)
+    quantity = "f cos θl" if cosine else "f"
+    ax.set_title(f"{quantity} (1/sr, {channel}) in the plane of incidence, θo = {theta:g}°\n"
+                 "angle: θl from the normal, positive on the side of wo")
+    if legend:  # below the half disc (its baseline is at axes y = 0.25)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.17), ncol=3, fontsize="small", frameon=False)
+    return ax
+
+
+# --------------------------------------------------------------------------
+# 3. lit sphere, optionally with an environment
+
+
+def sky_environment(direction, zenith=(0.25, 0.45, 1.0), horizon=(1.0, 1.0, 1.0), ground=(0.25, 0.22, 0.2)):
+    """A simple sky/ground gradient ``L(w)`` (RGB radiance) for camera-space directions ``(..., 3)``.
+
+    y is up (as in :mod:`principled_brdf.render`): above the horizon the sky
+    goes from ``horizon`` to ``zenith`` as ``sqrt(y)``; below it is ``ground``,
+    blended over a narrow band around the horizon.
+    """
+    w = np.asarray(direction, dtype=np.float64)
+    up = w[..., 1:2]
+    zenith, horizon, ground = (np.asarray(c, dtype=np.float64) for c in (zenith, horizon, ground))
+    sky = horizon + (zenith - horizon) * np.sqrt(np.clip(up, 0.0, 1.0))
+    blend = np.clip(0.5 + up / 0.04, 0.0, 1.0)
+    return ground + (sky - ground) * blend
+
+
+def _environment_term(material: Material, resolution: int, environment, samples: int, seed: int, model: str):
+    """Per-pixel ``∫ f L(wi) cos θl dwi`` by importance sampling (``pb.sample``), ``(R, R, 3)``."""
+    inside, to_local = sphere_frames(resolution)
+    wo = to_local((0.0, 0.0, 1.0))
+    # to_local(e_k)[..., j] = frame_j[k]: the rows of the local-to-camera matrix.
+    to_camera = np.stack([to_local(e) for e in np.eye(3)], axis=-2)  # [..., k, j]
+    pixels = resolution * resolution
+    chunk = max(1, (1 << 20) // pixels)
+    total = np.zeros((resolution, resolution, 3))
+    for start in range(0, samples, chunk):
+        count = min(chunk, samples - start)
+        u = _random_uniforms(seed, count * pixels, first=start * pixels).reshape(count, resolution, resolution, 3)
+        drawn = _sample(material, wo, u=u, model=model)
+        direction = np.einsum("...kj,s...j->s...k", to_camera, drawn.wi)
+        radiance = np.asarray(environment(direction), dtype=np.float64)
+        if radiance.shape != direction.shape:
+            raise ValueError(f"environment: expected RGB radiance of shape {direction.shape}, got {radiance.shape}")
+        total += np.einsum("s...c,s...c->...c", drawn.weight.astype(np.float64), radiance)
+    total /= samples
+    total[~inside] = 0.0
+    return total
+
+
+def lit_sphere(material, *, resolution: int = 256, light=DEFAULT_LIGHT, light_intensity: float = 3.0,
+               environment=False, environment_samples: int = 64, seed: int = 0, exposure: float = 1.0,
+               model: str = "disney2014", ax=None):
+    """The material on a sphere (``pb.render.render_sphere``), shown as sRGB; returns the Axes.
+
+    ``material`` is uniform or per pixel (leading shape ``(resolution,
+    resolution)``). ``light``: direction towards the light in camera space
+    (x right, y up, z to the viewer), ``light_intensity`` its irradiance
+    scale (0 turns it off). ``environment``: ``True`` adds the
+    :func:`sky_environment` lighting, a callable ``L(w)`` (camera-space
+    directions ``(..., 3)`` to RGB radiance) adds that one; the integral
+    ``∫ f L cos θl dωi`` is estimated per pixel from ``environment_samples``
+    importance samples (``pb.sample``, reproducible from ``seed``), and
+    replaces render_sphere's constant ambient term. ``exposure`` scales the
+    linear image before the sRGB encoding. Off the sphere is transparent.
+    """
+    material = _material("material", material)
+    n = _resolution(resolution)
+    exposure = _real("exposure", exposure, 0.0)
+    intensity = _real("light_intensity", light_intensity, 0.0)
+    if environment is True:
+        environment = sky_environment
+    elif environment is False or environment is None:
+        environment = None
+    elif not callable(environment):
+        raise TypeError(f"environment: expected a bool or a callable L(direction), got {type(environment).__name__}")
+    if material.shape not in ((), (n, n)):
+        raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
+                         f"got {material.shape}")
+    count = _resolution(environment_samples, "environment_samples", minimum=1)
+    model_index(model)
+    ax = _axes(ax)
+
+    image = render_sphere(material, n, light=light, light_intensity=intensity,
+                          ambient=_AMBIENT if environment is None else 0.0, model=model)
+    if environment is not None:
+        image = image + _environment_term(material, n, environment, count, seed, model)
+    inside, _ = sphere_frames(n)
+    ax.imshow(_rgba(image, inside, exposure), interpolation="nearest")
+    _sphere_axes(ax, "lit sphere" + (" + environment" if environment is not None else ""))
+    return ax
+
+
+# --------------------------------------------------------------------------
+# 4. directional albedo
+
+
+def albedo_curves(material, *, angles=np.linspace(0, 89, 46), samples: int = 1 << 14, seed: int = 0,
+                  model: str = "disney2014", channel: str = "luminance", lobes: bool = True, ax=None):
+    """Directional albedo ``E(θo) = ∫ f cos θl dωi`` against θo (``pb.albedo``), per lobe and in total.
+
+    ``angles``: view angles in degrees, in [0, 90). Each point is the mean of
+    ``samples`` importance-sampled weights; the bands are ±2 standard errors
+    (for ``"luminance"`` the luminance-weighted sum of the per-channel errors,
+    an upper bound). Lobes whose albedo is zero at every angle are left out.
+    Returns the Axes; lines carry labels ``"total"``, ``"diffuse"``, ...
+    """
+    material = _uniform_material("material", material)
+    weights = _channel(channel)
+    theta = np.asarray(angles, dtype=np.float64) if not isinstance(angles, str) else None
+    if theta is None or theta.ndim != 1 or theta.size < 1 or not np.all(np.isfinite(theta)):
+        raise ValueError("angles: expected a 1-d array of finite angles in degrees")
+    if np.any(theta < 0.0) or np.any(theta >= 90.0):
+        raise ValueError(f"angles: expected degrees in [0, 90), got values from {theta.min():g} to {theta.max():g}")
+    _resolution(samples, "samples")
+    model_index(model)
+    ax = _axes(ax)
+
+    result = _albedo(material, np.cos(np.radians(theta)), samples=samples, seed=seed, model=model)
+    curves = [("total", result.total, result.total_error)]
+    if lobes:
+        curves += [(name, value, error) for name, value, error in zip(LOBE_NAMES, result.lobes, result.lobe_errors)]
+    for name, value, error in curves:
+        mean, band = _project(value, weights), _project(error, weights) * 2.0
+        if name != "total" and not np.any(mean > 0.0):
+            continue
+        color = _LOBE_COLORS[name]
+        ax.plot(theta, mean, color=color, lw=1.8 if name == "total" else 1.2, label=name)
+        ax.fill_between(theta, mean - band, mean + band, color=color, alpha=0.25, lw=0)
+    ax.set_xlim(0.0, 90.0)
+    ax.set_ylim(bottom=0.0)
+    ax.set_xlabel("θo (degrees)")
+    ax.set_ylabel(f"directional albedo ({channel}, unitless)")
+    ax.set_title(f"directional albedo, ±2 s.e. ({samples} samples)")
+    ax.legend(fontsize="small", frameon=False)
+    return ax
+
+
+# --------------------------------------------------------------------------
+# 5. parameter sweep (Burley 2012, figure 16)
+
+
+def _default_sweep_base() -> Material:
+    return Material(base_color=(0.7, 0.2, 0.1), roughness=0.5)
+
+
+def _shade_spheres(material: Material, resolution: int, light, light_intensity: float, ambient: float, model: str):
+    """render_sphere's shading for many spheres at once: material of leading shape
+    ``S + (1, 1)`` gives linear RGB ``S + (R, R, 3)`` in one kernel call."""
+    inside, to_local = sphere_frames(resolution)
+    wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
+    radiance = light_intensity * _eval(material, wi, wo, cosine=True, model=model)
+    radiance += ambient * np.asarray(material.base_color, dtype=np.float32)
+    radiance[..., ~inside, :] = 0.0
+    return radiance, inside
+
+
+def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11, resolution: int = 64, ranges=None,
+                    light=DEFAULT_LIGHT, exposure: float = 1.0, model: str = "disney2014", figsize=None):
+    """The grid of Burley 2012 figure 16: one row per parameter, that parameter
+    going from 0 to 1 (or ``ranges[name] = (lo, hi)``) in ``steps`` spheres
+    along the row, every other parameter as in ``base``; returns the Figure.
+
+    ``base``: a uniform Material or preset name (default: a red dielectric,
+    roughness 0.5). Rows of ``sheen_tint`` and ``clearcoat_gloss`` use
+    ``sheen = 1`` / ``clearcoat = 1`` when the base has none, so the tint and
+    gloss are visible. All spheres are shaded as ``pb.render.render_sphere``
+    does, in one ``pb.eval`` call (materials batched per pixel). The Figure
+    has one Axes per row (in ``fig.axes`` order), each showing its row image.
+    """
+    base = _default_sweep_base() if base is None else _uniform_material("base", base)
+    if isinstance(parameters, str):
+        parameters = (parameters,)
+    names = tuple(parameters)
+    if not names:
+        raise ValueError("parameters: expected at least one parameter name")
+    for name in names:
+        if name not in SCALAR_PARAMETERS:
+            raise ValueError(f"parameters: unknown scalar parameter {name!r}; "
+                             f"choose from {', '.join(SCALAR_PARAMETERS)}")
+    count = _resolution(steps, "steps")
+    n = _resolution(resolution)
+    exposure = _real("exposure", exposure, 0.0)
+    ranges = {} if ranges is None else dict(ranges)
+    for name in ranges:
+        if name not in names:
+            raise ValueError(f"ranges: {name!r} is not one of the swept parameters")
+    spans = []
+    for name in names:
+        lo, hi = ranges.get(name, (0.0, 1.0))
+        spans.append((_real(f"ranges[{name!r}]", lo), _real(f"ranges[{name!r}]", hi)))
+
+    rows = len(names)
+    params = {"base_color": base.base_color}
+    for name in SCALAR_PARAMETERS:
+        grid = np.full((rows, count), float(getattr(base, name)))
+        if name in names:
+            lo, hi = spans[names.index(name)]
+            grid[names.index(name)] = np.linspace(lo, hi, count)
+        params[name] = grid
+    for tint, parent in (("sheen_tint", "sheen"), ("clearcoat_gloss", "clearcoat")):
+        if tint in names and float(getattr(base, parent)) == 0.0:
+            params[parent][names.index(tint)] = 1.0
+    try:
+        material = Material(**{k: (v[:, :, None, None] if k != "base_color" else v) for k, v in params.items()})
+    except ValueError as error:
+        raise ValueError(f"ranges: {error}") from None
+
+    linear, inside = _shade_spheres(material, n, light, _LIGHT_INTENSITY, _AMBIENT, model)
+    spheres = _rgba(linear, inside, exposure)  # (rows, steps, R, R, 4)
+    pad = max(1, n // 16)
+    spheres = np.pad(spheres, ((0, 0), (0, 0), (pad, pad), (pad, pad), (0, 0)))
+    cell = n + 2 * pad
+    strips = spheres.transpose(0, 2, 1, 3, 4).reshape(rows, cell, count * cell, 4)
+
+    plt = _pyplot()
+    if figsize is None:
+        figsize = (0.75 * count + 2.4, 0.75 * rows + 0.9)
+    fig, axes = plt.subplots(rows, 1, figsize=figsize, squeeze=False, layout="constrained")
+    for row, (name, (lo, hi)) in enumerate(zip(names, spans)):
+        ax = axes[row, 0]
+        ax.imshow(strips[row], interpolation="nearest")
+        _sphere_axes(ax, "")
+        ax.set_ylabel(name, rotation=0, ha="right", va="center")
+        ax.text(1.01, 0.5, f"{lo:g} → {hi:g}", transform=ax.transAxes, ha="left", va="center", fontsize="small")
+    bottom = axes[-1, 0]
+    fractions = np.linspace(0.0, 1.0, count)
+    bottom.set_xticks((np.arange(count) + 0.5) * cell)
+    bottom.set_xticklabels([f"{x:.2g}" for x in fractions], fontsize="small")
+    bottom.set_xlabel("t: each row's parameter = lo + t (hi − lo)")
+    fig.suptitle("parameter sweep (Burley 2012, figure 16)")
+    return fig
+
+
+# --------------------------------------------------------------------------
+# 6. blending by masks
+
+
+def _checker(resolution: int, cells: int = 8) -> np.ndarray:
+    index = (np.arange(resolution) * cells) // resolution
+    return ((index[:, None] + index[None, :]) % 2).astype(np.float64)
+
+
+def blend_demo(a, b, *, mask=None, resolution: int = 256, light=DEFAULT_LIGHT, exposure: float = 1.0,
+               model: str = "disney2014", ax=None):
+    """A sphere of ``Material.mix(a, b, mask)`` with a per-pixel mask; returns the Axes.
+
+    ``a``, ``b``: Materials or preset names. ``mask``: weights of ``b`` in
+    [0, 1], a number or an array of shape ``(resolution, resolution)`` (row 0
+    at the top, like the image); default an 8 x 8 checker. Rendered with
+    ``pb.render.render_sphere`` in one kernel call.
+    """
+    a = _material("a", a)
+    b = _material("b", b)
+    n = _resolution(resolution)
+    exposure = _real("exposure", exposure, 0.0)
+    if mask is None:
+        mask = _checker(n)
+    else:
+        if isinstance(mask, (str, bytes)):
+            raise TypeError(f"mask: expected a number or an array, got {type(mask).__name__}")
+        mask = np.asarray(mask, dtype=np.float64)
+        if mask.shape not in ((), (n, n)):
+            raise ValueError(f"mask: expected a number or shape {(n, n)}, got shape {mask.shape}")
+        bad = ~np.isfinite(mask) | (mask < 0.0) | (mask > 1.0)
+        if bad.any():
+            index = np.unravel_index(int(np.flatnonzero(bad)[0]), mask.shape)
+            raise ValueError(f"mask{list(index) if index else ''}: {float(mask[index])!r} is outside [0, 1]")
+    material = Material.mix(a, b, np.broadcast_to(mask, (n, n)))
+    model_index(model)
+    ax = _axes(ax)
+    image = render_sphere(material, n, light=light, model=model)
+    inside, _ = sphere_frames(n)
+    ax.imshow(_rgba(image, inside, exposure), interpolation="nearest")
+    _sphere_axes(ax, "Material.mix(a, b, mask)")
+    return ax

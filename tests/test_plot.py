@@ -1,0 +1,430 @@
+"""principled_brdf.plot: the notebook pictures (matplotlib, Agg backend).
+
+Each function: draws without error, returns the documented object (Axes,
+polar Axes, Figure), draws into a passed ``ax``, makes a picture that is not
+blank, shows the numbers the kernel gives (probed against pb.eval, pb.albedo,
+pb.render), and rejects bad arguments naming them.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+matplotlib = pytest.importorskip("matplotlib")
+matplotlib.use("Agg")
+import matplotlib.image as mpimg  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+import principled_brdf as pb  # noqa: E402
+import principled_brdf.plot as pbplot  # noqa: E402
+
+REC709 = np.array([0.2126, 0.7152, 0.0722])
+LOBE_NAMES = ("diffuse", "sheen", "specular", "clearcoat")
+
+# A material with every lobe switched on, and a rough, diffuse-dominated white dielectric.
+EVERYTHING = pb.Material(base_color=(0.6, 0.3, 0.2), roughness=0.4, sheen=1.0, clearcoat=0.6, clearcoat_gloss=0.3,
+                         specular_tint=0.5)
+ROUGH_WHITE = pb.Material(base_color=(1.0, 1.0, 1.0), roughness=1.0, specular=0.0)
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+def assert_png_not_blank(figure: Figure, tmp_path, name: str) -> None:
+    path = tmp_path / f"{name}.png"
+    figure.savefig(path, dpi=60)
+    assert path.stat().st_size > 3000
+    pixels = mpimg.imread(path)
+    assert pixels.ndim == 3 and pixels[..., :3].std() > 0.02
+
+
+def image_of(ax) -> np.ndarray:
+    assert len(ax.images) == 1
+    return ax.images[0].get_array()  # a masked array where the plot masks pixels
+
+
+def line(ax, label: str):
+    found = [l for l in ax.get_lines() if l.get_label() == label]
+    assert len(found) == 1, f"no single line labelled {label!r}: {[l.get_label() for l in ax.get_lines()]}"
+    return np.asarray(found[0].get_xdata(), float), np.asarray(found[0].get_ydata(), float)
+
+
+def srgb8_to_linear(values) -> np.ndarray:
+    c = np.asarray(values, dtype=np.float64) / 255.0
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def slice_pair(theta_h, theta_d, phi_d):
+    """wi, wo at (θh, θd, φd) in degrees, φh = 0, built from the half vector's frame."""
+    th, td, pd = np.radians([theta_h, theta_d, phi_d])
+    h = np.array([np.sin(th), 0.0, np.cos(th)])
+    t = np.array([np.cos(th), 0.0, -np.sin(th)])  # tangent of h in the plane of incidence
+    b = np.array([0.0, 1.0, 0.0])
+    wi = np.sin(td) * np.cos(pd) * t + np.sin(td) * np.sin(pd) * b + np.cos(td) * h
+    wo = 2.0 * (wi @ h) * h - wi
+    return wi, wo
+
+
+def test_import_does_not_need_matplotlib():
+    code = ("import sys, principled_brdf, principled_brdf.plot; "
+            "assert 'matplotlib' not in sys.modules, 'matplotlib imported at module import'")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
+
+
+# --------------------------------------------------------------------------
+# brdf_slice
+
+
+def test_brdf_slice_draws_a_log_image_with_colorbar(tmp_path):
+    ax = pbplot.brdf_slice(EVERYTHING, resolution=64)
+    assert isinstance(ax, Axes)
+    data = image_of(ax)
+    assert data.shape == (64, 64)
+    assert np.all(np.isfinite(np.ma.getdata(data)))
+    assert np.ma.count_masked(data) == 0  # φd = 90: both directions above the horizon everywhere
+    assert np.log(np.ma.getdata(data)).std() > 0.5
+    assert len(ax.figure.axes) == 2  # the colorbar
+    assert "θh" in ax.get_xlabel() and "θd" in ax.get_ylabel()
+    assert_png_not_blank(ax.figure, tmp_path, "slice")
+
+
+@pytest.mark.parametrize("phi_d", [90.0, 30.0])
+def test_brdf_slice_values_are_pb_eval_at_probed_angles(phi_d):
+    n = 90  # pixel centres at 0.5, 1.5, ... 89.5 degrees
+    ax = pbplot.brdf_slice(EVERYTHING, resolution=n, phi_d=phi_d)
+    data = image_of(ax)
+    for row, col in [(5, 2), (40, 10), (20, 70), (80, 3), (60, 60)]:
+        theta_h, theta_d = col + 0.5, row + 0.5
+        wi, wo = slice_pair(theta_h, theta_d, phi_d)
+        below = wi[2] <= 0 or wo[2] <= 0
+        assert bool(np.ma.getmaskarray(data)[row, col]) == below, (row, col)
+        if not below:
+            expected = float(pb.eval(EVERYTHING, wi, wo) @ REC709)
+            assert data[row, col] == pytest.approx(expected, rel=2e-4), (row, col)
+    if phi_d == 30.0:
+        mask = np.ma.getmaskarray(data)
+        assert mask[-1, -1] and not mask[0, 0]  # the below-horizon corner is masked, top right
+        assert np.all(np.isfinite(np.ma.getdata(data)))
+
+
+def test_brdf_slice_of_a_rough_diffuse_material_is_smooth():
+    data = np.ma.getdata(image_of(pbplot.brdf_slice(ROUGH_WHITE, resolution=64, phi_d=90.0)))
+    log = np.log(data)
+    # neighbouring pixels (1.4 degrees apart) differ by 2 % at most below 60 degrees (towards the
+    # horizon the Fresnel factors rise quickly), and nowhere is there a kink or a peak
+    # (a glossy material has first and second differences of 3 in log f at the specular peak)
+    assert np.abs(np.diff(log[:42, :42], axis=0)).max() < 0.02
+    assert np.abs(np.diff(log[:42, :42], axis=1)).max() < 0.02
+    assert np.abs(np.diff(log, axis=0)).max() < 0.2 and np.abs(np.diff(log, axis=1)).max() < 0.2
+    assert np.abs(np.diff(log, 2, axis=0)).max() < 0.03 and np.abs(np.diff(log, 2, axis=1)).max() < 0.03
+    assert data.max() / data.min() < 10.0
+
+
+def test_brdf_slice_rgb_channel_and_existing_axes():
+    fig, (left, right) = plt.subplots(1, 2)
+    assert pbplot.brdf_slice(EVERYTHING, resolution=32, channel="rgb", phi_d=30, ax=left) is left
+    rgba = image_of(left)
+    assert rgba.shape == (32, 32, 4) and np.all(np.isfinite(rgba)) and rgba[..., :3].std() > 0.05
+    assert pbplot.brdf_slice("gold", resolution=32, channel="r", log=False, ax=right) is right
+    assert len(fig.axes) == 3  # two panels and one colorbar
+
+
+def test_brdf_slice_bad_arguments():
+    with pytest.raises(ValueError, match="channel"):
+        pbplot.brdf_slice(EVERYTHING, channel="hue")
+    with pytest.raises(ValueError, match="resolution"):
+        pbplot.brdf_slice(EVERYTHING, resolution=1)
+    with pytest.raises(TypeError, match="material"):
+        pbplot.brdf_slice({"roughness": 0.5})
+    with pytest.raises(ValueError, match="model"):
+        pbplot.brdf_slice(EVERYTHING, resolution=8, model="phong")
+    with pytest.raises(TypeError, match="ax"):
+        pbplot.brdf_slice(EVERYTHING, resolution=8, ax="left")
+    with pytest.raises(ValueError, match="vmin"):
+        pbplot.brdf_slice(EVERYTHING, resolution=8, vmin=0.0)
+    assert plt.get_fignums() == []  # every check comes before any figure is made
+
+
+# --------------------------------------------------------------------------
+# polar_lobes
+
+
+def test_polar_lobes_total_is_the_sum_of_the_lobes(tmp_path):
+    ax = pbplot.polar_lobes(EVERYTHING, 40.0, resolution=181)
+    assert isinstance(ax, Axes) and ax.name == "polar"
+    angles, total = line(ax, "total")
+    assert angles.shape == (181,) and np.all(np.isfinite(total)) and total.std() > 0
+    assert angles[0] == pytest.approx(-np.pi / 2) and angles[-1] == pytest.approx(np.pi / 2)
+    lobe_sum = sum(line(ax, name)[1] for name in LOBE_NAMES)
+    np.testing.assert_allclose(lobe_sum, total, rtol=1e-5, atol=1e-7)
+    assert_png_not_blank(ax.figure, tmp_path, "polar")
+
+
+def test_polar_lobes_values_and_peak():
+    theta_o = 35.0
+    glossy = pb.Material(base_color=(0.5, 0.5, 0.5), roughness=0.2)
+    ax = pbplot.polar_lobes(glossy, theta_o, resolution=721, cosine=True)
+    angles, total = line(ax, "total")
+    wo = np.array([np.sin(np.radians(theta_o)), 0.0, np.cos(np.radians(theta_o))])
+    for k in (100, 250, 600):
+        wi = np.array([np.sin(angles[k]), 0.0, np.cos(angles[k])])
+        expected = float(pb.eval(glossy, wi, wo, cosine=True) @ REC709)
+        assert total[k] == pytest.approx(expected, rel=1e-5)
+    # the specular peak is at the mirror direction, on the other side of the normal
+    assert np.degrees(angles[np.argmax(line(ax, "specular")[1])]) == pytest.approx(-theta_o, abs=1.0)
+    assert total[0] == 0.0 and total[-1] == 0.0  # on the horizon
+    # no sheen or clearcoat: those lines are left out
+    assert {l.get_label() for l in ax.get_lines()} == {"diffuse", "specular", "total", "wo"}
+
+
+def test_polar_lobes_into_existing_polar_axes_and_total_only():
+    fig = plt.figure()
+    ax = fig.add_subplot(projection="polar")
+    assert pbplot.polar_lobes("car_paint", 10, lobes=False, resolution=91, ax=ax) is ax
+    assert {l.get_label() for l in ax.get_lines()} == {"total", "wo"}
+
+
+def test_polar_lobes_bad_arguments():
+    with pytest.raises(ValueError, match="ax"):
+        pbplot.polar_lobes(EVERYTHING, 30, ax=plt.figure().add_subplot())
+    with pytest.raises(ValueError, match="theta_o"):
+        pbplot.polar_lobes(EVERYTHING, 90)
+    with pytest.raises(ValueError, match="resolution"):
+        pbplot.polar_lobes(EVERYTHING, 30, resolution=1)
+    with pytest.raises(ValueError, match="channel"):
+        pbplot.polar_lobes(EVERYTHING, 30, channel="alpha")
+    with pytest.raises(TypeError, match="material"):
+        pbplot.polar_lobes(0.5, 30)
+
+
+# --------------------------------------------------------------------------
+# lit_sphere
+
+
+def test_lit_sphere_is_render_sphere_in_srgb(tmp_path):
+    material = pb.presets.get("car_paint")
+    ax = pbplot.lit_sphere(material, resolution=48)
+    assert isinstance(ax, Axes)
+    rgba = image_of(ax)
+    assert rgba.shape == (48, 48, 4) and rgba.dtype == np.uint8
+    expected = pb.render.to_srgb8(pb.render.render_sphere(material, 48))
+    np.testing.assert_array_equal(rgba[..., :3], expected)
+    inside, _ = pb.render.sphere_frames(48)
+    np.testing.assert_array_equal(rgba[..., 3] > 0, inside)  # transparent off the sphere
+    assert rgba[..., :3][inside].std() > 5
+    assert_png_not_blank(ax.figure, tmp_path, "sphere")
+
+
+def test_lit_sphere_environment_matches_the_albedo():
+    # A constant environment L = 1 with the light off shows the directional albedo E(wo);
+    # at the centre of the sphere wo is (nearly) the normal.
+    n, exposure = 64, 0.5
+    ax = pbplot.lit_sphere(ROUGH_WHITE, resolution=n, light_intensity=0.0, environment=lambda w: np.ones_like(w),
+                           environment_samples=32, exposure=exposure, seed=3)
+    centre = srgb8_to_linear(image_of(ax)[n // 2 - 4: n // 2 + 4, n // 2 - 4: n // 2 + 4, :3]) / exposure
+    expected = pb.albedo(ROUGH_WHITE, 1.0, samples=1 << 15).total
+    np.testing.assert_allclose(centre.mean(axis=(0, 1)), expected, rtol=0.03)
+
+
+def test_lit_sphere_sky_environment_is_seeded_and_brightens():
+    fig, axes = plt.subplots(1, 3)
+    material = pb.presets.get("gold")
+    plain = image_of(pbplot.lit_sphere(material, resolution=40, ax=axes[0]))
+    sky = image_of(pbplot.lit_sphere(material, resolution=40, environment=True, environment_samples=8, ax=axes[1]))
+    again = image_of(pbplot.lit_sphere(material, resolution=40, environment=True, environment_samples=8, ax=axes[2]))
+    np.testing.assert_array_equal(sky, again)
+    inside = plain[..., 3] > 0
+    assert sky[..., :3][inside].astype(float).mean() > plain[..., :3][inside].astype(float).mean() + 20
+
+
+def test_lit_sphere_per_pixel_material():
+    n = 32
+    roughness = np.tile(np.linspace(0.05, 1.0, n), (n, 1))
+    material = pb.Material(roughness=roughness, base_color=(0.5, 0.5, 0.5))
+    rgba = image_of(pbplot.lit_sphere(material, resolution=n))
+    np.testing.assert_array_equal(rgba[..., :3], pb.render.to_srgb8(pb.render.render_sphere(material, n)))
+    lit = image_of(pbplot.lit_sphere(material, resolution=n, environment=True, environment_samples=4))
+    inside = rgba[..., 3] > 0
+    assert np.all(lit[..., :3][inside].astype(int) >= rgba[..., :3][inside] - 2)  # the sky replaces a 0.03 ambient
+
+
+def test_lit_sphere_bad_arguments():
+    with pytest.raises(ValueError, match="resolution"):
+        pbplot.lit_sphere(EVERYTHING, resolution=0)
+    with pytest.raises(TypeError, match="material"):
+        pbplot.lit_sphere(None)
+    with pytest.raises(ValueError, match="material"):
+        pbplot.lit_sphere("no_such_preset")
+    with pytest.raises(ValueError, match="material"):
+        pbplot.lit_sphere(pb.Material(roughness=np.full((5, 5), 0.3)), resolution=8)
+    with pytest.raises(TypeError, match="environment"):
+        pbplot.lit_sphere(EVERYTHING, resolution=8, environment="sky")
+    with pytest.raises(ValueError, match="exposure"):
+        pbplot.lit_sphere(EVERYTHING, resolution=8, exposure=-1.0)
+    with pytest.raises(ValueError, match="environment_samples"):
+        pbplot.lit_sphere(EVERYTHING, resolution=8, environment=True, environment_samples=0)
+    with pytest.raises(ValueError, match="model"):
+        pbplot.lit_sphere(EVERYTHING, resolution=8, model="disney2015")
+    assert plt.get_fignums() == []
+
+
+# --------------------------------------------------------------------------
+# albedo_curves
+
+
+def test_albedo_curves_of_a_white_rough_dielectric(tmp_path):
+    white = pb.Material(base_color=(1.0, 1.0, 1.0), roughness=0.5)
+    ax = pbplot.albedo_curves(white, samples=4096)
+    assert isinstance(ax, Axes)
+    angles, total = line(ax, "total")
+    np.testing.assert_allclose(angles, np.linspace(0, 89, 46))
+    assert np.all(np.isfinite(total)) and total.std() > 0
+    # Burley's diffuse is not energy conserving: E is about 1.04 at normal incidence, 1.2 at grazing
+    assert np.all(total > 0.9) and np.all(total < 1.3)
+    lobe_sum = sum(line(ax, name)[1] for name in ("diffuse", "specular"))
+    np.testing.assert_allclose(lobe_sum, total, rtol=1e-6)
+    expected = pb.albedo(white, np.cos(np.radians(angles)), samples=4096).total @ REC709
+    np.testing.assert_allclose(total, expected, rtol=1e-12)
+    assert len(ax.collections) == 3  # ±2 standard-error bands: total, diffuse, specular
+    assert "θo" in ax.get_xlabel()
+    assert_png_not_blank(ax.figure, tmp_path, "albedo")
+
+
+def test_albedo_curves_bands_cover_the_mean_and_existing_axes():
+    fig, ax = plt.subplots()
+    assert pbplot.albedo_curves("satin_cloth", angles=[0, 30, 60, 80], samples=512, channel="r", ax=ax) is ax
+    _, total = line(ax, "total")
+    band = ax.collections[0].get_paths()[0].vertices[:, 1]
+    assert band.min() < total.min() and band.max() > total.max()
+    assert {l.get_label() for l in ax.get_lines()} == {"total", "diffuse", "sheen", "specular"}
+
+
+def test_albedo_curves_bad_arguments():
+    with pytest.raises(ValueError, match="angles"):
+        pbplot.albedo_curves(EVERYTHING, angles=[0, 90])
+    with pytest.raises(ValueError, match="angles"):
+        pbplot.albedo_curves(EVERYTHING, angles=[[10, 20]])
+    with pytest.raises(ValueError, match="samples"):
+        pbplot.albedo_curves(EVERYTHING, angles=[10], samples=1)
+    with pytest.raises(ValueError, match="channel"):
+        pbplot.albedo_curves(EVERYTHING, angles=[10], channel="rgb")
+    with pytest.raises(TypeError, match="material"):
+        pbplot.albedo_curves([0.5], angles=[10])
+    assert plt.get_fignums() == []
+
+
+# --------------------------------------------------------------------------
+# parameter_sweep
+
+
+def test_parameter_sweep_grid(tmp_path):
+    steps, n = 5, 24
+    fig = pbplot.parameter_sweep(steps=steps, resolution=n)
+    assert isinstance(fig, Figure)
+    assert len(fig.axes) == len(pbplot.SCALAR_PARAMETERS) == 10
+    assert [ax.get_ylabel() for ax in fig.axes] == list(pbplot.SCALAR_PARAMETERS)
+    strips = [image_of(ax) for ax in fig.axes]
+    cell = strips[0].shape[1] // steps
+    assert all(s.shape == (cell, steps * cell, 4) for s in strips)
+    for name, strip in zip(pbplot.SCALAR_PARAMETERS, strips):
+        first, last = strip[:, :cell, :3].astype(float), strip[:, -cell:, :3].astype(float)
+        assert first.std() > 5
+        if name not in ("sheen", "sheen_tint"):  # a faint grazing lobe: little change with this light
+            assert np.abs(first - last).max() > 5, name
+    assert_png_not_blank(fig, tmp_path, "sweep")
+
+
+def test_parameter_sweep_cells_are_render_sphere():
+    base = pb.Material(base_color=(0.2, 0.5, 0.8), roughness=0.3)
+    steps, n = 4, 20
+    fig = pbplot.parameter_sweep(base, parameters=("roughness", "clearcoat_gloss"), steps=steps, resolution=n,
+                                 ranges={"roughness": (0.2, 0.8)})
+    strips = [image_of(ax) for ax in fig.axes]
+    cell = strips[0].shape[1] // steps
+    pad = (cell - n) // 2
+    for j, value in enumerate(np.linspace(0.2, 0.8, steps)):
+        sphere = strips[0][pad:pad + n, j * cell + pad: j * cell + pad + n, :3]
+        expected = pb.render.to_srgb8(pb.render.render_sphere(base.replace(roughness=value), n))
+        assert np.abs(sphere.astype(int) - expected).max() <= 1, j
+    # clearcoat_gloss row: the base has no clearcoat, so the row turns it on to show the gloss
+    j = steps - 1
+    sphere = strips[1][pad:pad + n, j * cell + pad: j * cell + pad + n, :3]
+    expected = pb.render.to_srgb8(pb.render.render_sphere(base.replace(clearcoat=1.0, clearcoat_gloss=1.0), n))
+    assert np.abs(sphere.astype(int) - expected).max() <= 1
+
+
+def test_parameter_sweep_bad_arguments():
+    with pytest.raises(ValueError, match="parameters"):
+        pbplot.parameter_sweep(parameters=("base_color",))
+    with pytest.raises(ValueError, match="parameters"):
+        pbplot.parameter_sweep(parameters=("shininess",))
+    with pytest.raises(ValueError, match="steps"):
+        pbplot.parameter_sweep(steps=1)
+    with pytest.raises(ValueError, match="resolution"):
+        pbplot.parameter_sweep(resolution=1)
+    with pytest.raises(ValueError, match="ranges"):
+        pbplot.parameter_sweep(parameters=("metallic",), ranges={"metallic": (0.0, 2.0)}, resolution=8, steps=2)
+    with pytest.raises(ValueError, match="ranges"):
+        pbplot.parameter_sweep(parameters=("metallic",), ranges={"roughness": (0.0, 1.0)}, resolution=8, steps=2)
+    with pytest.raises(TypeError, match="base"):
+        pbplot.parameter_sweep(base=3.0)
+    with pytest.raises(ValueError, match="base"):
+        pbplot.parameter_sweep(base=pb.Material(roughness=[0.1, 0.2]))
+    assert plt.get_fignums() == []
+
+
+# --------------------------------------------------------------------------
+# blend_demo
+
+
+def test_blend_demo_default_checker_shows_both_materials(tmp_path):
+    a, b = pb.presets.get("gold"), pb.presets.get("blue_rubber")
+    n = 64
+    ax = pbplot.blend_demo(a, b, resolution=n)
+    assert isinstance(ax, Axes)
+    rgba = image_of(ax)
+    only_a = pb.render.to_srgb8(pb.render.render_sphere(a, n))
+    only_b = pb.render.to_srgb8(pb.render.render_sphere(b, n))
+    inside = rgba[..., 3] > 0
+    from_a = np.all(rgba[..., :3] == only_a, axis=-1) & inside
+    from_b = np.all(rgba[..., :3] == only_b, axis=-1) & inside
+    assert from_a.sum() > 0.3 * inside.sum() and from_b.sum() > 0.3 * inside.sum()
+    assert_png_not_blank(ax.figure, tmp_path, "blend")
+
+
+def test_blend_demo_mask_and_existing_axes():
+    n = 32
+    fig, ax = plt.subplots()
+    mask = np.zeros((n, n))
+    mask[:, n // 2:] = 1.0  # right half is b
+    assert pbplot.blend_demo("gold", "blue_rubber", mask=mask, resolution=n, ax=ax) is ax
+    rgba = image_of(ax)
+    gold = pb.render.to_srgb8(pb.render.render_sphere(pb.presets.get("gold"), n))
+    rubber = pb.render.to_srgb8(pb.render.render_sphere(pb.presets.get("blue_rubber"), n))
+    np.testing.assert_array_equal(rgba[:, : n // 2, :3], gold[:, : n // 2])
+    np.testing.assert_array_equal(rgba[:, n // 2:, :3], rubber[:, n // 2:])
+
+
+def test_blend_demo_bad_arguments():
+    with pytest.raises(TypeError, match="^a:"):
+        pbplot.blend_demo(1.0, "gold")
+    with pytest.raises(TypeError, match="^b:"):
+        pbplot.blend_demo("gold", object())
+    with pytest.raises(ValueError, match="mask"):
+        pbplot.blend_demo("gold", "chrome", mask=np.zeros((3, 3)), resolution=8)
+    with pytest.raises(ValueError, match="mask"):
+        pbplot.blend_demo("gold", "chrome", mask=np.full((8, 8), 2.0), resolution=8)
+    with pytest.raises(TypeError, match="mask"):
+        pbplot.blend_demo("gold", "chrome", mask="stripes", resolution=8)
+    with pytest.raises(ValueError, match="resolution"):
+        pbplot.blend_demo("gold", "chrome", resolution=1)
+    assert plt.get_fignums() == []
