@@ -11,10 +11,30 @@ PB_KERNEL_INLINE Floats smith_denominator_iso(Floats cos_theta, Floats a2) {
     return smith_denominator(cos_theta, xsimd::fma(cos_theta * cos_theta, Floats(1.0f) - a2, a2));
 }
 
+// The lobes as scalar factors of the material's colours (SPEC §3):
+//   diffuse   = D  base_color (1 - metallic) / π        (s.diffuse_color)
+//   sheen     = FH sheen Csheen (1 - metallic)          (s.sheen_color)
+//   specular  = S  mix(Cspec0, 1, FH),  S = Gs Ds
+//   clearcoat = C  (grey)
 struct LobeValues {
-    Rgb diffuse, sheen, specular;
-    Floats clearcoat;
+    Floats diffuse, fh, specular, clearcoat;
     Mask finite_half_vector;  // false where a direction held NaN or infinity (checks off)
+
+    Rgb diffuse_rgb(const Shading& s) const { return diffuse * s.diffuse_color; }
+    Rgb sheen_rgb(const Shading& s) const { return fh * s.sheen_color; }
+    Rgb specular_rgb(const Shading& s) const { return specular * mix(s.specular_f0, Rgb{Floats(1.0f), Floats(1.0f), Floats(1.0f)}, fh); }
+
+    // f per channel: D dc + FH sc + S (1 - FH) Cspec0 + (S FH + C), three FMAs a channel
+    Rgb total(const Shading& s) const {
+        const Floats specular_tinted = specular * (Floats(1.0f) - fh);
+        const Floats grey = xsimd::fma(specular, fh, clearcoat);
+        auto channel = [&](Floats dc, Floats sc, Floats f0) {
+            return xsimd::fma(diffuse, dc, xsimd::fma(fh, sc, xsimd::fma(specular_tinted, f0, grey)));
+        };
+        return {channel(s.diffuse_color.r, s.sheen_color.r, s.specular_f0.r),
+                channel(s.diffuse_color.g, s.sheen_color.g, s.specular_f0.g),
+                channel(s.diffuse_color.b, s.sheen_color.b, s.specular_f0.b)};
+    }
 };
 
 // What every lobe and pdf needs of a pair (wi, wo), through the unnormalised
@@ -85,9 +105,9 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s) {
     const Floats fss = xsimd::fma(fss90_minus_1, fl, one) * xsimd::fma(fss90_minus_1, fv, one);
     const Floats inv_cos_sum = reciprocal(cos_theta_l + cos_theta_v);
     const Floats ss = 1.25f * xsimd::fma(fss, inv_cos_sum - 0.5f, Floats(0.5f));
-    out.diffuse = mix(fd, ss, s.subsurface) * s.diffuse_color;
+    out.diffuse = mix(fd, ss, s.subsurface);
 
-    out.sheen = fh * s.sheen_color;
+    out.fh = fh;
 
     const Floats ds = gtr2_aniso_d(g, s);
     Floats gs_denominator;
@@ -96,7 +116,7 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s) {
     } else {
         gs_denominator = smith_denominator_aniso(wi, s) * smith_denominator_aniso(wo, s);
     }
-    out.specular = (ds * reciprocal(gs_denominator)) * mix(s.specular_f0, Rgb{one, one, one}, fh);
+    out.specular = ds * reciprocal(gs_denominator);
 
     // Clearcoat 0.25 clearcoat Gr Fr Dr with GTR1 Dr = (ac² - 1)/(π ln ac²) / (ac² cos²θh + sin²θh)
     // (the constants are in clearcoat_scale) and Gr = S(wi) S(wo) at alpha 0.25.

@@ -14,19 +14,18 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3&
         xsimd::select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     } else {
         const LobeValues lobes = eval_lobes<model>(g, s);
-        const Floats weight = job.cosine ? wi.z : Floats(1.0f);
-        auto masked = [&](const Rgb& c) {
-            return Rgb{xsimd::select(above, weight * c.r, Floats(0.0f)), xsimd::select(above, weight * c.g, Floats(0.0f)),
-                       xsimd::select(above, weight * c.b, Floats(0.0f))};
+        auto masked = [&](Rgb c) {
+            if (job.cosine) c = wi.z * c;
+            return Rgb{xsimd::select(above, c.r, Floats(0.0f)), xsimd::select(above, c.g, Floats(0.0f)),
+                       xsimd::select(above, c.b, Floats(0.0f))};
         };
-        const Rgb clearcoat{lobes.clearcoat, lobes.clearcoat, lobes.clearcoat};
         if constexpr (output == Output::kLobes) {
-            store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse));
-            store_rgb<layouts>(job.out[1], i, masked(lobes.sheen));
-            store_rgb<layouts>(job.out[2], i, masked(lobes.specular));
-            store_rgb<layouts>(job.out[3], i, masked(clearcoat));
+            store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse_rgb(s)));
+            store_rgb<layouts>(job.out[1], i, masked(lobes.sheen_rgb(s)));
+            store_rgb<layouts>(job.out[2], i, masked(lobes.specular_rgb(s)));
+            store_rgb<layouts>(job.out[3], i, masked(Rgb{lobes.clearcoat, lobes.clearcoat, lobes.clearcoat}));
         } else {
-            store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse + lobes.sheen + lobes.specular + clearcoat));
+            store_rgb<layouts>(job.out[0], i, masked(lobes.total(s)));
         }
     }
 }

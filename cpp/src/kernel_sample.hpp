@@ -25,18 +25,14 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
     const Geometry g = geometry_of(wi, wo);
     const Floats pdf = mixture_pdf(g, s, probabilities, job.sampler);
     const Mask valid = (wi.z > Floats(0.0f)) & (wo.z > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));
-    const LobeValues f = eval_lobes<model>(g, s);
+    const Rgb f = eval_lobes<model>(g, s).total(s);
     const Floats scale = wi.z * reciprocal(pdf);  // cos θl / pdf
     // select after multiplying: below the horizon f may be infinite or NaN
-    auto weight = [&](Floats diffuse, Floats sheen, Floats specular) {
-        return xsimd::select(valid, scale * (diffuse + sheen + specular + f.clearcoat), Floats(0.0f));
-    };
+    auto weight = [&](Floats value) { return xsimd::select(valid, scale * value, Floats(0.0f)); };
 
     store_rgb<layouts>(job.wi, i, Rgb{wi.x, wi.y, wi.z});
     xsimd::select(valid, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
-    store_rgb<layouts>(job.weight, i,
-                       Rgb{weight(f.diffuse.r, f.sheen.r, f.specular.r), weight(f.diffuse.g, f.sheen.g, f.specular.g),
-                           weight(f.diffuse.b, f.sheen.b, f.specular.b)});
+    store_rgb<layouts>(job.weight, i, Rgb{weight(f.r), weight(f.g), weight(f.b)});
     const Floats lobe_index = xsimd::select(lobe.cosine, Floats(0.0f), xsimd::select(lobe.specular, Floats(1.0f), Floats(2.0f)));
     xsimd::to_int(lobe_index).store_unaligned(job.lobe + i);
     return true;
