@@ -22,7 +22,7 @@ bench: deps
 	cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release -DPRINCIPLED_BRDF_BENCH=ON \
 	  -Dpybind11_DIR="$$($(PYTHON) -c 'import pybind11; print(pybind11.get_cmake_dir())')"
 	cmake --build build/bench --target principled_brdf_bench
-	build/bench/bench/principled_brdf_bench --benchmark_min_time=0.3 --benchmark_repetitions=5 \
+	build/bench/bench/principled_brdf_bench --benchmark_min_time=0.2 --benchmark_repetitions=6 \
 	  --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
 	  --benchmark_out=bench/results.json --benchmark_out_format=json
 	$(PYTHON) bench/summarize.py bench/results.json

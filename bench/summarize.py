@@ -36,7 +36,7 @@ def main(path: str) -> None:
     print(f"machine: {threads} CPUs at {context.get('mhz_per_cpu', '?')} MHz, {context.get('date', '')}\n")
     print("| benchmark | M items/s |")
     print("|---|---:|")
-    for name, rate in rates.items():
+    for name, rate in sorted(rates.items()):
         print(f"| `{name}` | {rate / 1e6:.1f} |")
 
     def ratio(a, b):
