@@ -23,5 +23,5 @@ python=${PYTHON:-python3}
 # builds reuse them) and the test/plot extras' packages.
 "$python" -m pip install -q --disable-pip-version-check \
   "scikit-build-core>=0.10" "pybind11>=3" "cmake>=3.18" ninja numpy \
-  "pytest>=7" "hypothesis>=6" "scipy>=1.9" "matplotlib>=3.6" \
+  "pytest>=7" "hypothesis>=6" "scipy>=1.9" "mpmath>=1.2" "matplotlib>=3.6" \
   "nbclient>=0.7" "nbformat>=5" "ipykernel>=6" "dask[array]>=2023.1"

@@ -35,7 +35,7 @@ CELL_TIMEOUT = 300  # seconds per cell
 @pytest.fixture(scope="module")
 def python3_kernel(tmp_path_factory):
     """A Jupyter path whose ``python3`` kernel runs this interpreter; returns the kernel name."""
-    pytest.importorskip("ipykernel")
+    import ipykernel  # noqa: F401  (a test dependency: fail, never skip)
     data_dir = tmp_path_factory.mktemp("jupyter")
     spec_dir = data_dir / "kernels" / "python3"
     spec_dir.mkdir(parents=True)
@@ -60,10 +60,10 @@ def _stored_without_outputs(notebook) -> bool:
 
 @pytest.mark.parametrize("name", NOTEBOOKS)
 def test_notebook_runs(name, python3_kernel, tmp_path):
-    nbformat = pytest.importorskip("nbformat")
-    nbclient = pytest.importorskip("nbclient")
-    pytest.importorskip("matplotlib")
-    pytest.importorskip("scipy")
+    import nbformat
+    import nbclient
+    import matplotlib  # noqa: F401  (a test dependency: fail, never skip)
+    import scipy  # noqa: F401  (a test dependency: fail, never skip)
     from jupyter_client.kernelspec import KernelSpecManager
 
     spec = KernelSpecManager().get_kernel_spec(python3_kernel)
@@ -91,7 +91,7 @@ def test_notebook_runs(name, python3_kernel, tmp_path):
 
 
 def _load_dask_example():
-    pytest.importorskip("dask.array")
+    import dask.array  # noqa: F401  (a test dependency: fail, never skip)
     spec = importlib.util.spec_from_file_location("dask_scale_out", EXAMPLES / "dask_scale_out.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -185,7 +185,7 @@ def test_dask_rejects_bad_arguments():
 
 
 def test_dask_example_runs_as_a_script(tmp_path):
-    pytest.importorskip("dask.array")
+    import dask.array  # noqa: F401  (a test dependency: fail, never skip)
     result = subprocess.run([sys.executable, str(EXAMPLES / "dask_scale_out.py"), "--n", "600000", "--chunk",
                              "131072"], capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
