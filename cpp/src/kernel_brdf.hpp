@@ -100,12 +100,18 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s) {
     // Diffuse: Fd = mix(1, Fd90, FL) mix(1, Fd90, FV), Fd90 = 0.5 + 2 roughness cos²θd
     const Floats fd90_minus_1 = xsimd::fma(2.0f * s.roughness, cos2_theta_d, Floats(-0.5f));
     const Floats fd = xsimd::fma(fd90_minus_1, fl, one) * xsimd::fma(fd90_minus_1, fv, one);
-    // Subsurface: ss = 1.25 (Fss (1/(cos θl + cos θv) - 0.5) + 0.5), Fss90 = roughness cos²θd
-    const Floats fss90_minus_1 = xsimd::fms(s.roughness, cos2_theta_d, one);
-    const Floats fss = xsimd::fma(fss90_minus_1, fl, one) * xsimd::fma(fss90_minus_1, fv, one);
-    const Floats inv_cos_sum = reciprocal(cos_theta_l + cos_theta_v);
-    const Floats ss = 1.25f * xsimd::fma(fss, inv_cos_sum - 0.5f, Floats(0.5f));
-    out.diffuse = mix(fd, ss, s.subsurface);
+    out.diffuse = fd;
+    // Lobes whose weight is 0 in every lane are skipped: for a uniform material
+    // the test has the same outcome for every batch, and the result is the same
+    // bits (mix(fd, ss, 0) = fd, 0 clearcoat x finite = 0).
+    if (xsimd::any(s.subsurface != Floats(0.0f))) {
+        // Subsurface: ss = 1.25 (Fss (1/(cos θl + cos θv) - 0.5) + 0.5), Fss90 = roughness cos²θd
+        const Floats fss90_minus_1 = xsimd::fms(s.roughness, cos2_theta_d, one);
+        const Floats fss = xsimd::fma(fss90_minus_1, fl, one) * xsimd::fma(fss90_minus_1, fv, one);
+        const Floats inv_cos_sum = reciprocal(cos_theta_l + cos_theta_v);
+        const Floats ss = 1.25f * xsimd::fma(fss, inv_cos_sum - 0.5f, Floats(0.5f));
+        out.diffuse = mix(fd, ss, s.subsurface);
+    }
 
     out.fh = fh;
 
@@ -120,10 +126,13 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s) {
 
     // Clearcoat 0.25 clearcoat Gr Fr Dr with GTR1 Dr = (ac² - 1)/(π ln ac²) / (ac² cos²θh + sin²θh)
     // (the constants are in clearcoat_scale) and Gr = S(wi) S(wo) at alpha 0.25.
-    const Floats fr = xsimd::fma(Floats(0.96f), fh, Floats(0.04f));
-    const Floats quarter2 = Floats(0.0625f);
-    const Floats gr_denominator = smith_denominator_iso(cos_theta_l, quarter2) * smith_denominator_iso(cos_theta_v, quarter2);
-    out.clearcoat = s.clearcoat_scale * fr * g.h_len2 * reciprocal(gtr1_denominator(g, s) * gr_denominator);
+    out.clearcoat = Floats(0.0f);
+    if (xsimd::any(s.clearcoat_scale != Floats(0.0f))) {
+        const Floats fr = xsimd::fma(Floats(0.96f), fh, Floats(0.04f));
+        const Floats quarter2 = Floats(0.0625f);
+        const Floats gr_denominator = smith_denominator_iso(cos_theta_l, quarter2) * smith_denominator_iso(cos_theta_v, quarter2);
+        out.clearcoat = s.clearcoat_scale * fr * g.h_len2 * reciprocal(gtr1_denominator(g, s) * gr_denominator);
+    }
     return out;
 }
 
