@@ -54,6 +54,21 @@ RANGES = {
 }
 
 SCALAR_PARAMETERS = tuple(RANGES)
+
+# SPEC §2 domains restated for the tests (the library's own table is checked against it)
+SPEC_DOMAINS = {
+    "base_color": (0.0, np.inf),
+    "metallic": (0.0, 1.0),
+    "subsurface": (0.0, 1.0),
+    "specular": (0.0, np.inf),
+    "specular_tint": (0.0, 1.0),
+    "roughness": (0.0, np.inf),
+    "anisotropic": (0.0, 1.0),
+    "sheen": (0.0, np.inf),
+    "sheen_tint": (0.0, 1.0),
+    "clearcoat": (0.0, np.inf),
+    "clearcoat_gloss": (0.0, 1.0),
+}
 BOUNDED_PARAMETERS = ("metallic", "subsurface", "specular_tint", "anisotropic", "sheen_tint", "clearcoat_gloss")
 NON_NEGATIVE_PARAMETERS = ("base_color", "specular", "roughness", "sheen", "clearcoat")
 

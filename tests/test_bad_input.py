@@ -9,23 +9,12 @@ import numpy as np
 import pytest
 
 import principled_brdf as pb
-from conftest import random_directions, seeded_rng
+from conftest import SPEC_DOMAINS, random_directions, seeded_rng
 
 EVALUATORS = {"eval": pb.reference.eval, "eval_lobes": pb.reference.eval_lobes}
 DIRECTIONS = ("wi", "wo")
 
-SCALAR_DOMAINS = {
-    "metallic": (0.0, 1.0),
-    "subsurface": (0.0, 1.0),
-    "specular": (0.0, np.inf),
-    "specular_tint": (0.0, 1.0),
-    "roughness": (0.0, np.inf),
-    "anisotropic": (0.0, 1.0),
-    "sheen": (0.0, np.inf),
-    "sheen_tint": (0.0, 1.0),
-    "clearcoat": (0.0, np.inf),
-    "clearcoat_gloss": (0.0, 1.0),
-}
+SCALAR_DOMAINS = {name: domain for name, domain in SPEC_DOMAINS.items() if name != "base_color"}
 # (parameter, side) for every finite bound of SPEC §2
 DOMAIN_CASES = [(name, "below") for name in SCALAR_DOMAINS] + [
     (name, "above") for name, (_, hi) in SCALAR_DOMAINS.items() if np.isfinite(hi)

@@ -6,35 +6,11 @@ import numpy as np
 import pytest
 
 import principled_brdf as pb
-from conftest import random_directions, random_material_arrays, random_material_dict, seeded_rng
+import numpy_model
+from conftest import SPEC_DOMAINS, random_directions, random_material_arrays, random_material_dict, seeded_rng
 
 # SPEC §2, copied from the table (not from the library)
-SPEC_DEFAULTS = {
-    "base_color": (0.82, 0.67, 0.16),
-    "metallic": 0.0,
-    "subsurface": 0.0,
-    "specular": 0.5,
-    "specular_tint": 0.0,
-    "roughness": 0.5,
-    "anisotropic": 0.0,
-    "sheen": 0.0,
-    "sheen_tint": 0.5,
-    "clearcoat": 0.0,
-    "clearcoat_gloss": 1.0,
-}
-SPEC_DOMAINS = {
-    "base_color": (0.0, np.inf),
-    "metallic": (0.0, 1.0),
-    "subsurface": (0.0, 1.0),
-    "specular": (0.0, np.inf),
-    "specular_tint": (0.0, 1.0),
-    "roughness": (0.0, np.inf),
-    "anisotropic": (0.0, 1.0),
-    "sheen": (0.0, np.inf),
-    "sheen_tint": (0.0, 1.0),
-    "clearcoat": (0.0, np.inf),
-    "clearcoat_gloss": (0.0, 1.0),
-}
+SPEC_DEFAULTS = numpy_model.DEFAULTS  # SPEC §2, restated once in the independent transcription
 
 
 # --------------------------------------------------------------------------
