@@ -2,6 +2,7 @@
 broadcasting, out=, threads, instruction-set selection and its bad input."""
 
 import os
+import re
 import subprocess
 import sys
 
@@ -162,3 +163,25 @@ def test_soa_shape_errors_name_the_argument():
 def test_empty_input():
     f = pb.eval(pb.Material(), np.zeros((0, 3)), np.zeros((0, 3)))
     assert f.shape == (0, 3)
+
+
+@pytest.mark.parametrize("name, value, limit", [("roughness", 1e5, "10000"), ("sheen", 1e25, "1e+20"),
+                                                ("base_color", (0.5, 1e21, 0.5), "1e+20")])
+def test_parameters_beyond_float32_range_are_refused_not_nan(name, value, limit):
+    wi = np.array([0.3, 0.2, np.sqrt(0.87)])
+    material = pb.Material(**{name: value})
+    assert np.all(np.isfinite(pb.reference.eval(material, wi, wi)))  # the float64 reference takes them
+    for call in (lambda: pb.eval(material, wi, wi), lambda: pb.sample(material, wi, seed=1),
+                 lambda: pb.pdf(material, wi, wi)):
+        with pytest.raises(ValueError, match=f"{name}.*beyond what the float32 kernels represent \\(<= {re.escape(limit)}\\)"):
+            call()
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_largest_float32_parameters_stay_finite(isa):
+    rng = seeded_rng("largest", isa)
+    wi, wo = (w.astype(np.float32) for w in random_direction_pairs(rng, 20_000))
+    material = pb.Material(roughness=1e4, base_color=(1e20, 1e20, 1e20), specular=1e20, sheen=1e20, clearcoat=1e20)
+    assert np.all(np.isfinite(pb.eval(material, wi, wo, isa=isa)))
+    s = pb.sample(material, wo, seed=3, isa=isa)
+    assert all(np.all(np.isfinite(a)) for a in s[:3])

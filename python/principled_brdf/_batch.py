@@ -133,12 +133,28 @@ class _Directions:
         raise ValueError(f"{where}: length {length:.6g} is not 1 (within {DIRECTION_LENGTH_TOLERANCE:g})")
 
 
+# The float32 kernels stay finite for parameters up to these bounds, all at
+# once (f grows like base_color x roughness² through Fd90², and linearly in
+# the other unbounded parameters; sample weights divide by small pdfs).
+# Beyond them, use pb.reference.
+FLOAT32_LIMITS = {"roughness": 1e4, "base_color": 1e20, "specular": 1e20, "sheen": 1e20, "clearcoat": 1e20}
+
+
+def _require_float32_range(name: str, value: np.ndarray) -> None:
+    limit = FLOAT32_LIMITS.get(name)
+    if limit is not None and value.size and value.max() > limit:
+        i = int(np.flatnonzero(value.ravel() > limit)[0])
+        raise ValueError(f"{element_name(name, i, value.shape)}: {float(value.ravel()[i])!r} is beyond what the "
+                         f"float32 kernels represent (<= {limit:g}); pb.reference evaluates it in float64")
+
+
 def _params(material: Material, leading: tuple) -> list:
     """One entry per parameter: a number (uniform) or a float32 per-element array."""
     n = int(np.prod(leading, dtype=np.int64))
     entries = []
     for name, info in PARAMETERS.items():
         value = getattr(material, name)
+        _require_float32_range(name, value)
         uniform = value.shape == (() if info.slots == 1 else (3,))
         if uniform:
             entries.append(tuple(float(v) for v in value) if info.slots == 3 else float(value))
