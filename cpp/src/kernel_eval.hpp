@@ -49,11 +49,9 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const S
 }
 
 inline std::int64_t first_bad_pair(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    for (std::int64_t i = begin; i < end; ++i)
-        if (!unit_length(job.wi, i, job.length2_lowest, job.length2_highest) ||
-            !unit_length(job.wo, i, job.length2_lowest, job.length2_highest))
-            return i;
-    return -1;
+    const std::int64_t in = first_bad_direction(job.wi, begin, end, job.length2_lowest, job.length2_highest);
+    const std::int64_t out = first_bad_direction(job.wo, begin, end, job.length2_lowest, job.length2_highest);
+    return in < 0 ? out : out < 0 ? in : std::min(in, out);
 }
 
 template <Model model, Output output, bool per_element>

@@ -39,9 +39,7 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
 }
 
 inline std::int64_t first_bad_view(const SampleJob& job, std::int64_t begin, std::int64_t end) {
-    for (std::int64_t i = begin; i < end; ++i)
-        if (!unit_length(job.wo, i, job.length2_lowest, job.length2_highest)) return i;
-    return -1;
+    return first_bad_direction(job.wo, begin, end, job.length2_lowest, job.length2_highest);
 }
 
 template <Model model, bool per_element>

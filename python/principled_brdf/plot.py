@@ -457,17 +457,6 @@ def _default_sweep_base() -> Material:
     return Material(base_color=(0.7, 0.2, 0.1), roughness=0.5)
 
 
-def _shade_spheres(material: Material, resolution: int, light, light_intensity: float, ambient: float, model: str):
-    """render_sphere's shading for many spheres at once: material of leading shape
-    ``S + (1, 1)`` gives linear RGB ``S + (R, R, 3)`` in one kernel call."""
-    inside, to_local = sphere_frames(resolution)
-    wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
-    radiance = light_intensity * _eval(material, wi, wo, cosine=True, model=model)
-    radiance += ambient * np.asarray(material.base_color, dtype=np.float32)
-    radiance[..., ~inside, :] = 0.0
-    return radiance, inside
-
-
 def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11, resolution: int = 64, ranges=None,
                     light=DEFAULT_LIGHT, exposure: float = 1.0, model: str = "disney2014", figsize=None):
     """The grid of Burley 2012 figure 16: one row per parameter, that parameter
@@ -519,7 +508,8 @@ def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11,
     except ValueError as error:
         raise ValueError(f"ranges: {error}") from None
 
-    linear, inside = _shade_spheres(material, n, light, _LIGHT_INTENSITY, _AMBIENT, model)
+    linear = render_sphere(material, n, light=light, light_intensity=_LIGHT_INTENSITY, ambient=_AMBIENT, model=model)
+    inside = sphere_frames(n)[0]
     spheres = _rgba(linear, inside, exposure)  # (rows, steps, R, R, 4)
     pad = max(1, n // 16)
     spheres = np.pad(spheres, ((0, 0), (0, 0), (pad, pad), (pad, pad), (0, 0)))

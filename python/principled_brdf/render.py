@@ -55,13 +55,15 @@ def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT
     """Linear RGB ``(resolution, resolution, 3)`` image of ``material`` on a sphere.
 
     ``material`` may be uniform or per pixel (leading shape ``(resolution, resolution)``,
-    e.g. made by :meth:`Material.mix` with a mask). Background is 0.
+    e.g. made by :meth:`Material.mix` with a mask); a leading shape ``S + (1, 1)``
+    renders one sphere per material, ``S + (resolution, resolution, 3)``, in one
+    kernel call. Background is 0.
     """
     inside, to_local = sphere_frames(resolution)
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
     radiance = light_intensity * _eval(material, wi, wo, cosine=True, model=model)
     radiance += ambient * np.asarray(material.base_color, dtype=np.float32)
-    radiance[~inside] = 0.0
+    radiance[..., ~inside, :] = 0.0
     return radiance
 
 
