@@ -75,14 +75,22 @@ def test_generator_is_the_same_on_every_isa():
 
 
 def test_random_uniforms_are_uniform():
+    from scipy import stats
+
     u = pb.random_uniforms(99, 1 << 20).astype(np.float64)
     assert u.shape == (1 << 20, 3) and u.min() >= 0.0 and u.max() < 1.0
     np.testing.assert_allclose(u.mean(axis=0), 0.5, atol=5 * 0.2887 / 1024)
     np.testing.assert_allclose(np.corrcoef(u.T)[np.triu_indices(3, 1)], 0.0, atol=5 / 1024)
-    counts = np.histogram(u[:, 0], bins=256, range=(0, 1))[0]
-    from scipy import stats
-
-    assert stats.chisquare(counts).pvalue > 1e-4
+    # Chi-square tests that a weak hash fails (lowbias32 of plain consecutive
+    # counters fails the first): each stream on 256 bins, the triple on 16^3
+    # cells, consecutive elements' values on 64^2 cells, within a stream and across.
+    for k in range(3):
+        assert stats.chisquare(np.histogram(u[:, k], bins=256, range=(0, 1))[0]).pvalue > 1e-4, k
+    cube = np.histogramdd(u, bins=16, range=((0, 1),) * 3)[0]
+    assert stats.chisquare(cube.ravel()).pvalue > 1e-4
+    for a, b in ((0, 0), (1, 1), (2, 2), (2, 0)):
+        pairs = np.histogram2d(u[:-1, a], u[1:, b], bins=64, range=((0, 1), (0, 1)))[0]
+        assert stats.chisquare(pairs.ravel()).pvalue > 1e-4, (a, b)
 
 
 @pytest.mark.parametrize("isa", ISAS)

@@ -81,9 +81,9 @@ namespace rng {
 }  // namespace rng
 
 void counter_uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n, float* out) {
-    const rng::CounterKeys keys = rng::counter_keys(seed);
+    const rng::CounterSeed mixed = rng::counter_seed(seed);
     for (std::int64_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) out[3 * i + k] = rng::counter_uniform(static_cast<std::uint64_t>(first + i), keys, k);
+        for (int k = 0; k < 3; ++k) out[3 * i + k] = rng::counter_uniform(static_cast<std::uint64_t>(first + i), mixed, k);
 }
 
 void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int threads) {

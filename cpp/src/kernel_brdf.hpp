@@ -78,23 +78,47 @@ PB_KERNEL_INLINE Floats gtr1_denominator(const Geometry& g, const Shading& s) {
     return xsimd::fma(s.clearcoat_alpha2, g.hz2, g.hx2 + g.hy2);
 }
 
-// Smith denominator of the 2014 model for w: n·w + sqrt((w·x ax)² + (w·y ay)² + (n·w)²)
+// What the lobes and the pdf need of wo alone.
+struct View {
+    Floats fv;                  // Schlick(cos θv)
+    Floats smith_visible;       // cos θv + sqrt(q), q = (wo.x ax)² + (wo.y ay)² + cos²θv: the 2014 Smith
+                                // denominator, and the visible-normal pdf's in both models
+    Floats smith_specular;      // the model's Smith denominator for wo
+    Floats smith_clearcoat;     // Smith denominator for wo at alpha 0.25 (1 when no lane has a clearcoat)
+};
+
+template <Model model>
+PB_KERNEL_INLINE View view_of(const Vec3& wo, const Shading& s) {
+    View v;
+    v.fv = schlick_weight(wo.z);
+    const Floats q = xsimd::fma(s.alpha_x2, wo.x * wo.x, xsimd::fma(s.alpha_y2, wo.y * wo.y, wo.z * wo.z));
+    v.smith_visible = smith_denominator(wo.z, q);
+    if constexpr (model == Model::kDisney2012) {
+        v.smith_specular = smith_denominator_iso(wo.z, s.alpha_g2);
+    } else {
+        v.smith_specular = v.smith_visible;
+    }
+    v.smith_clearcoat = Floats(1.0f);
+    if (xsimd::any(s.clearcoat_scale != Floats(0.0f))) v.smith_clearcoat = smith_denominator_iso(wo.z, Floats(0.0625f));
+    return v;
+}
+
+// Smith denominator of the 2014 model for wi: n·w + sqrt((w·x ax)² + (w·y ay)² + (n·w)²)
 PB_KERNEL_INLINE Floats smith_denominator_aniso(const Vec3& w, const Shading& s) {
     return smith_denominator(w.z, xsimd::fma(s.alpha_x2, w.x * w.x, xsimd::fma(s.alpha_y2, w.y * w.y, w.z * w.z)));
 }
 
 template <Model model>
-PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s) {
+PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s, const View& view) {
     const Floats one(1.0f);
     const Vec3& wi = g.wi;
-    const Vec3& wo = g.wo;
-    const Floats cos_theta_l = wi.z, cos_theta_v = wo.z;
+    const Floats cos_theta_l = wi.z, cos_theta_v = g.wo.z;
     const Floats cos2_theta_d = 0.25f * g.h_len2;
     LobeValues out;
     out.finite_half_vector = g.finite;
 
     const Floats fl = schlick_weight(cos_theta_l);
-    const Floats fv = schlick_weight(cos_theta_v);
+    const Floats fv = view.fv;
     const Floats fh = schlick_weight_of_complement(g.one_minus_cos_theta_d);
 
     // Diffuse: Fd = mix(1, Fd90, FL) mix(1, Fd90, FV), Fd90 = 0.5 + 2 roughness cos²θd
@@ -118,9 +142,9 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s) {
     const Floats ds = gtr2_aniso_d(g, s);
     Floats gs_denominator;
     if constexpr (model == Model::kDisney2012) {
-        gs_denominator = smith_denominator_iso(cos_theta_l, s.alpha_g2) * smith_denominator_iso(cos_theta_v, s.alpha_g2);
+        gs_denominator = smith_denominator_iso(cos_theta_l, s.alpha_g2) * view.smith_specular;
     } else {
-        gs_denominator = smith_denominator_aniso(wi, s) * smith_denominator_aniso(wo, s);
+        gs_denominator = smith_denominator_aniso(wi, s) * view.smith_specular;
     }
     out.specular = ds * reciprocal(gs_denominator);
 
@@ -130,7 +154,7 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s) {
     if (xsimd::any(s.clearcoat_scale != Floats(0.0f))) {
         const Floats fr = xsimd::fma(Floats(0.96f), fh, Floats(0.04f));
         const Floats quarter2 = Floats(0.0625f);
-        const Floats gr_denominator = smith_denominator_iso(cos_theta_l, quarter2) * smith_denominator_iso(cos_theta_v, quarter2);
+        const Floats gr_denominator = smith_denominator_iso(cos_theta_l, quarter2) * view.smith_clearcoat;
         out.clearcoat = s.clearcoat_scale * fr * g.h_len2 * reciprocal(gtr1_denominator(g, s) * gr_denominator);
     }
     return out;
@@ -147,8 +171,8 @@ struct LobeProbabilities {
 
 // w0 = (1 - metallic)(Cdlum + 0.1 sheen lum(Csheen)), w1 = max(lum(mix(Cspec0, 1, FV)), 0.02),
 // w2 = 0.25 clearcoat mix(0.04, 1, FV); P_k = w_k / Σ w.
-PB_KERNEL_INLINE LobeProbabilities lobe_probabilities(Floats cos_theta_v, const Shading& s) {
-    const Floats fv = schlick_weight(cos_theta_v);
+PB_KERNEL_INLINE LobeProbabilities lobe_probabilities(const View& view, const Shading& s) {
+    const Floats fv = view.fv;
     const Floats w0 = s.cosine_lobe_weight;
     const Floats w1 = xsimd::max(mix(s.specular_f0_luminance, Floats(1.0f), fv), Floats(0.02f));
     const Floats w2 = s.clearcoat_lobe_weight * xsimd::fma(Floats(0.96f), fv, Floats(0.04f));
@@ -162,11 +186,12 @@ PB_KERNEL_INLINE LobeProbabilities lobe_probabilities(Floats cos_theta_v, const 
 //        = Ds cos θh / (4 cos θd) = Ds Hz / (2 |H|²)                (distribution)
 //   pdf2 = Dr cos θh / (4 cos θd) = gtr1_norm Hz / (2 gtr1_denominator)
 // with cos θh = Hz / |H| and cos θd = |H| / 2.
-PB_KERNEL_INLINE Floats mixture_pdf(const Geometry& g, const Shading& s, const LobeProbabilities& p, SpecularSampler sampler) {
+PB_KERNEL_INLINE Floats mixture_pdf(const Geometry& g, const Shading& s, const View& view, const LobeProbabilities& p,
+                                    SpecularSampler sampler) {
     const Floats ds = gtr2_aniso_d(g, s);
     const Floats pdf1 = sampler == SpecularSampler::kDistribution
                             ? ds * g.hz * reciprocal(2.0f * g.h_len2)
-                            : ds * reciprocal(2.0f * smith_denominator_aniso(g.wo, s));
+                            : ds * reciprocal(2.0f * view.smith_visible);
     const Floats pdf2 = s.gtr1_norm * g.hz * reciprocal(2.0f * gtr1_denominator(g, s));
     return xsimd::fma(p.cosine, kInvPi * g.wi.z, xsimd::fma(p.specular, pdf1, p.clearcoat * pdf2));
 }

@@ -9,11 +9,12 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3&
     // select also discards whatever the formulas gave there (H may be 0).
     const Mask above = (wi.z > Floats(0.0f)) & (wo.z > Floats(0.0f)) & g.finite;
 
+    const View view = view_of<model>(wo, s);
     if constexpr (output == Output::kPdf) {
-        const Floats pdf = mixture_pdf(g, s, lobe_probabilities(wo.z, s), job.sampler);
+        const Floats pdf = mixture_pdf(g, s, view, lobe_probabilities(view, s), job.sampler);
         xsimd::select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     } else {
-        const LobeValues lobes = eval_lobes<model>(g, s);
+        const LobeValues lobes = eval_lobes<model>(g, s, view);
         auto masked = [&](Rgb c) {
             if (job.cosine) c = wi.z * c;
             return Rgb{xsimd::select(above, c.r, Floats(0.0f)), xsimd::select(above, c.g, Floats(0.0f)),

@@ -3,29 +3,81 @@
 // pdf at (wi, wo) and weight = f cos θl / pdf, 0 below the horizon.
 #pragma once  // (per translation unit)
 
-template <Model model, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterKeys& keys) {
-    const Vec3 wo = load_vec3<layouts>(job.wo, i);
-    if (job.check_directions && !xsimd::all(unit_length(wo, job.length2_lowest, job.length2_highest))) return false;
-    Shading per_batch;
-    if constexpr (per_element) per_batch = shading_of(load_material(job.params, i));
-    const Shading& s = per_element ? per_batch : uniform;
+// A batch goes through three stages, each a function of the previous one's
+// result: choose (wo, the uniforms, the lobe), draw (wi) and weigh (f, pdf,
+// weight; the stores). What passes between stages is kept small: anything
+// recomputable from wo is recomputed, which is cheaper than holding it in
+// registers across the other batches' work (see sample_loop).
 
+// The material of a batch when per element (else the call's, passed apart so
+// that the compiler keeps it in registers).
+template <bool per_element>
+struct BatchShading {
+    Shading value;
+};
+template <>
+struct BatchShading<false> {};
+
+template <bool per_element>
+PB_KERNEL_INLINE const Shading& shading_for(const BatchShading<per_element>& batch, const Shading& uniform) {
+    if constexpr (per_element) {
+        return batch.value;
+    } else {
+        return uniform;
+    }
+}
+
+template <bool per_element>
+struct Chosen {
+    BatchShading<per_element> shading;
+    Vec3 wo;
     Uniforms u;
+    LobeProbabilities probabilities;
+    LobeChoice lobe;
+};
+
+template <bool per_element>
+struct Drawn {
+    BatchShading<per_element> shading;
+    Vec3 wo, wi;
+    LobeProbabilities probabilities;
+    LobeChoice lobe;
+};
+
+// false, with nothing stored, when the fused direction check fails
+template <Model model, bool per_element, Layouts layouts>
+PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterSeed& seed,
+                             Chosen<per_element>& c) {
+    c.wo = load_vec3<layouts>(job.wo, i);
+    if (job.check_directions && !xsimd::all(unit_length(c.wo, job.length2_lowest, job.length2_highest))) return false;
+    if constexpr (per_element) c.shading.value = shading_of(load_material(job.params, i));
+    const Shading& s = shading_for(c.shading, uniform);
     if (job.u.data != nullptr) {
         const Vec3 given = load_vec3<layouts>(job.u, i);
-        u = {given.x, given.y, given.z};
+        c.u = {given.x, given.y, given.z};
     } else {
-        u = counter_uniforms(static_cast<std::uint64_t>(job.first_index + i), keys);
+        c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index + i), seed);
     }
-    const LobeProbabilities probabilities = lobe_probabilities(wo.z, s);
-    const LobeChoice lobe = choose_lobe(u.u0, probabilities);
-    const Vec3 wi = sample_direction(wo, u, lobe, s, job.sampler);
+    c.probabilities = lobe_probabilities(view_of<model>(c.wo, s), s);
+    c.lobe = choose_lobe(c.u.u0, c.probabilities);
+    return true;
+}
 
-    const Geometry g = geometry_of(wi, wo);
-    const Floats pdf = mixture_pdf(g, s, probabilities, job.sampler);
-    const Mask valid = (wi.z > Floats(0.0f)) & (wo.z > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));
-    const Rgb f = eval_lobes<model>(g, s).total(s);
+template <bool per_element>
+PB_KERNEL_INLINE Drawn<per_element> draw(const SampleJob& job, const Chosen<per_element>& c, const Shading& uniform) {
+    const Vec3 wi = sample_direction(c.wo, c.u, c.lobe, shading_for(c.shading, uniform), job.sampler);
+    return {c.shading, c.wo, wi, c.probabilities, c.lobe};
+}
+
+template <Model model, bool per_element, Layouts layouts>
+PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn<per_element>& d, const Shading& uniform) {
+    const Shading& s = shading_for(d.shading, uniform);
+    const Vec3& wi = d.wi;
+    const View view = view_of<model>(d.wo, s);
+    const Geometry g = geometry_of(wi, d.wo);
+    const Floats pdf = mixture_pdf(g, s, view, d.probabilities, job.sampler);
+    const Mask valid = (wi.z > Floats(0.0f)) & (d.wo.z > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));
+    const Rgb f = eval_lobes<model>(g, s, view).total(s);
     const Floats scale = wi.z * reciprocal(pdf);  // cos θl / pdf
     // select after multiplying: below the horizon f may be infinite or NaN
     auto weight = [&](Floats value) { return xsimd::select(valid, scale * value, Floats(0.0f)); };
@@ -33,8 +85,15 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
     store_rgb<layouts>(job.wi, i, Rgb{wi.x, wi.y, wi.z});
     xsimd::select(valid, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     store_rgb<layouts>(job.weight, i, Rgb{weight(f.r), weight(f.g), weight(f.b)});
-    const Floats lobe_index = xsimd::select(lobe.cosine, Floats(0.0f), xsimd::select(lobe.specular, Floats(1.0f), Floats(2.0f)));
+    const Floats lobe_index = xsimd::select(d.lobe.cosine, Floats(0.0f), xsimd::select(d.lobe.specular, Floats(1.0f), Floats(2.0f)));
     xsimd::to_int(lobe_index).store_unaligned(job.lobe + i);
+}
+
+template <Model model, bool per_element, Layouts layouts>
+PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterSeed& seed) {
+    Chosen<per_element> chosen;
+    if (!choose<model, per_element, layouts>(job, i, uniform, seed, chosen)) return false;
+    weigh<model, per_element, layouts>(job, i, draw(job, chosen, uniform), uniform);
     return true;
 }
 
@@ -43,7 +102,7 @@ inline std::int64_t first_bad_view(const SampleJob& job, std::int64_t begin, std
 }
 
 template <Model model, bool per_element>
-bool sample_tail(const SampleJob& job, const Padding& pad, const Shading& uniform, const CounterKeys& keys) {
+bool sample_tail(const SampleJob& job, const Padding& pad, const Shading& uniform, const CounterSeed& seed) {
     alignas(64) PadBuffer wo, u, params[kParamSlots], wi, weight;
     alignas(64) float pdf[kLanes];
     alignas(64) std::int32_t lobe[kLanes];
@@ -57,7 +116,7 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const Shading& unifor
     padded.lobe = lobe;
     padded.first_index = job.first_index + pad.begin;  // the generator sees the true element indices
 
-    if (!sample_one_batch<model, per_element, Layouts::kMixed>(padded, 0, uniform, keys)) return false;
+    if (!sample_one_batch<model, per_element, Layouts::kMixed>(padded, 0, uniform, seed)) return false;
 
     unpad_vec3(job.wi, pad, wi);
     unpad_vec3(job.weight, pad, weight);
@@ -66,15 +125,42 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const Shading& unifor
     return true;
 }
 
+// Software-pipelined over batches: while batch b is weighed, batch b + 1
+// draws its direction and batch b + 2 chooses its lobe. The stages of one
+// batch are one long dependency chain (uniforms, lobe, direction, f and pdf)
+// and a batch alone has more instructions than the out-of-order window holds,
+// so run one after another the batches barely overlap; interleaved, the
+// independent work of three batches fills the wait (about 1.2x here).
 template <Model model, bool per_element, Layouts layouts>
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     Shading uniform{};
     if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
-    const CounterKeys keys = counter_keys(job.seed);
-    std::int64_t i = begin;
-    for (; i + kLanes <= end; i += kLanes)
-        if (!sample_one_batch<model, per_element, layouts>(job, i, uniform, keys)) return first_bad_view(job, i, i + kLanes);
-    if (i < end && !sample_tail<model, per_element>(job, Padding{i, end - i}, uniform, keys))
+    const CounterSeed seed = counter_seed(job.seed);
+    const std::int64_t batches = (end - begin) / kLanes;
+    auto at = [&](std::int64_t b) { return begin + b * kLanes; };
+    std::int64_t b = 0;
+    if (batches >= 2) {
+        Chosen<per_element> first, chosen;
+        if (!choose<model, per_element, layouts>(job, at(0), uniform, seed, first)) return first_bad_view(job, at(0), at(1));
+        if (!choose<model, per_element, layouts>(job, at(1), uniform, seed, chosen)) return first_bad_view(job, at(1), at(2));
+        Drawn<per_element> drawn = draw(job, first, uniform);
+        for (; b + 2 < batches; ++b) {
+            Chosen<per_element> next;  // batch b + 2
+            if (!choose<model, per_element, layouts>(job, at(b + 2), uniform, seed, next))
+                return first_bad_view(job, at(b + 2), at(b + 3));
+            const Drawn<per_element> next_drawn = draw(job, chosen, uniform);  // batch b + 1
+            weigh<model, per_element, layouts>(job, at(b), drawn, uniform);
+            chosen = next;
+            drawn = next_drawn;
+        }
+        weigh<model, per_element, layouts>(job, at(b), drawn, uniform);
+        weigh<model, per_element, layouts>(job, at(b + 1), draw(job, chosen, uniform), uniform);
+        b += 2;
+    }
+    for (; b < batches; ++b)
+        if (!sample_one_batch<model, per_element, layouts>(job, at(b), uniform, seed)) return first_bad_view(job, at(b), at(b + 1));
+    const std::int64_t i = begin + batches * kLanes;
+    if (i < end && !sample_tail<model, per_element>(job, Padding{i, end - i}, uniform, seed))
         return first_bad_view(job, i, end);
     return -1;
 }

@@ -33,12 +33,13 @@ inline constexpr LaneIndices kLaneIndices{};
 
 // u_k for elements first + 0 .. first + kLanes - 1; first is a multiple of
 // kLanes, so the low 32 bits never carry into the high ones within a batch.
-PB_KERNEL_INLINE Uniforms counter_uniforms(std::uint64_t first, const CounterKeys& keys) {
+PB_KERNEL_INLINE Uniforms counter_uniforms(std::uint64_t first, const CounterSeed& seed) {
     const UInts index_low = UInts::load_aligned(kLaneIndices.lanes) + UInts(static_cast<std::uint32_t>(first));
-    const auto high = static_cast<std::uint32_t>(first >> 32);
+    const std::uint32_t key = counter_key(seed, static_cast<std::uint32_t>(first >> 32));
+    const UInts spread = spread_counter(index_low);
     Floats u[3];
     for (int k = 0; k < 3; ++k) {
-        const UInts bits = counter_bits(index_low, high, keys, k) >> 8;
+        const UInts bits = counter_bits(spread, key, k) >> 8;
         u[k] = xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int32_t, Arch>>(bits)) * 0x1p-24f;
     }
     return {u[0], u[1], u[2]};
@@ -82,72 +83,79 @@ PB_KERNEL_INLINE Floats fast_sqrt(Floats x) {
     return xsimd::select(x > Floats(0.0f), x * reciprocal_sqrt(x), Floats(0.0f));
 }
 
-PB_KERNEL_INLINE Vec3 normalized(const Vec3& v) {
-    const Floats inv_length = reciprocal_sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-    return {v.x * inv_length, v.y * inv_length, v.z * inv_length};
-}
-
 PB_KERNEL_INLINE Vec3 select(const Mask& m, const Vec3& a, const Vec3& b) {
     return {xsimd::select(m, a.x, b.x), xsimd::select(m, a.y, b.y), xsimd::select(m, a.z, b.z)};
 }
 
-// Primary specular half vector, unnormalised. Visible normals by spherical
-// caps (Dupuy & Benyoub 2023): v = normalize(ax wo.x, ay wo.y, wo.z),
-// z = (1 - u2)(1 + v.z) - v.z, m = (s cos φ, s sin φ, z) + v,
-// h ∝ (ax m.x, ay m.y, m.z). Distribution (eq. 14-15):
-// h ∝ (sqrt(u2) ax cos φ, sqrt(u2) ay sin φ, sqrt(1 - u2)).
-PB_KERNEL_INLINE Vec3 specular_half_vector(const Vec3& wo, Floats u2, Floats cos_phi, Floats sin_phi, const Shading& s,
-                                 SpecularSampler sampler) {
-    if (sampler == SpecularSampler::kDistribution) {
-        const Floats radius = fast_sqrt(u2);
-        return {radius * s.alpha_x * cos_phi, radius * s.alpha_y * sin_phi, fast_sqrt(Floats(1.0f) - u2)};
-    }
-    const Vec3 v = normalized({s.alpha_x * wo.x, s.alpha_y * wo.y, wo.z});
-    const Floats z = xsimd::fms(Floats(1.0f) - u2, Floats(1.0f) + v.z, v.z);
-    const Floats sin_theta = fast_sqrt(xsimd::fnma(z, z, Floats(1.0f)));
-    return {s.alpha_x * xsimd::fma(sin_theta, cos_phi, v.x), s.alpha_y * xsimd::fma(sin_theta, sin_phi, v.y), z + v.z};
-}
-
-// e^x - 1 for x in [0, 14] without expm1's division: exp(x) - 1, and for
-// x < 0.25, where that cancels, the Taylor series to x^7 (error < 2e-8 relative).
+// e^x - 1 for x in [0, 14] (the clearcoat draw): x = k ln 2 + r with k = round(x / ln 2)
+// and |r| <= ln 2 / 2, then e^x - 1 = 2^k (e^r - 1) + (2^k - 1), both terms of one sign
+// for k >= 1, and e^r - 1 = r (1 + r/2 + ... + r^6/7!) (Taylor, relative error < 2e-8).
 PB_KERNEL_INLINE Floats exp_minus_one(Floats x) {
+    const Floats k = xsimd::nearbyint(x * 1.44269504088896341f);
+    const Floats r = xsimd::fnma(k, Floats(-1.90465429995776e-9f), xsimd::fnma(k, Floats(0.693145751953125f), x));
     Floats series(1.0f / 5040.0f);
     for (float coefficient : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f})
-        series = xsimd::fma(series, x, Floats(coefficient));
-    return xsimd::select(x < Floats(0.25f), series * x, xsimd::exp(x) - 1.0f);
+        series = xsimd::fma(series, r, Floats(coefficient));
+    using Ints = xsimd::batch<std::int32_t, Arch>;
+    const Floats two_to_k = xsimd::bitwise_cast<Floats>((xsimd::to_int(k) + Ints(127)) << 23);
+    return xsimd::fma(two_to_k, series * r, two_to_k - 1.0f);
 }
 
-// Clearcoat (GTR1, a = ac) half vector: sin²θh = a² (a^(-2 u2) - 1) / (1 - a²),
-// written as e^x - 1 with x = -u2 ln a², which keeps the narrow peak (u2 -> 0) accurate.
-PB_KERNEL_INLINE Vec3 clearcoat_half_vector(Floats u2, Floats cos_phi, Floats sin_phi, const Shading& s) {
-    const Floats sin2 = xsimd::min(s.clearcoat_sin2_scale * exp_minus_one(-u2 * s.clearcoat_log_alpha2), Floats(1.0f));
-    const Floats sin_theta = fast_sqrt(sin2);
-    return {sin_theta * cos_phi, sin_theta * sin_phi, fast_sqrt(Floats(1.0f) - sin2)};
-}
-
-// wi for the chosen lobes. Every lane computes the candidates of the lobes
-// chosen in the batch and selects its own; a candidate no lane chose is
-// skipped, which changes no result. A half vector of length 0 (u2 = 1 at
-// special angles) gives h = 0, so wi = -wo: below the horizon like every
+// wi for the chosen lobes. Each lobe draws a unit vector about a centre and
+// stretches it (README "Sampling and pdf"):
+//   m = (sinθ cos φ + c.x, sinθ sin φ + c.y, cosθ + c.z),  d = (sx m.x, sy m.y, m.z)
+// cosine lobe:  sin²θ = u1, c = 0, s = 1, wi = d
+// clearcoat:    sin²θ = ac² (ac^(-2 u2) - 1) / (1 - ac²) = e^x - 1 scaled, x = -u2 ln ac²;
+//               c = 0, s = 1, h ∝ d
+// specular, visible normals by spherical caps (Dupuy & Benyoub 2023):
+//               c = normalize(ax wo.x, ay wo.y, wo.z), cosθ = (1 - u2)(1 + c.z) - c.z,
+//               s = (ax, ay), h ∝ d
+// specular, distribution (eq. 14-15): sin²θ = u2, c = 0, s = (ax, ay), h ∝ d
+// and wi = 2 (wo·h) h - wo for the reflected lobes. So every lane does one
+// draw, whatever the mixture of lobes in its batch; the parts of a lobe no
+// lane chose are skipped, which changes no result. A d of length 0 (u2 = 1 at
+// special angles) gives h = 0 and wi = -wo: below the horizon like every
 // other u2 = 1 sample of the reflected lobes.
 PB_KERNEL_INLINE Vec3 sample_direction(const Vec3& wo, const Uniforms& u, const LobeChoice& lobe, const Shading& s,
                                        SpecularSampler sampler) {
+    const Floats zero(0.0f), one(1.0f);
     // φ = 2π u2 for the cosine lobe, 2π u1 for the others: one sincos for all
     const auto [sin_phi, cos_phi] = sincos_turns(xsimd::select(lobe.cosine, u.u2, u.u1));
-
-    // Cosine lobe: r = sqrt(u1), wi = (r cos φ, r sin φ, sqrt(1 - u1))
-    const Floats radius = fast_sqrt(u.u1);
-    const Vec3 cosine{radius * cos_phi, radius * sin_phi, fast_sqrt(Floats(1.0f) - u.u1)};
-    if (xsimd::all(lobe.cosine)) return cosine;
-
+    if (xsimd::all(lobe.cosine)) {
+        const Floats radius = fast_sqrt(u.u1);
+        return {radius * cos_phi, radius * sin_phi, fast_sqrt(one - u.u1)};
+    }
     const Mask clearcoat = !lobe.cosine & !lobe.specular;
-    Vec3 h = xsimd::any(lobe.specular) ? specular_half_vector(wo, u.u2, cos_phi, sin_phi, s, sampler) : cosine;
-    if (xsimd::any(clearcoat)) h = select(clearcoat, clearcoat_half_vector(u.u2, cos_phi, sin_phi, s), h);
-    const Floats h_len2 = h.x * h.x + h.y * h.y + h.z * h.z;
-    const Floats zero(0.0f);
-    h = select(h_len2 > zero, normalized(h), Vec3{zero, zero, zero});
-    // wi = 2 (wo·h) h - wo
-    const Floats twice_cos = 2.0f * (wo.x * h.x + wo.y * h.y + wo.z * h.z);
-    const Vec3 reflected{xsimd::fms(twice_cos, h.x, wo.x), xsimd::fms(twice_cos, h.y, wo.y), xsimd::fms(twice_cos, h.z, wo.z)};
-    return select(lobe.cosine, cosine, reflected);
+    const bool visible_normals = sampler == SpecularSampler::kVisibleNormals;
+
+    Floats sin2_theta = xsimd::select(lobe.cosine, u.u1, u.u2);  // cosine lobe, distribution sampler
+    Vec3 centre{zero, zero, zero};
+    if (visible_normals && xsimd::any(lobe.specular)) {
+        const Vec3 stretched{s.alpha_x * wo.x, s.alpha_y * wo.y, wo.z};
+        const Floats inv_length = reciprocal_sqrt(stretched.x * stretched.x + stretched.y * stretched.y + stretched.z * stretched.z);
+        const Vec3 v{stretched.x * inv_length, stretched.y * inv_length, stretched.z * inv_length};
+        const Floats cos_theta = xsimd::fms(one - u.u2, one + v.z, v.z);
+        sin2_theta = xsimd::select(lobe.specular, xsimd::fnma(cos_theta, cos_theta, one), sin2_theta);
+        // cosθ + c.z enters through c.z, see below
+        centre = {xsimd::select(lobe.specular, v.x, zero), xsimd::select(lobe.specular, v.y, zero),
+                  xsimd::select(lobe.specular, cos_theta + v.z, zero)};
+    }
+    if (xsimd::any(clearcoat)) {
+        const Floats sin2 = xsimd::min(s.clearcoat_sin2_scale * exp_minus_one(-u.u2 * s.clearcoat_log_alpha2), one);
+        sin2_theta = xsimd::select(clearcoat, sin2, sin2_theta);
+    }
+    const Floats sin_theta = fast_sqrt(sin2_theta);
+    // cosθ from sin²θ except for the visible-normal specular, whose cosθ is in c.z
+    const Mask drawn_cos = visible_normals ? !lobe.specular : Mask(true);
+    const Floats cos_theta = xsimd::select(drawn_cos, fast_sqrt(one - sin2_theta), zero);
+    const Floats stretch_x = xsimd::select(lobe.specular, s.alpha_x, one);
+    const Floats stretch_y = xsimd::select(lobe.specular, s.alpha_y, one);
+    const Vec3 d{stretch_x * xsimd::fma(sin_theta, cos_phi, centre.x), stretch_y * xsimd::fma(sin_theta, sin_phi, centre.y),
+                 cos_theta + centre.z};
+
+    // wi = 2 (wo·h) h - wo with h = d / |d|
+    const Floats d_len2 = d.x * d.x + d.y * d.y + d.z * d.z;
+    const Floats scale = xsimd::select(d_len2 > zero, 2.0f * (wo.x * d.x + wo.y * d.y + wo.z * d.z) * reciprocal(d_len2), zero);
+    const Vec3 reflected{xsimd::fms(scale, d.x, wo.x), xsimd::fms(scale, d.y, wo.y), xsimd::fms(scale, d.z, wo.z)};
+    return select(lobe.cosine, d, reflected);
 }
