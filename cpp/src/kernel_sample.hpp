@@ -9,49 +9,24 @@
 // recomputable from wo is recomputed, which is cheaper than holding it in
 // registers across the other batches' work (see sample_loop).
 
-// The material of a batch when per element (else the call's, passed apart so
-// that the compiler keeps it in registers).
-template <bool per_element>
-struct BatchShading {
-    Shading value;
-};
-template <>
-struct BatchShading<false> {};
-
-template <bool per_element>
-PB_KERNEL_INLINE const Shading& shading_for(const BatchShading<per_element>& batch, const Shading& uniform) {
-    if constexpr (per_element) {
-        return batch.value;
-    } else {
-        return uniform;
-    }
-}
-
-template <bool per_element>
 struct Chosen {
-    BatchShading<per_element> shading;
     Vec3 wo;
     Uniforms u;
     LobeProbabilities probabilities;
     LobeChoice lobe;
 };
 
-template <bool per_element>
 struct Drawn {
-    BatchShading<per_element> shading;
     Vec3 wo, wi;
     LobeProbabilities probabilities;
     LobeChoice lobe;
 };
 
 // false, with nothing stored, when the fused direction check fails
-template <Model model, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterSeed& seed,
-                             Chosen<per_element>& c) {
+template <Model model, Layouts layouts>
+PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed, Chosen& c) {
     c.wo = load_vec3<layouts>(job.wo, i);
     if (job.check_directions && !xsimd::all(unit_length(c.wo, job.length2_lowest, job.length2_highest))) return false;
-    if constexpr (per_element) c.shading.value = shading_of(load_material(job.params, i));
-    const Shading& s = shading_for(c.shading, uniform);
     if (job.u.data != nullptr) {
         const Vec3 given = load_vec3<layouts>(job.u, i);
         c.u = {given.x, given.y, given.z};
@@ -63,15 +38,12 @@ PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading
     return true;
 }
 
-template <bool per_element>
-PB_KERNEL_INLINE Drawn<per_element> draw(const SampleJob& job, const Chosen<per_element>& c, const Shading& uniform) {
-    const Vec3 wi = sample_direction(c.wo, c.u, c.lobe, shading_for(c.shading, uniform), job.sampler);
-    return {c.shading, c.wo, wi, c.probabilities, c.lobe};
+PB_KERNEL_INLINE Drawn draw(const SampleJob& job, const Chosen& c, const Shading& s) {
+    return {c.wo, sample_direction(c.wo, c.u, c.lobe, s, job.sampler), c.probabilities, c.lobe};
 }
 
-template <Model model, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn<per_element>& d, const Shading& uniform) {
-    const Shading& s = shading_for(d.shading, uniform);
+template <Model model, Layouts layouts>
+PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn& d, const Shading& s) {
     const Vec3& wi = d.wi;
     const View view = view_of<model>(d.wo, s);
     const Geometry g = geometry_of(wi, d.wo);
@@ -91,9 +63,12 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn<pe
 
 template <Model model, bool per_element, Layouts layouts>
 PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterSeed& seed) {
-    Chosen<per_element> chosen;
-    if (!choose<model, per_element, layouts>(job, i, uniform, seed, chosen)) return false;
-    weigh<model, per_element, layouts>(job, i, draw(job, chosen, uniform), uniform);
+    Shading per_batch;
+    if constexpr (per_element) per_batch = shading_of(load_material(job.params, i));
+    const Shading& s = per_element ? per_batch : uniform;
+    Chosen chosen;
+    if (!choose<model, layouts>(job, i, s, seed, chosen)) return false;
+    weigh<model, layouts>(job, i, draw(job, chosen, s), s);
     return true;
 }
 
@@ -130,7 +105,9 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const Shading& unifor
 // batch are one long dependency chain (uniforms, lobe, direction, f and pdf)
 // and a batch alone has more instructions than the out-of-order window holds,
 // so run one after another the batches barely overlap; interleaved, the
-// independent work of three batches fills the wait (about 1.2x here).
+// independent work of three batches fills the wait (about 1.2x here). Not for
+// per-element materials: each batch's Shading in flight would not fit in the
+// registers (interleaved they run 0.8x as fast as one after another).
 template <Model model, bool per_element, Layouts layouts>
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     Shading uniform{};
@@ -139,23 +116,24 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
     const std::int64_t batches = (end - begin) / kLanes;
     auto at = [&](std::int64_t b) { return begin + b * kLanes; };
     std::int64_t b = 0;
-    if (batches >= 2) {
-        Chosen<per_element> first, chosen;
-        if (!choose<model, per_element, layouts>(job, at(0), uniform, seed, first)) return first_bad_view(job, at(0), at(1));
-        if (!choose<model, per_element, layouts>(job, at(1), uniform, seed, chosen)) return first_bad_view(job, at(1), at(2));
-        Drawn<per_element> drawn = draw(job, first, uniform);
-        for (; b + 2 < batches; ++b) {
-            Chosen<per_element> next;  // batch b + 2
-            if (!choose<model, per_element, layouts>(job, at(b + 2), uniform, seed, next))
-                return first_bad_view(job, at(b + 2), at(b + 3));
-            const Drawn<per_element> next_drawn = draw(job, chosen, uniform);  // batch b + 1
-            weigh<model, per_element, layouts>(job, at(b), drawn, uniform);
-            chosen = next;
-            drawn = next_drawn;
+    if constexpr (!per_element) {
+        if (batches >= 2) {
+            Chosen first, chosen;
+            if (!choose<model, layouts>(job, at(0), uniform, seed, first)) return first_bad_view(job, at(0), at(1));
+            if (!choose<model, layouts>(job, at(1), uniform, seed, chosen)) return first_bad_view(job, at(1), at(2));
+            Drawn drawn = draw(job, first, uniform);
+            for (; b + 2 < batches; ++b) {
+                Chosen next;  // batch b + 2
+                if (!choose<model, layouts>(job, at(b + 2), uniform, seed, next)) return first_bad_view(job, at(b + 2), at(b + 3));
+                const Drawn next_drawn = draw(job, chosen, uniform);  // batch b + 1
+                weigh<model, layouts>(job, at(b), drawn, uniform);
+                chosen = next;
+                drawn = next_drawn;
+            }
+            weigh<model, layouts>(job, at(b), drawn, uniform);
+            weigh<model, layouts>(job, at(b + 1), draw(job, chosen, uniform), uniform);
+            b += 2;
         }
-        weigh<model, per_element, layouts>(job, at(b), drawn, uniform);
-        weigh<model, per_element, layouts>(job, at(b + 1), draw(job, chosen, uniform), uniform);
-        b += 2;
     }
     for (; b < batches; ++b)
         if (!sample_one_batch<model, per_element, layouts>(job, at(b), uniform, seed)) return first_bad_view(job, at(b), at(b + 1));
