@@ -78,11 +78,6 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> sincos_turns(Floats u) {
     return {xsimd::select(q2 | q3, -sine, sine), xsimd::select(q1 | q2, -cosine, cosine)};
 }
 
-// sqrt(x) for x >= 0 through the refined reciprocal square root (0 stays 0)
-PB_KERNEL_INLINE Floats fast_sqrt(Floats x) {
-    return xsimd::select(x > Floats(0.0f), x * reciprocal_sqrt(x), Floats(0.0f));
-}
-
 PB_KERNEL_INLINE Vec3 select(const Mask& m, const Vec3& a, const Vec3& b) {
     return {xsimd::select(m, a.x, b.x), xsimd::select(m, a.y, b.y), xsimd::select(m, a.z, b.z)};
 }
@@ -122,8 +117,8 @@ PB_KERNEL_INLINE Vec3 sample_direction(const Vec3& wo, const Uniforms& u, const 
     // φ = 2π u2 for the cosine lobe, 2π u1 for the others: one sincos for all
     const auto [sin_phi, cos_phi] = sincos_turns(xsimd::select(lobe.cosine, u.u2, u.u1));
     if (xsimd::all(lobe.cosine)) {
-        const Floats radius = fast_sqrt(u.u1);
-        return {radius * cos_phi, radius * sin_phi, fast_sqrt(one - u.u1)};
+        const Floats radius = square_root(u.u1);
+        return {radius * cos_phi, radius * sin_phi, square_root(one - u.u1)};
     }
     const Mask clearcoat = !lobe.cosine & !lobe.specular;
     const bool visible_normals = sampler == SpecularSampler::kVisibleNormals;
@@ -144,10 +139,10 @@ PB_KERNEL_INLINE Vec3 sample_direction(const Vec3& wo, const Uniforms& u, const 
         const Floats sin2 = xsimd::min(s.clearcoat_sin2_scale * exp_minus_one(-u.u2 * s.clearcoat_log_alpha2), one);
         sin2_theta = xsimd::select(clearcoat, sin2, sin2_theta);
     }
-    const Floats sin_theta = fast_sqrt(sin2_theta);
+    const Floats sin_theta = square_root(sin2_theta);
     // cosθ from sin²θ except for the visible-normal specular, whose cosθ is in c.z
     const Mask drawn_cos = visible_normals ? !lobe.specular : Mask(true);
-    const Floats cos_theta = xsimd::select(drawn_cos, fast_sqrt(one - sin2_theta), zero);
+    const Floats cos_theta = xsimd::select(drawn_cos, square_root(one - sin2_theta), zero);
     const Floats stretch_x = xsimd::select(lobe.specular, s.alpha_x, one);
     const Floats stretch_y = xsimd::select(lobe.specular, s.alpha_y, one);
     const Vec3 d{stretch_x * xsimd::fma(sin_theta, cos_phi, centre.x), stretch_y * xsimd::fma(sin_theta, sin_phi, centre.y),

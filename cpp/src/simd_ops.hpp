@@ -1,5 +1,5 @@
-// Per-instruction-set building blocks of the kernel: fast reciprocal and
-// reciprocal square root refined to float precision, and the (N, 3)
+// Per-instruction-set building blocks of the kernel: fast reciprocal, square
+// root and reciprocal square root refined to float precision, and the (N, 3)
 // interleaved <-> structure-of-arrays transposes done in registers.
 //
 // Included by kernel.hpp inside the per-arch namespace, after `Floats` is
@@ -59,6 +59,16 @@ PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
     // One Newton-Raphson step: y + (y / 2) (1 - x y²)
     const __m512 residual = _mm512_fnmadd_ps(_mm512_mul_ps(x, estimate), estimate, _mm512_set1_ps(1.0f));
     return _mm512_fmadd_ps(_mm512_mul_ps(_mm512_set1_ps(0.5f), estimate), residual, estimate);
+}
+
+// sqrt(x): s = x y from the estimate y of 1/sqrt(x), then one Newton-Raphson
+// step s + (s / 2) (1 - s y); 0 for x <= 0 (where s would be 0 inf or NaN).
+PB_KERNEL_INLINE Floats square_root(Floats x) {
+    const __m512 estimate = _mm512_rsqrt14_ps(x);
+    const __m512 root = _mm512_mul_ps(x, estimate);
+    const __m512 residual = _mm512_fnmadd_ps(root, estimate, _mm512_set1_ps(1.0f));
+    const __m512 refined = _mm512_fmadd_ps(_mm512_mul_ps(_mm512_set1_ps(0.5f), root), residual, root);
+    return _mm512_maskz_mov_ps(_mm512_cmp_ps_mask(x, _mm512_setzero_ps(), _CMP_GT_OQ), refined);
 }
 
 // Two-source permutes (vpermt2ps): a component of 16 elements comes from the
@@ -128,6 +138,15 @@ PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
     return _mm256_fmadd_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), estimate), residual, estimate);
 }
 
+// sqrt(x), 0 for x <= 0, as for AVX-512
+PB_KERNEL_INLINE Floats square_root(Floats x) {
+    const __m256 estimate = _mm256_rsqrt_ps(x);
+    const __m256 root = _mm256_mul_ps(x, estimate);
+    const __m256 residual = _mm256_fnmadd_ps(root, estimate, _mm256_set1_ps(1.0f));
+    const __m256 refined = _mm256_fmadd_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), root), residual, root);
+    return _mm256_and_ps(refined, _mm256_cmp_ps(x, _mm256_setzero_ps(), _CMP_GT_OQ));
+}
+
 template <int k>
 PB_KERNEL_INLINE __m256i interleave_load_permutation() {
     return _mm256_load_si256(reinterpret_cast<const __m256i*>(kInterleave3Permutation<8, k, false>.lanes));
@@ -186,6 +205,7 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
 
 PB_KERNEL_INLINE Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
 PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) { return Floats(1.0f) / xsimd::sqrt(x); }
+PB_KERNEL_INLINE Floats square_root(Floats x) { return xsimd::sqrt(xsimd::max(x, Floats(0.0f))); }
 
 PB_KERNEL_INLINE void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
     alignas(64) float xs[Floats::size], ys[Floats::size], zs[Floats::size];
