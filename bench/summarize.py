@@ -62,11 +62,12 @@ def main(path: str) -> None:
             aos = find(rates, f"eval/{best}/aos/{material}/{size}/{threads_used}/")
             soa = find(rates, f"eval/{best}/soa/{material}/{size}/{threads_used}/")
             print(f"| (N,3) vs (3,N), N={size}, {threads_used} thread(s), {material} (>= 0.9x) | {ratio(aos, soa)} |")
-    for isa in isas:
-        sample = find(rates, f"sample/{isa}/aos/uniform/{small}/1/")
-        evaluate = find(rates, f"eval/{isa}/aos/uniform/{small}/1/")
-        if sample:
-            print(f"| {isa} sampling vs eval, in cache (>= 0.5x) | {ratio(sample, evaluate)} |")
+    for material in ("uniform", "per_element"):
+        for isa in isas:
+            sample = find(rates, f"sample/{isa}/aos/{material}/{small}/1/")
+            evaluate = find(rates, f"eval/{isa}/aos/{material}/{small}/1/")
+            if sample:
+                print(f"| {isa} sampling vs eval, in cache, {material} (>= 0.5x) | {ratio(sample, evaluate)} |")
 
 
 if __name__ == "__main__":

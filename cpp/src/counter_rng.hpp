@@ -12,9 +12,9 @@
 // sequence) before the hash: lowbias32 of plain consecutive counters fails a
 // 256-bin uniformity test at 2^20 values, this passes it and the 2-D and 3-D
 // tests of tests/test_simd_sampling.py. The key depends only on the seed and
-// the high half of the index, so for a batch of lanes it is one scalar; a
-// lane costs one multiply for the three counters and one hash (two
-// multiplies) per uniform.
+// the high half of the index, so for a batch of lanes it is one scalar, and
+// so is the first lane's spread counter (the others add a constant); a lane
+// costs one hash (two multiplies) per uniform.
 //
 // lowbias32 is Chris Wellons' 32-bit integer hash (two multiply-xorshift
 // rounds, a bijection). Included inside a namespace by each user (kernel.hpp
@@ -22,7 +22,7 @@
 // multiply_low(U, std::uint32_t) for its integer type U.
 #pragma once  // (per translation unit)
 
-inline std::uint32_t multiply_low(std::uint32_t a, std::uint32_t b) { return a * b; }
+constexpr std::uint32_t multiply_low(std::uint32_t a, std::uint32_t b) { return a * b; }
 
 template <class U>
 PB_KERNEL_INLINE U lowbias32(U x) {
@@ -52,7 +52,7 @@ constexpr std::uint32_t kGolden = 0x9E3779B9u;
 
 // 3 lo32(i) 0x9E3779B9, shared by the three counters of element i
 template <class U>
-PB_KERNEL_INLINE U spread_counter(U index_low) {
+PB_KERNEL_INLINE constexpr U spread_counter(U index_low) {
     return multiply_low(index_low, 3u * kGolden);
 }
 

@@ -17,26 +17,26 @@ PB_KERNEL_INLINE UInts multiply_low(UInts a, std::uint32_t b) { return a * UInts
 
 #include "counter_rng.hpp"
 
-constexpr float kTwoPi = 6.28318530717958647692f;
-
 struct Uniforms {
     Floats u0, u1, u2;
 };
 
-struct LaneIndices {
+// spread_counter(j) for lane j: the spread counters of a batch are the
+// first element's plus these (the spread is linear mod 2^32), one add instead
+// of a 32-bit multiply per batch.
+struct LaneSpreads {
     alignas(64) std::uint32_t lanes[kLanes];
-    constexpr LaneIndices() : lanes{} {
-        for (std::int64_t j = 0; j < kLanes; ++j) lanes[j] = static_cast<std::uint32_t>(j);
+    constexpr LaneSpreads() : lanes{} {
+        for (std::int64_t j = 0; j < kLanes; ++j) lanes[j] = spread_counter(static_cast<std::uint32_t>(j));
     }
 };
-inline constexpr LaneIndices kLaneIndices{};
+inline constexpr LaneSpreads kLaneSpreads{};
 
 // u_k for elements first + 0 .. first + kLanes - 1; first is a multiple of
 // kLanes, so the low 32 bits never carry into the high ones within a batch.
 PB_KERNEL_INLINE Uniforms counter_uniforms(std::uint64_t first, const CounterSeed& seed) {
-    const UInts index_low = UInts::load_aligned(kLaneIndices.lanes) + UInts(static_cast<std::uint32_t>(first));
     const std::uint32_t key = counter_key(seed, static_cast<std::uint32_t>(first >> 32));
-    const UInts spread = spread_counter(index_low);
+    const UInts spread = UInts::load_aligned(kLaneSpreads.lanes) + UInts(spread_counter(static_cast<std::uint32_t>(first)));
     Floats u[3];
     for (int k = 0; k < 3; ++k) {
         const UInts bits = counter_bits(spread, key, k) >> 8;
