@@ -1,7 +1,7 @@
 // Part of kernel.hpp, included inside the per-arch namespace: drawing wi from
 // the three lobes exactly as README "Sampling and pdf" defines it, branch-free
-// (every lane computes every lobe's candidate, then selects), and the
-// counter-based uniforms.
+// across lanes (one construction for all lobes, its parameters selected per
+// lane), and the counter-based uniforms.
 #pragma once  // (per translation unit)
 
 using UInts = xsimd::batch<std::uint32_t, Arch>;
@@ -83,11 +83,12 @@ PB_KERNEL_INLINE Vec3 select(const Mask& m, const Vec3& a, const Vec3& b) {
 }
 
 // e^x - 1 for x in [0, 14] (the clearcoat draw): x = k ln 2 + r with k = round(x / ln 2)
-// and |r| <= ln 2 / 2, then e^x - 1 = 2^k (e^r - 1) + (2^k - 1), both terms of one sign
-// for k >= 1, and e^r - 1 = r (1 + r/2 + ... + r^6/7!) (Taylor, relative error < 2e-8).
+// (ln 2 in two parts, Cody-Waite, so r is exact to float precision) and |r| <= ln 2 / 2;
+// then e^x - 1 = 2^k (e^r - 1) + (2^k - 1), both terms of one sign for k >= 1, and
+// e^r - 1 = r (1 + r/2 + ... + r^6/7!) (Taylor). Relative error < 2e-7 over [0, 14].
 PB_KERNEL_INLINE Floats exp_minus_one(Floats x) {
     const Floats k = xsimd::nearbyint(x * 1.44269504088896341f);
-    const Floats r = xsimd::fnma(k, Floats(-1.90465429995776e-9f), xsimd::fnma(k, Floats(0.693145751953125f), x));
+    const Floats r = xsimd::fnma(k, Floats(1.42860682030941723e-6f), xsimd::fnma(k, Floats(0.693145751953125f), x));
     Floats series(1.0f / 5040.0f);
     for (float coefficient : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f})
         series = xsimd::fma(series, r, Floats(coefficient));
