@@ -24,6 +24,8 @@
 
 constexpr std::uint32_t multiply_low(std::uint32_t a, std::uint32_t b) { return a * b; }
 
+constexpr std::uint32_t kGolden = 0x9E3779B9u;  // 2^32 / golden ratio
+
 template <class U>
 PB_KERNEL_INLINE U lowbias32(U x) {
     x = x ^ (x >> 16);
@@ -39,7 +41,7 @@ struct CounterSeed {
 };
 
 inline CounterSeed counter_seed(std::uint64_t seed) {
-    const std::uint32_t low = lowbias32(static_cast<std::uint32_t>(seed) + 0x9E3779B9u);
+    const std::uint32_t low = lowbias32(static_cast<std::uint32_t>(seed) + kGolden);
     return {lowbias32(low + static_cast<std::uint32_t>(seed >> 32))};
 }
 
@@ -47,8 +49,6 @@ inline CounterSeed counter_seed(std::uint64_t seed) {
 inline std::uint32_t counter_key(const CounterSeed& seed, std::uint32_t index_high) {
     return lowbias32(seed.mixed + 0x632BE5ABu * index_high);
 }
-
-constexpr std::uint32_t kGolden = 0x9E3779B9u;
 
 // 3 lo32(i) 0x9E3779B9, shared by the three counters of element i
 template <class U>
