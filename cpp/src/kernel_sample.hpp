@@ -123,9 +123,9 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
             if (!choose<model, layouts>(job, at(1), uniform, seed, chosen)) return first_bad_view(job, at(1), at(2));
             Drawn drawn = draw(job, first, uniform);
             for (; b + 2 < batches; ++b) {
+                const Drawn next_drawn = draw(job, chosen, uniform);  // batch b + 1
                 Chosen next;  // batch b + 2
                 if (!choose<model, layouts>(job, at(b + 2), uniform, seed, next)) return first_bad_view(job, at(b + 2), at(b + 3));
-                const Drawn next_drawn = draw(job, chosen, uniform);  // batch b + 1
                 weigh<model, layouts>(job, at(b), drawn, uniform);
                 chosen = next;
                 drawn = next_drawn;
