@@ -87,12 +87,13 @@ struct View {
     Floats smith_clearcoat;     // Smith denominator for wo at alpha 0.25 (1 when no lane has a clearcoat)
 };
 
+// given FV and the visible-normal Smith denominator (the sampling loop has them from
+// the lobe choice and the draw)
 template <Model model>
-PB_KERNEL_INLINE View view_of(const Vec3& wo, const Shading& s) {
+PB_KERNEL_INLINE View view_of(const Vec3& wo, const Shading& s, Floats smith_visible, Floats fv) {
     View v;
-    v.fv = schlick_weight(wo.z);
-    const Floats q = xsimd::fma(s.alpha_x2, wo.x * wo.x, xsimd::fma(s.alpha_y2, wo.y * wo.y, wo.z * wo.z));
-    v.smith_visible = smith_denominator(wo.z, q);
+    v.fv = fv;
+    v.smith_visible = smith_visible;
     if constexpr (model == Model::kDisney2012) {
         v.smith_specular = smith_denominator_iso(wo.z, s.alpha_g2);
     } else {
@@ -101,6 +102,12 @@ PB_KERNEL_INLINE View view_of(const Vec3& wo, const Shading& s) {
     v.smith_clearcoat = Floats(1.0f);
     if (xsimd::any(s.clearcoat_scale != Floats(0.0f))) v.smith_clearcoat = smith_denominator_iso(wo.z, Floats(0.0625f));
     return v;
+}
+
+template <Model model>
+PB_KERNEL_INLINE View view_of(const Vec3& wo, const Shading& s) {
+    const Floats q = xsimd::fma(s.alpha_x2, wo.x * wo.x, xsimd::fma(s.alpha_y2, wo.y * wo.y, wo.z * wo.z));
+    return view_of<model>(wo, s, smith_denominator(wo.z, q), schlick_weight(wo.z));
 }
 
 // Smith denominator of the 2014 model for wi: n·w + sqrt((w·x ax)² + (w·y ay)² + (n·w)²)
@@ -171,8 +178,7 @@ struct LobeProbabilities {
 
 // w0 = (1 - metallic)(Cdlum + 0.1 sheen lum(Csheen)), w1 = max(lum(mix(Cspec0, 1, FV)), 0.02),
 // w2 = 0.25 clearcoat mix(0.04, 1, FV); P_k = w_k / Σ w.
-PB_KERNEL_INLINE LobeProbabilities lobe_probabilities(const View& view, const Shading& s) {
-    const Floats fv = view.fv;
+PB_KERNEL_INLINE LobeProbabilities lobe_probabilities(Floats fv, const Shading& s) {
     const Floats w0 = s.cosine_lobe_weight;
     const Floats w1 = xsimd::max(mix(s.specular_f0_luminance, Floats(1.0f), fv), Floats(0.02f));
     const Floats w2 = s.clearcoat_lobe_weight * xsimd::fma(Floats(0.96f), fv, Floats(0.04f));

@@ -4,20 +4,23 @@
 #pragma once  // (per translation unit)
 
 // A batch goes through three stages, each a function of the previous one's
-// result: choose (wo, the uniforms, the lobe), draw (wi) and weigh (f, pdf,
-// weight; the stores). What passes between stages is kept small: anything
-// recomputable from wo is recomputed, which is cheaper than holding it in
-// registers across the other batches' work (see sample_loop).
+// result: choose (wo, the uniforms, FV, the lobe), draw (wi and the Smith
+// denominator of wo) and weigh (f, pdf, weight; the stores). What passes
+// between stages is kept small: the rest of what depends on wo alone is
+// recomputed, which is cheaper than holding it in registers across the other
+// batches' work (see sample_loop).
 
 struct Chosen {
     Vec3 wo;
     Uniforms u;
     LobeProbabilities probabilities;
     LobeChoice lobe;
+    Floats fv;
 };
 
 struct Drawn {
     Vec3 wo, wi;
+    Floats smith_visible, fv;
     LobeProbabilities probabilities;
     LobeChoice lobe;
 };
@@ -33,19 +36,21 @@ PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading
     } else {
         c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index + i), seed);
     }
-    c.probabilities = lobe_probabilities(view_of<model>(c.wo, s), s);
+    c.fv = schlick_weight(c.wo.z);
+    c.probabilities = lobe_probabilities(c.fv, s);
     c.lobe = choose_lobe(c.u.u0, c.probabilities);
     return true;
 }
 
 PB_KERNEL_INLINE Drawn draw(const SampleJob& job, const Chosen& c, const Shading& s) {
-    return {c.wo, sample_direction(c.wo, c.u, c.lobe, s, job.sampler), c.probabilities, c.lobe};
+    const Direction direction = sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
+    return {c.wo, direction.wi, direction.smith_visible, c.fv, c.probabilities, c.lobe};
 }
 
 template <Model model, Layouts layouts>
 PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn& d, const Shading& s) {
     const Vec3& wi = d.wi;
-    const View view = view_of<model>(d.wo, s);
+    const View view = view_of<model>(d.wo, s, d.smith_visible, d.fv);
     const Geometry g = geometry_of(wi, d.wo);
     const Floats pdf = mixture_pdf(g, s, view, d.probabilities, job.sampler);
     const Mask valid = (wi.z > Floats(0.0f)) & (d.wo.z > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));

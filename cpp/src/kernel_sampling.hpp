@@ -21,25 +21,27 @@ struct Uniforms {
     Floats u0, u1, u2;
 };
 
-// spread_counter(j) for lane j: the spread counters of a batch are the
-// first element's plus these (the spread is linear mod 2^32), one add instead
-// of a 32-bit multiply per batch.
-struct LaneSpreads {
-    alignas(64) std::uint32_t lanes[kLanes];
-    constexpr LaneSpreads() : lanes{} {
-        for (std::int64_t j = 0; j < kLanes; ++j) lanes[j] = spread_counter(static_cast<std::uint32_t>(j));
+// The three counters of lane j, spread: spread_counter(j) + k 0x9E3779B9 for
+// stream k. Those of a batch are the first element's spread counter plus
+// these (the spread is linear mod 2^32): one add per stream instead of a
+// 32-bit multiply.
+struct LaneCounters {
+    alignas(64) std::uint32_t lanes[3][kLanes];
+    constexpr LaneCounters() : lanes{} {
+        for (std::uint32_t k = 0; k < 3; ++k)
+            for (std::int64_t j = 0; j < kLanes; ++j) lanes[k][j] = spread_counter(static_cast<std::uint32_t>(j)) + k * kGolden;
     }
 };
-inline constexpr LaneSpreads kLaneSpreads{};
+inline constexpr LaneCounters kLaneCounters{};
 
 // u_k for elements first + 0 .. first + kLanes - 1; first is a multiple of
 // kLanes, so the low 32 bits never carry into the high ones within a batch.
 PB_KERNEL_INLINE Uniforms counter_uniforms(std::uint64_t first, const CounterSeed& seed) {
-    const std::uint32_t key = counter_key(seed, static_cast<std::uint32_t>(first >> 32));
-    const UInts spread = UInts::load_aligned(kLaneSpreads.lanes) + UInts(spread_counter(static_cast<std::uint32_t>(first)));
+    const UInts key(counter_key(seed, static_cast<std::uint32_t>(first >> 32)));
+    const UInts first_spread(spread_counter(static_cast<std::uint32_t>(first)));
     Floats u[3];
     for (int k = 0; k < 3; ++k) {
-        const UInts bits = counter_bits(spread, key, k) >> 8;
+        const UInts bits = lowbias32((UInts::load_aligned(kLaneCounters.lanes[k]) + first_spread) ^ key) >> 8;
         u[k] = xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int32_t, Arch>>(bits)) * 0x1p-24f;
     }
     return {u[0], u[1], u[2]};
@@ -95,6 +97,13 @@ PB_KERNEL_INLINE Floats exp_minus_one(Floats x) {
     return xsimd::fma(two_to_k, series * r, two_to_k - 1.0f);
 }
 
+// What the draw returns: wi, and the visible-normal Smith denominator of wo
+// (View::smith_visible), which the draw computes on the way.
+struct Direction {
+    Vec3 wi;
+    Floats smith_visible;  // cos θv + |V|, V = (ax wo.x, ay wo.y, wo.z)
+};
+
 // wi for the chosen lobes. Each lobe draws a unit vector about a centre and
 // stretches it (README "Sampling and pdf"):
 //   m = (sinθ cos φ + c.x, sinθ sin φ + c.y, cosθ + c.z),  d = (sx m.x, sy m.y, m.z)
@@ -110,14 +119,21 @@ PB_KERNEL_INLINE Floats exp_minus_one(Floats x) {
 // lane chose are skipped, which changes no result. A d of length 0 (u2 = 1 at
 // special angles) gives h = 0 and wi = -wo: below the horizon like every
 // other u2 = 1 sample of the reflected lobes.
-PB_KERNEL_INLINE Vec3 sample_direction(const Vec3& wo, const Uniforms& u, const LobeChoice& lobe, const Shading& s,
-                                       SpecularSampler sampler) {
+PB_KERNEL_INLINE Direction sample_direction(const Vec3& wo, const Uniforms& u, const LobeChoice& lobe, const Shading& s,
+                                            SpecularSampler sampler) {
     const Floats zero(0.0f), one(1.0f);
+    // the visible-normal cap construction scaled by L = |V|, V = (ax wo.x, ay wo.y, wo.z),
+    // so V need not be normalised: L cosθ = (1 - u2)(L + V.z) - V.z, L² sin²θ = L² - (L cosθ)²;
+    // cos θv + L is the View's smith_visible, which the weight needs anyway
+    const Vec3 stretched{s.alpha_x * wo.x, s.alpha_y * wo.y, wo.z};
+    const Floats length2 = stretched.x * stretched.x + stretched.y * stretched.y + stretched.z * stretched.z;
+    const Floats length = square_root(length2);
+    const Floats smith_visible = wo.z + length;
     // φ = 2π u2 for the cosine lobe, 2π u1 for the others: one sincos for all
     const auto [sin_phi, cos_phi] = sincos_turns(xsimd::select(lobe.cosine, u.u2, u.u1));
     if (xsimd::all(lobe.cosine)) {
         const Floats radius = square_root(u.u1);
-        return {radius * cos_phi, radius * sin_phi, square_root(one - u.u1)};
+        return {{radius * cos_phi, radius * sin_phi, square_root(one - u.u1)}, smith_visible};
     }
     const Mask clearcoat = !lobe.cosine & !lobe.specular;
     const bool visible_normals = sampler == SpecularSampler::kVisibleNormals;
@@ -125,11 +141,6 @@ PB_KERNEL_INLINE Vec3 sample_direction(const Vec3& wo, const Uniforms& u, const 
     Floats sin2_theta = xsimd::select(lobe.cosine, u.u1, u.u2);  // cosine lobe, distribution sampler
     Vec3 centre{zero, zero, zero};
     if (visible_normals && xsimd::any(lobe.specular)) {
-        // the cap construction scaled by L = |V|, V = (ax wo.x, ay wo.y, wo.z), so V
-        // need not be normalised: L cosθ = (1 - u2)(L + V.z) - V.z, L² sin²θ = L² - (L cosθ)²
-        const Vec3 stretched{s.alpha_x * wo.x, s.alpha_y * wo.y, wo.z};
-        const Floats length2 = stretched.x * stretched.x + stretched.y * stretched.y + stretched.z * stretched.z;
-        const Floats length = square_root(length2);
         const Floats scaled_cos = xsimd::fms(one - u.u2, length + stretched.z, stretched.z);
         sin2_theta = xsimd::select(lobe.specular, xsimd::fnma(scaled_cos, scaled_cos, length2), sin2_theta);
         // cosθ + c.z enters through c.z, see below
@@ -153,5 +164,5 @@ PB_KERNEL_INLINE Vec3 sample_direction(const Vec3& wo, const Uniforms& u, const 
     const Floats d_len2 = d.x * d.x + d.y * d.y + d.z * d.z;
     const Floats scale = xsimd::select(d_len2 > zero, 2.0f * (wo.x * d.x + wo.y * d.y + wo.z * d.z) * reciprocal(d_len2), zero);
     const Vec3 reflected{xsimd::fms(scale, d.x, wo.x), xsimd::fms(scale, d.y, wo.y), xsimd::fms(scale, d.z, wo.z)};
-    return select(lobe.cosine, d, reflected);
+    return {select(lobe.cosine, d, reflected), smith_visible};
 }
