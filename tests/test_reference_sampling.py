@@ -117,8 +117,8 @@ def readme_lobe(probability, u0):
 
 
 def readme_cosine(u1, u2):
-    r, phi = np.sqrt(u1), 2.0 * np.pi * u2
-    return np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - u1)], axis=-1)
+    r, phi = np.sqrt(u2), 2.0 * np.pi * u1
+    return np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - u2)], axis=-1)
 
 
 def readme_visible_normal(wo, ax, ay, u1, u2):
@@ -634,8 +634,8 @@ def test_end_of_unit_interval_conventions():
                     assert s.wi[2] == pytest.approx(-wo[2], abs=1e-12)
     s = pb.reference.sample(material, [0.0, 0.0, 1.0], [0.0, 0.3, 1.0])
     np.testing.assert_array_equal(s.wi, [0.0, 0.0, -1.0])
-    # u1 = 1 (cosine lobe) is the horizon itself
-    s = pb.reference.sample(pb.Material(), view(30.0), [0.0, 1.0, 0.3])
+    # u2 = 1 (cosine lobe) is the horizon itself
+    s = pb.reference.sample(pb.Material(), view(30.0), [0.0, 0.3, 1.0])
     assert s.lobe == 0 and s.wi[2] == 0 and s.pdf == 0
     # u0 = 1 without clearcoat: lobe 1, never the empty lobe 2
     assert pb.reference.sample(pb.Material(), view(30.0), [1.0, 0.5, 0.5]).lobe == 1

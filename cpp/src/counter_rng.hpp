@@ -26,13 +26,19 @@ constexpr std::uint32_t multiply_low(std::uint32_t a, std::uint32_t b) { return 
 
 constexpr std::uint32_t kGolden = 0x9E3779B9u;  // 2^32 / golden ratio
 
+// lowbias32 after its first step x ^= x >> 16 (which the SIMD generator folds
+// into its key, see counter_uniforms)
 template <class U>
-PB_KERNEL_INLINE U lowbias32(U x) {
-    x = x ^ (x >> 16);
+PB_KERNEL_INLINE U lowbias32_rounds(U x) {
     x = multiply_low(x, 0x7feb352du);
     x = x ^ (x >> 15);
     x = multiply_low(x, 0x846ca68bu);
     return x ^ (x >> 16);
+}
+
+template <class U>
+PB_KERNEL_INLINE U lowbias32(U x) {
+    return lowbias32_rounds(x ^ (x >> 16));
 }
 
 // What the key needs of the seed, computed once per call.

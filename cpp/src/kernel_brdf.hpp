@@ -172,18 +172,19 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s, cons
 // README "Sampling and pdf": the mixture of the cosine lobe, the primary
 // specular and the clearcoat, with probabilities from the albedo estimates.
 
-struct LobeProbabilities {
-    Floats cosine, specular, clearcoat;
+// The unnormalised weights w1, w2 at wo (w0 is the material's) and 1 / Σ w:
+// the lobe choice compares u0 Σ w against them, so it does not wait for the
+// reciprocal, and the pdf multiplies by it once.
+struct LobeWeights {
+    Floats specular, clearcoat, inv_total;
 };
 
 // w0 = (1 - metallic)(Cdlum + 0.1 sheen lum(Csheen)), w1 = max(lum(mix(Cspec0, 1, FV)), 0.02),
 // w2 = 0.25 clearcoat mix(0.04, 1, FV); P_k = w_k / Σ w.
-PB_KERNEL_INLINE LobeProbabilities lobe_probabilities(Floats fv, const Shading& s) {
-    const Floats w0 = s.cosine_lobe_weight;
+PB_KERNEL_INLINE LobeWeights lobe_weights(Floats fv, const Shading& s) {
     const Floats w1 = xsimd::max(mix(s.specular_f0_luminance, Floats(1.0f), fv), Floats(0.02f));
     const Floats w2 = s.clearcoat_lobe_weight * xsimd::fma(Floats(0.96f), fv, Floats(0.04f));
-    const Floats inv_total = reciprocal(w0 + w1 + w2);
-    return {w0 * inv_total, w1 * inv_total, w2 * inv_total};
+    return {w1, w2, reciprocal(s.cosine_lobe_weight + w1 + w2)};
 }
 
 // Σ P_k pdf_k(wi), before the horizon test:
@@ -192,12 +193,12 @@ PB_KERNEL_INLINE LobeProbabilities lobe_probabilities(Floats fv, const Shading& 
 //        = Ds cos θh / (4 cos θd) = Ds Hz / (2 |H|²)                (distribution)
 //   pdf2 = Dr cos θh / (4 cos θd) = gtr1_norm Hz / (2 gtr1_denominator)
 // with cos θh = Hz / |H| and cos θd = |H| / 2.
-PB_KERNEL_INLINE Floats mixture_pdf(const Geometry& g, const Shading& s, const View& view, const LobeProbabilities& p,
+PB_KERNEL_INLINE Floats mixture_pdf(const Geometry& g, const Shading& s, const View& view, const LobeWeights& w,
                                     SpecularSampler sampler) {
     const Floats ds = gtr2_aniso_d(g, s);
     const Floats pdf1 = sampler == SpecularSampler::kDistribution
                             ? ds * g.hz * reciprocal(2.0f * g.h_len2)
                             : ds * reciprocal(2.0f * view.smith_visible);
     const Floats pdf2 = s.gtr1_norm * g.hz * reciprocal(2.0f * gtr1_denominator(g, s));
-    return xsimd::fma(p.cosine, kInvPi * g.wi.z, xsimd::fma(p.specular, pdf1, p.clearcoat * pdf2));
+    return w.inv_total * xsimd::fma(s.cosine_lobe_weight * kInvPi, g.wi.z, xsimd::fma(w.specular, pdf1, w.clearcoat * pdf2));
 }

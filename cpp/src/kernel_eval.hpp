@@ -11,7 +11,7 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3&
 
     const View view = view_of<model>(wo, s);
     if constexpr (output == Output::kPdf) {
-        const Floats pdf = mixture_pdf(g, s, view, lobe_probabilities(view.fv, s), job.sampler);
+        const Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         xsimd::select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     } else {
         const LobeValues lobes = eval_lobes<model>(g, s, view);

@@ -13,7 +13,7 @@
 struct Chosen {
     Vec3 wo;
     Uniforms u;
-    LobeProbabilities probabilities;
+    LobeWeights weights;
     LobeChoice lobe;
     Floats fv;
 };
@@ -21,7 +21,7 @@ struct Chosen {
 struct Drawn {
     Vec3 wo, wi;
     Floats smith_visible, fv;
-    LobeProbabilities probabilities;
+    LobeWeights weights;
     LobeChoice lobe;
 };
 
@@ -37,14 +37,14 @@ PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading
         c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index + i), seed);
     }
     c.fv = schlick_weight(c.wo.z);
-    c.probabilities = lobe_probabilities(c.fv, s);
-    c.lobe = choose_lobe(c.u.u0, c.probabilities);
+    c.weights = lobe_weights(c.fv, s);
+    c.lobe = choose_lobe(c.u.u0, s, c.weights);
     return true;
 }
 
 PB_KERNEL_INLINE Drawn draw(const SampleJob& job, const Chosen& c, const Shading& s) {
     const Direction direction = sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
-    return {c.wo, direction.wi, direction.smith_visible, c.fv, c.probabilities, c.lobe};
+    return {c.wo, direction.wi, direction.smith_visible, c.fv, c.weights, c.lobe};
 }
 
 template <Model model, Layouts layouts>
@@ -52,8 +52,8 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn& d
     const Vec3& wi = d.wi;
     const View view = view_of<model>(d.wo, s, d.smith_visible, d.fv);
     const Geometry g = geometry_of(wi, d.wo);
-    const Floats pdf = mixture_pdf(g, s, view, d.probabilities, job.sampler);
-    const Mask valid = (wi.z > Floats(0.0f)) & (d.wo.z > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));
+    const Floats pdf = mixture_pdf(g, s, view, d.weights, job.sampler);
+    const Mask valid = (xsimd::min(wi.z, d.wo.z) > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));
     const Rgb f = eval_lobes<model>(g, s, view).total(s);
     const Floats scale = wi.z * reciprocal(pdf);  // cos θl / pdf
     // select after multiplying: below the horizon f may be infinite or NaN
@@ -62,8 +62,10 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn& d
     store_rgb<layouts>(job.wi, i, Rgb{wi.x, wi.y, wi.z});
     xsimd::select(valid, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     store_rgb<layouts>(job.weight, i, Rgb{weight(f.r), weight(f.g), weight(f.b)});
-    const Floats lobe_index = xsimd::select(d.lobe.cosine, Floats(0.0f), xsimd::select(d.lobe.specular, Floats(1.0f), Floats(2.0f)));
-    xsimd::to_int(lobe_index).store_unaligned(job.lobe + i);
+    // the indices' int32 bit patterns selected as floats: no conversion
+    auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
+    const Floats lobe_index = xsimd::select(d.lobe.cosine, index_bits(0), xsimd::select(d.lobe.specular, index_bits(1), index_bits(2)));
+    xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
 template <Model model, bool per_element, Layouts layouts>

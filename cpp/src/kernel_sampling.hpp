@@ -5,6 +5,7 @@
 #pragma once  // (per translation unit)
 
 using UInts = xsimd::batch<std::uint32_t, Arch>;
+using Ints = xsimd::batch<std::int32_t, Arch>;
 
 // Low 32 bits of a 32 x 32-bit product (xsimd 8.1 has no native one for AVX-512).
 #if defined(__AVX512F__)
@@ -34,15 +35,30 @@ struct LaneCounters {
 };
 inline constexpr LaneCounters kLaneCounters{};
 
+// The top 24 bits of x as a float in [0, 1): (x >> 8) 2^-24. On AVX-512 as
+// (x & ~0xFF) 2^-32 with an unsigned conversion, which fuses with the hash's
+// last xor into one three-input logic op.
+PB_KERNEL_INLINE Floats unit_interval(UInts x) {
+#if defined(__AVX512F__)
+    return Floats(_mm512_cvtepu32_ps(x & UInts(0xFFFFFF00u))) * 0x1p-32f;
+#else
+    return xsimd::to_float(xsimd::bitwise_cast<Ints>(x >> 8)) * 0x1p-24f;
+#endif
+}
+
 // u_k for elements first + 0 .. first + kLanes - 1; first is a multiple of
 // kLanes, so the low 32 bits never carry into the high ones within a batch.
+// lowbias32's first step of c ^ key, y ^ (y >> 16) with y = c ^ key, is
+// c ^ (c >> 16) ^ (key ^ (key >> 16)) (a logical shift distributes over ^):
+// the key's part is one scalar and the rest fuses into one op on AVX-512.
 PB_KERNEL_INLINE Uniforms counter_uniforms(std::uint64_t first, const CounterSeed& seed) {
-    const UInts key(counter_key(seed, static_cast<std::uint32_t>(first >> 32)));
+    const std::uint32_t key = counter_key(seed, static_cast<std::uint32_t>(first >> 32));
+    const UInts key_shifted_in(key ^ (key >> 16));
     const UInts first_spread(spread_counter(static_cast<std::uint32_t>(first)));
     Floats u[3];
     for (int k = 0; k < 3; ++k) {
-        const UInts bits = lowbias32((UInts::load_aligned(kLaneCounters.lanes[k]) + first_spread) ^ key) >> 8;
-        u[k] = xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int32_t, Arch>>(bits)) * 0x1p-24f;
+        const UInts counter = UInts::load_aligned(kLaneCounters.lanes[k]) + first_spread;
+        u[k] = unit_interval(lowbias32_rounds(counter ^ key_shifted_in ^ (counter >> 16)));
     }
     return {u[0], u[1], u[2]};
 }
@@ -51,11 +67,12 @@ struct LobeChoice {
     Mask cosine, specular;  // clearcoat otherwise
 };
 
-// Lobe 0 if u0 < P0, else 1 if u0 < P0 + P1, else 2; never 2 when P2 = 0
-// (P0 + P1 may round below 1 while u0 reaches 1 - 2^-24, or 1 if passed).
-PB_KERNEL_INLINE LobeChoice choose_lobe(Floats u0, const LobeProbabilities& p) {
-    const Mask cosine = u0 < p.cosine;
-    return {cosine, ((u0 < p.cosine + p.specular) | (p.clearcoat <= Floats(0.0f))) & !cosine};
+// Lobe 0 if u0 < P0, else 1 if u0 < P0 + P1, else 2, compared as u0 Σ w
+// against w0 and w0 + w1; never 2 when w2 = 0 (u0 may be 1 if passed).
+PB_KERNEL_INLINE LobeChoice choose_lobe(Floats u0, const Shading& s, const LobeWeights& w) {
+    const Floats scaled = u0 * (s.cosine_lobe_weight + w.specular + w.clearcoat);
+    const Mask cosine = scaled < s.cosine_lobe_weight;
+    return {cosine, ((scaled < s.cosine_lobe_weight + w.specular) | (w.clearcoat <= Floats(0.0f))) & !cosine};
 }
 
 // (sin 2πu, cos 2πu) for u in [0, 1] by the double angle, without quadrant
@@ -87,13 +104,13 @@ PB_KERNEL_INLINE Vec3 select(const Mask& m, const Vec3& a, const Vec3& b) {
 // then e^x - 1 = 2^k (e^r - 1) + (2^k - 1), both terms of one sign for k >= 1, and
 // e^r - 1 = r (1 + r/2 + ... + r^6/7!) (Taylor). Relative error < 2e-7 over [0, 14].
 PB_KERNEL_INLINE Floats exp_minus_one(Floats x) {
-    const Floats k = xsimd::nearbyint(x * 1.44269504088896341f);
+    const Ints k_int = xsimd::nearbyint_as_int(x * 1.44269504088896341f);  // one conversion on every instruction set
+    const Floats k = xsimd::to_float(k_int);
     const Floats r = xsimd::fnma(k, Floats(1.42860682030941723e-6f), xsimd::fnma(k, Floats(0.693145751953125f), x));
     Floats series(1.0f / 5040.0f);
     for (float coefficient : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f})
         series = xsimd::fma(series, r, Floats(coefficient));
-    using Ints = xsimd::batch<std::int32_t, Arch>;
-    const Floats two_to_k = xsimd::bitwise_cast<Floats>((xsimd::to_int(k) + Ints(127)) << 23);
+    const Floats two_to_k = xsimd::bitwise_cast<Floats>((k_int + Ints(127)) << 23);
     return xsimd::fma(two_to_k, series * r, two_to_k - 1.0f);
 }
 
@@ -104,10 +121,10 @@ struct Direction {
     Floats smith_visible;  // cos θv + |V|, V = (ax wo.x, ay wo.y, wo.z)
 };
 
-// wi for the chosen lobes. Each lobe draws a unit vector about a centre and
-// stretches it (README "Sampling and pdf"):
+// wi for the chosen lobes. Each lobe draws a point at azimuth φ = 2π u1 about
+// a centre and stretches it (README "Sampling and pdf"):
 //   m = (sinθ cos φ + c.x, sinθ sin φ + c.y, cosθ + c.z),  d = (sx m.x, sy m.y, m.z)
-// cosine lobe:  sin²θ = u1, c = 0, s = 1, wi = d
+// cosine lobe:  sin²θ = u2, c = 0, s = 1, wi = d
 // clearcoat:    sin²θ = ac² (ac^(-2 u2) - 1) / (1 - ac²) = e^x - 1 scaled, x = -u2 ln ac²;
 //               c = 0, s = 1, h ∝ d
 // specular, visible normals by spherical caps (Dupuy & Benyoub 2023):
@@ -129,36 +146,34 @@ PB_KERNEL_INLINE Direction sample_direction(const Vec3& wo, const Uniforms& u, c
     const Floats length2 = stretched.x * stretched.x + stretched.y * stretched.y + stretched.z * stretched.z;
     const Floats length = square_root(length2);
     const Floats smith_visible = wo.z + length;
-    // φ = 2π u2 for the cosine lobe, 2π u1 for the others: one sincos for all
-    const auto [sin_phi, cos_phi] = sincos_turns(xsimd::select(lobe.cosine, u.u2, u.u1));
+    const auto [sin_phi, cos_phi] = sincos_turns(u.u1);
     if (xsimd::all(lobe.cosine)) {
-        const Floats radius = square_root(u.u1);
-        return {{radius * cos_phi, radius * sin_phi, square_root(one - u.u1)}, smith_visible};
+        const Floats radius = square_root(u.u2);
+        return {{radius * cos_phi, radius * sin_phi, square_root(one - u.u2)}, smith_visible};
     }
     const Mask clearcoat = !lobe.cosine & !lobe.specular;
     const bool visible_normals = sampler == SpecularSampler::kVisibleNormals;
+    const Mask visible_specular = visible_normals ? lobe.specular : Mask(false);
 
-    Floats sin2_theta = xsimd::select(lobe.cosine, u.u1, u.u2);  // cosine lobe, distribution sampler
-    Vec3 centre{zero, zero, zero};
+    Floats sin2_theta = u.u2;  // cosine lobe, distribution sampler
+    Floats scaled_cos = zero;  // L cosθ of the visible-normal specular
+    Floats centre_x = zero, centre_y = zero;
     if (visible_normals && xsimd::any(lobe.specular)) {
-        const Floats scaled_cos = xsimd::fms(one - u.u2, length + stretched.z, stretched.z);
+        scaled_cos = xsimd::fms(one - u.u2, length + stretched.z, stretched.z);
         sin2_theta = xsimd::select(lobe.specular, xsimd::fnma(scaled_cos, scaled_cos, length2), sin2_theta);
-        // cosθ + c.z enters through c.z, see below
-        centre = {xsimd::select(lobe.specular, stretched.x, zero), xsimd::select(lobe.specular, stretched.y, zero),
-                  xsimd::select(lobe.specular, scaled_cos + stretched.z, zero)};
+        centre_x = xsimd::select(lobe.specular, stretched.x, zero);
+        centre_y = xsimd::select(lobe.specular, stretched.y, zero);
     }
     if (xsimd::any(clearcoat)) {
         const Floats sin2 = xsimd::min(s.clearcoat_sin2_scale * exp_minus_one(-u.u2 * s.clearcoat_log_alpha2), one);
         sin2_theta = xsimd::select(clearcoat, sin2, sin2_theta);
     }
     const Floats sin_theta = square_root(sin2_theta);
-    // cosθ from sin²θ except for the visible-normal specular, whose cosθ is in c.z
-    const Mask drawn_cos = visible_normals ? !lobe.specular : Mask(true);
-    const Floats cos_theta = xsimd::select(drawn_cos, square_root(one - sin2_theta), zero);
+    // m.z: L cosθ + V.z for the visible-normal specular, else cosθ from sin²θ
+    const Floats height = xsimd::select(visible_specular, scaled_cos + stretched.z, square_root(one - sin2_theta));
     const Floats stretch_x = xsimd::select(lobe.specular, s.alpha_x, one);
     const Floats stretch_y = xsimd::select(lobe.specular, s.alpha_y, one);
-    const Vec3 d{stretch_x * xsimd::fma(sin_theta, cos_phi, centre.x), stretch_y * xsimd::fma(sin_theta, sin_phi, centre.y),
-                 cos_theta + centre.z};
+    const Vec3 d{stretch_x * xsimd::fma(sin_theta, cos_phi, centre_x), stretch_y * xsimd::fma(sin_theta, sin_phi, centre_y), height};
 
     // wi = 2 (wo·h) h - wo with h = d / |d|
     const Floats d_len2 = d.x * d.x + d.y * d.y + d.z * d.z;

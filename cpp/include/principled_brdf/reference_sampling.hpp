@@ -74,12 +74,12 @@ inline int choose_lobe(const std::array<double, 3>& probability, double u0) {
 // Mirror of wo about the microfacet normal h: wi = 2 (wo·h) h - wo.
 inline Vector3d reflect(const Vector3d& wo, const Vector3d& h) { return 2.0 * wo.dot(h) * h - wo; }
 
-// Lobe 0, cosine-weighted hemisphere (Malley): r = sqrt(u1), φ = 2π u2,
-// wi = (r cos φ, r sin φ, sqrt(1 - u1)).
+// Lobe 0, cosine-weighted hemisphere (Malley): φ = 2π u1 as for the other
+// lobes, r = sqrt(u2), wi = (r cos φ, r sin φ, sqrt(1 - u2)).
 inline Vector3d sample_cosine(double u1, double u2) {
-    const double r = std::sqrt(u1);
-    const double phi = 2.0 * kPi * u2;
-    return Vector3d(r * std::cos(phi), r * std::sin(phi), std::sqrt(1.0 - u1));
+    const double r = std::sqrt(u2);
+    const double phi = 2.0 * kPi * u1;
+    return Vector3d(r * std::cos(phi), r * std::sin(phi), std::sqrt(1.0 - u2));
 }
 
 // Lobe 1, visible normals of anisotropic GGX by spherical caps (Dupuy & Benyoub 2023):
