@@ -129,13 +129,12 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
             if (!choose<model, layouts>(job, at(0), uniform, seed, first)) return first_bad_view(job, at(0), at(1));
             if (!choose<model, layouts>(job, at(1), uniform, seed, chosen)) return first_bad_view(job, at(1), at(2));
             Drawn drawn = draw(job, first, uniform);
+            // weigh first: drawn and chosen die before their successors are made, so
+            // the compiler keeps each in one place instead of copying it every batch
             for (; b + 2 < batches; ++b) {
-                const Drawn next_drawn = draw(job, chosen, uniform);  // batch b + 1
-                Chosen next;  // batch b + 2
-                if (!choose<model, layouts>(job, at(b + 2), uniform, seed, next)) return first_bad_view(job, at(b + 2), at(b + 3));
                 weigh<model, layouts>(job, at(b), drawn, uniform);
-                chosen = next;
-                drawn = next_drawn;
+                drawn = draw(job, chosen, uniform);  // batch b + 1
+                if (!choose<model, layouts>(job, at(b + 2), uniform, seed, chosen)) return first_bad_view(job, at(b + 2), at(b + 3));
             }
             weigh<model, layouts>(job, at(b), drawn, uniform);
             weigh<model, layouts>(job, at(b + 1), draw(job, chosen, uniform), uniform);
