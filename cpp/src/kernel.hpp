@@ -44,7 +44,7 @@ PB_KERNEL_INLINE Rgb operator+(const Rgb& a, const Rgb& b) { return {a.r + b.r, 
 
 // mix(a, b, t) = a (1 - t) + b t: for a, b >= 0 nothing cancels (a + (b - a) t
 // loses b's digits when b << a and t -> 1, e.g. Csheen of a saturated colour).
-PB_KERNEL_INLINE Floats mix(Floats a, Floats b, Floats t) { return xsimd::fma(b, t, a * (Floats(1.0f) - t)); }
+PB_KERNEL_INLINE Floats mix(Floats a, Floats b, Floats t) { return mul_add(b, t, a * (Floats(1.0f) - t)); }
 PB_KERNEL_INLINE Rgb mix(const Rgb& a, const Rgb& b, Floats t) { return {mix(a.r, b.r, t), mix(a.g, b.g, t), mix(a.b, b.b, t)}; }
 
 // Schlick(u) = clamp(1 - u, 0, 1)^5, given 1 - u

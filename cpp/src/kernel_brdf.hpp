@@ -4,11 +4,11 @@
 // n·w + sqrt(q), the denominator of the Smith factor S(w) = G1(w) / (2 n·w)
 // of SPEC §3, given q = (w·x ax)² + (w·y ay)² + (n·w)². Products of these
 // share one reciprocal.
-PB_KERNEL_INLINE Floats smith_denominator(Floats cos_theta, Floats q) { return xsimd::fma(q, reciprocal_sqrt(q), cos_theta); }
+PB_KERNEL_INLINE Floats smith_denominator(Floats cos_theta, Floats q) { return mul_add(q, reciprocal_sqrt(q), cos_theta); }
 
 // Isotropic form, alpha² = a2: q = a2 + cos²(1 - a2)
 PB_KERNEL_INLINE Floats smith_denominator_iso(Floats cos_theta, Floats a2) {
-    return smith_denominator(cos_theta, xsimd::fma(cos_theta * cos_theta, Floats(1.0f) - a2, a2));
+    return smith_denominator(cos_theta, mul_add(cos_theta * cos_theta, Floats(1.0f) - a2, a2));
 }
 
 // The lobes as scalar factors of the material's colours (SPEC §3):
@@ -27,9 +27,9 @@ struct LobeValues {
     // f per channel: D dc + FH sc + S (1 - FH) Cspec0 + (S FH + C), three FMAs a channel
     Rgb total(const Shading& s) const {
         const Floats specular_tinted = specular * (Floats(1.0f) - fh);
-        const Floats grey = xsimd::fma(specular, fh, clearcoat);
+        const Floats grey = mul_add(specular, fh, clearcoat);
         auto channel = [&](Floats dc, Floats sc, Floats f0) {
-            return xsimd::fma(diffuse, dc, xsimd::fma(fh, sc, xsimd::fma(specular_tinted, f0, grey)));
+            return mul_add(diffuse, dc, mul_add(fh, sc, mul_add(specular_tinted, f0, grey)));
         };
         return {channel(s.diffuse_color.r, s.sheen_color.r, s.specular_f0.r),
                 channel(s.diffuse_color.g, s.sheen_color.g, s.specular_f0.g),
@@ -61,21 +61,21 @@ PB_KERNEL_INLINE Geometry geometry_of(const Vec3& wi, const Vec3& wo) {
     g.finite = g.h_len2 <= Floats(std::numeric_limits<float>::max());
     g.cos_theta_d = 0.5f * g.h_len2 * reciprocal_sqrt(g.h_len2);
     const Floats dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
-    const Floats d_len2 = xsimd::fma(dx, dx, xsimd::fma(dy, dy, dz * dz));
-    g.one_minus_cos_theta_d = d_len2 * reciprocal(4.0f + 4.0f * g.cos_theta_d);
+    const Floats d_len2 = mul_add(dx, dx, mul_add(dy, dy, dz * dz));
+    g.one_minus_cos_theta_d = d_len2 * reciprocal(mul_add(Floats(4.0f), g.cos_theta_d, Floats(4.0f)));
     return g;
 }
 
 // GTR2 aniso: Ds = 1/(π ax ay (hx²/ax² + hy²/ay² + hz²)²), with h = H/|H|
 PB_KERNEL_INLINE Floats gtr2_aniso_d(const Geometry& g, const Shading& s) {
-    const Floats stretched = xsimd::fma(g.hx2, s.inv_alpha_x2, xsimd::fma(g.hy2, s.inv_alpha_y2, g.hz2));
+    const Floats stretched = mul_add(g.hx2, s.inv_alpha_x2, mul_add(g.hy2, s.inv_alpha_y2, g.hz2));
     const Floats ds_root = g.h_len2 * reciprocal(stretched);
     return s.ggx_norm * ds_root * ds_root;
 }
 
 // |H|² (ac² cos²θh + sin²θh): GTR1 is gtr1_norm |H|² over this
 PB_KERNEL_INLINE Floats gtr1_denominator(const Geometry& g, const Shading& s) {
-    return xsimd::fma(s.clearcoat_alpha2, g.hz2, g.hx2 + g.hy2);
+    return mul_add(s.clearcoat_alpha2, g.hz2, g.hx2 + g.hy2);
 }
 
 // What the lobes and the pdf need of wo alone.
@@ -106,13 +106,13 @@ PB_KERNEL_INLINE View view_of(const Vec3& wo, const Shading& s, Floats smith_vis
 
 template <Model model>
 PB_KERNEL_INLINE View view_of(const Vec3& wo, const Shading& s) {
-    const Floats q = xsimd::fma(s.alpha_x2, wo.x * wo.x, xsimd::fma(s.alpha_y2, wo.y * wo.y, wo.z * wo.z));
+    const Floats q = mul_add(s.alpha_x2, wo.x * wo.x, mul_add(s.alpha_y2, wo.y * wo.y, wo.z * wo.z));
     return view_of<model>(wo, s, smith_denominator(wo.z, q), schlick_weight(wo.z));
 }
 
 // Smith denominator of the 2014 model for wi: n·w + sqrt((w·x ax)² + (w·y ay)² + (n·w)²)
 PB_KERNEL_INLINE Floats smith_denominator_aniso(const Vec3& w, const Shading& s) {
-    return smith_denominator(w.z, xsimd::fma(s.alpha_x2, w.x * w.x, xsimd::fma(s.alpha_y2, w.y * w.y, w.z * w.z)));
+    return smith_denominator(w.z, mul_add(s.alpha_x2, w.x * w.x, mul_add(s.alpha_y2, w.y * w.y, w.z * w.z)));
 }
 
 template <Model model>
@@ -129,18 +129,18 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s, cons
     const Floats fh = schlick_weight_of_complement(g.one_minus_cos_theta_d);
 
     // Diffuse: Fd = mix(1, Fd90, FL) mix(1, Fd90, FV), Fd90 = 0.5 + 2 roughness cos²θd
-    const Floats fd90_minus_1 = xsimd::fma(2.0f * s.roughness, cos2_theta_d, Floats(-0.5f));
-    const Floats fd = xsimd::fma(fd90_minus_1, fl, one) * xsimd::fma(fd90_minus_1, fv, one);
+    const Floats fd90_minus_1 = mul_add(2.0f * s.roughness, cos2_theta_d, Floats(-0.5f));
+    const Floats fd = mul_add(fd90_minus_1, fl, one) * mul_add(fd90_minus_1, fv, one);
     out.diffuse = fd;
     // Lobes whose weight is 0 in every lane are skipped: for a uniform material
     // the test has the same outcome for every batch, and the result is the same
     // bits (mix(fd, ss, 0) = fd, 0 clearcoat x finite = 0).
     if (xsimd::any(s.subsurface != Floats(0.0f))) {
         // Subsurface: ss = 1.25 (Fss (1/(cos θl + cos θv) - 0.5) + 0.5), Fss90 = roughness cos²θd
-        const Floats fss90_minus_1 = xsimd::fms(s.roughness, cos2_theta_d, one);
-        const Floats fss = xsimd::fma(fss90_minus_1, fl, one) * xsimd::fma(fss90_minus_1, fv, one);
+        const Floats fss90_minus_1 = mul_sub(s.roughness, cos2_theta_d, one);
+        const Floats fss = mul_add(fss90_minus_1, fl, one) * mul_add(fss90_minus_1, fv, one);
         const Floats inv_cos_sum = reciprocal(cos_theta_l + cos_theta_v);
-        const Floats ss = 1.25f * xsimd::fma(fss, inv_cos_sum - 0.5f, Floats(0.5f));
+        const Floats ss = 1.25f * mul_add(fss, inv_cos_sum - 0.5f, Floats(0.5f));
         out.diffuse = mix(fd, ss, s.subsurface);
     }
 
@@ -159,7 +159,7 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s, cons
     // (the constants are in clearcoat_scale) and Gr = S(wi) S(wo) at alpha 0.25.
     out.clearcoat = Floats(0.0f);
     if (xsimd::any(s.clearcoat_scale != Floats(0.0f))) {
-        const Floats fr = xsimd::fma(Floats(0.96f), fh, Floats(0.04f));
+        const Floats fr = mul_add(Floats(0.96f), fh, Floats(0.04f));
         const Floats quarter2 = Floats(0.0625f);
         const Floats gr_denominator = smith_denominator_iso(cos_theta_l, quarter2) * view.smith_clearcoat;
         out.clearcoat = s.clearcoat_scale * fr * g.h_len2 * reciprocal(gtr1_denominator(g, s) * gr_denominator);
@@ -183,7 +183,7 @@ struct LobeWeights {
 // w2 = 0.25 clearcoat mix(0.04, 1, FV); P_k = w_k / Σ w.
 PB_KERNEL_INLINE LobeWeights lobe_weights(Floats fv, const Shading& s) {
     const Floats w1 = xsimd::max(mix(s.specular_f0_luminance, Floats(1.0f), fv), Floats(0.02f));
-    const Floats w2 = s.clearcoat_lobe_weight * xsimd::fma(Floats(0.96f), fv, Floats(0.04f));
+    const Floats w2 = s.clearcoat_lobe_weight * mul_add(Floats(0.96f), fv, Floats(0.04f));
     return {w1, w2, reciprocal(s.cosine_lobe_weight + w1 + w2)};
 }
 
@@ -200,5 +200,5 @@ PB_KERNEL_INLINE Floats mixture_pdf(const Geometry& g, const Shading& s, const V
                             ? ds * g.hz * reciprocal(2.0f * g.h_len2)
                             : ds * reciprocal(2.0f * view.smith_visible);
     const Floats pdf2 = s.gtr1_norm * g.hz * reciprocal(2.0f * gtr1_denominator(g, s));
-    return w.inv_total * xsimd::fma(s.cosine_lobe_weight * kInvPi, g.wi.z, xsimd::fma(w.specular, pdf1, w.clearcoat * pdf2));
+    return w.inv_total * mul_add(s.cosine_lobe_weight * kInvPi, g.wi.z, mul_add(w.specular, pdf1, w.clearcoat * pdf2));
 }

@@ -47,7 +47,7 @@ struct Shading {
     Floats clearcoat_lobe_weight;      // 0.25 clearcoat
 };
 
-PB_KERNEL_INLINE Floats luminance_of(const Rgb& c) { return 0.3f * c.r + 0.6f * c.g + 0.1f * c.b; }
+PB_KERNEL_INLINE Floats luminance_of(const Rgb& c) { return mul_add(Floats(0.3f), c.r, mul_add(Floats(0.6f), c.g, 0.1f * c.b)); }
 
 PB_KERNEL_INLINE Shading shading_of(const RawMaterial& m) {
     const Floats* p = m.slot;
@@ -74,7 +74,7 @@ PB_KERNEL_INLINE Shading shading_of(const RawMaterial& m) {
     s.specular_f0 = mix((p[kSpecular] * 0.08f) * mix(white, tint, p[kSpecularTint]), base, metallic);
 
     // 2014 addenda: aspect = sqrt(1 - 0.9 anisotropic), alpha = roughness²
-    const Floats aspect2 = one - 0.9f * p[kAnisotropic];  // in [0.1, 1]
+    const Floats aspect2 = neg_mul_add(Floats(0.9f), p[kAnisotropic], one);  // in [0.1, 1]
     const Floats inv_aspect = reciprocal_sqrt(aspect2);
     const Floats aspect = aspect2 * inv_aspect;
     const Floats alpha = p[kRoughness] * p[kRoughness];
@@ -85,7 +85,7 @@ PB_KERNEL_INLINE Shading shading_of(const RawMaterial& m) {
     s.inv_alpha_x2 = reciprocal(s.alpha_x2);
     s.inv_alpha_y2 = reciprocal(s.alpha_y2);
     s.ggx_norm = kInvPi * reciprocal(alpha_x * alpha_y);
-    const Floats alpha_g = 0.5f + 0.5f * p[kRoughness];
+    const Floats alpha_g = mul_add(Floats(0.5f), p[kRoughness], Floats(0.5f));
     s.alpha_g2 = (alpha_g * alpha_g) * (alpha_g * alpha_g);
 
     // GTR1 with ac = mix(0.1, 0.001, clearcoat_gloss); ac stays in [0.001, 0.1]
@@ -98,7 +98,7 @@ PB_KERNEL_INLINE Shading shading_of(const RawMaterial& m) {
 
     s.alpha_x = alpha_x;
     s.alpha_y = alpha_y;
-    s.cosine_lobe_weight = dielectric * xsimd::fma(0.1f * p[kSheen], luminance_of(sheen_tint), luminance);
+    s.cosine_lobe_weight = dielectric * mul_add(0.1f * p[kSheen], luminance_of(sheen_tint), luminance);
     s.specular_f0_luminance = luminance_of(s.specular_f0);
     s.clearcoat_lobe_weight = 0.25f * p[kClearcoat];
     return s;

@@ -43,7 +43,7 @@ PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const
 // SPEC §7: squared length within [lowest, highest]; a NaN fails both
 // comparisons and an infinity the second.
 PB_KERNEL_INLINE Mask unit_length(const Vec3& w, float lowest, float highest) {
-    const Floats length2 = w.x * w.x + w.y * w.y + w.z * w.z;
+    const Floats length2 = mul_add(w.x, w.x, mul_add(w.y, w.y, w.z * w.z));
     return (length2 >= Floats(lowest)) & (length2 <= Floats(highest));
 }
 

@@ -18,13 +18,6 @@ struct Chosen {
     Floats fv;
 };
 
-struct Drawn {
-    Vec3 wo, wi;
-    Floats smith_visible, fv;
-    LobeWeights weights;
-    LobeChoice lobe;
-};
-
 // false, with nothing stored, when the fused direction check fails
 template <Model model, Layouts layouts>
 PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed, Chosen& c) {
@@ -42,18 +35,17 @@ PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading
     return true;
 }
 
-PB_KERNEL_INLINE Drawn draw(const SampleJob& job, const Chosen& c, const Shading& s) {
-    const Direction direction = sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
-    return {c.wo, direction.wi, direction.smith_visible, c.fv, c.weights, c.lobe};
+PB_KERNEL_INLINE Direction draw(const SampleJob& job, const Chosen& c, const Shading& s) {
+    return sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
 }
 
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn& d, const Shading& s) {
+PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction& d, const Shading& s) {
     const Vec3& wi = d.wi;
-    const View view = view_of<model>(d.wo, s, d.smith_visible, d.fv);
-    const Geometry g = geometry_of(wi, d.wo);
-    const Floats pdf = mixture_pdf(g, s, view, d.weights, job.sampler);
-    const Mask valid = (xsimd::min(wi.z, d.wo.z) > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));
+    const View view = view_of<model>(c.wo, s, d.smith_visible, c.fv);
+    const Geometry g = geometry_of(wi, c.wo);
+    const Floats pdf = mixture_pdf(g, s, view, c.weights, job.sampler);
+    const Mask valid = (xsimd::min(wi.z, c.wo.z) > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));
     const Rgb f = eval_lobes<model>(g, s, view).total(s);
     const Floats scale = wi.z * reciprocal(pdf);  // cos θl / pdf
     // select after multiplying: below the horizon f may be infinite or NaN
@@ -64,7 +56,7 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Drawn& d
     store_rgb<layouts>(job.weight, i, Rgb{weight(f.r), weight(f.g), weight(f.b)});
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
-    const Floats lobe_index = xsimd::select(d.lobe.cosine, index_bits(0), xsimd::select(d.lobe.specular, index_bits(1), index_bits(2)));
+    const Floats lobe_index = xsimd::select(c.lobe.cosine, index_bits(0), xsimd::select(c.lobe.specular, index_bits(1), index_bits(2)));
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
@@ -75,7 +67,7 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
     const Shading& s = per_element ? per_batch : uniform;
     Chosen chosen;
     if (!choose<model, layouts>(job, i, s, seed, chosen)) return false;
-    weigh<model, layouts>(job, i, draw(job, chosen, s), s);
+    weigh<model, layouts>(job, i, chosen, draw(job, chosen, s), s);
     return true;
 }
 
@@ -107,14 +99,37 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const Shading& unifor
     return true;
 }
 
+// One batch between its stages: chosen, then drawn.
+struct InFlight {
+    Chosen chosen;
+    Direction drawn;
+};
+
+// One step of the pipeline: weigh the batch at i, draw the next one, choose
+// the one after it at i + 2 kLanes (false, with nothing stored for it, when
+// its directions fail the check).
+template <Model model, Layouts layouts>
+PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed,
+                                    InFlight& weighed, InFlight& drawn, InFlight& chosen) {
+    weigh<model, layouts>(job, i, weighed.chosen, weighed.drawn, s);
+    drawn.drawn = draw(job, drawn.chosen, s);
+    return choose<model, layouts>(job, i + 2 * kLanes, s, seed, chosen.chosen);
+}
+
 // Software-pipelined over batches: while batch b is weighed, batch b + 1
 // draws its direction and batch b + 2 chooses its lobe. The stages of one
 // batch are one long dependency chain (uniforms, lobe, direction, f and pdf)
 // and a batch alone has more instructions than the out-of-order window holds,
 // so run one after another the batches barely overlap; interleaved, the
-// independent work of three batches fills the wait (about 1.2x here). Not for
-// per-element materials: each batch's Shading in flight would not fit in the
-// registers (interleaved they run 0.8x as fast as one after another).
+// independent work of three batches fills the wait. Each batch stays in one
+// of three slots from its choice to its weight, the slots' roles rotating
+// through a loop unrolled three times: nothing is copied from batch to batch
+// (GCC kept a moved state poorly, copying it through the stack: 1.25x slower
+// on AVX-512). The batches before and after the loop run the same operations
+// in other copies of the code, to the same bits (no contraction, see
+// simd_ops.hpp). Not for per-element materials: each batch's Shading in
+// flight would not fit in the registers (interleaved they ran 0.8x as fast as
+// one after another).
 template <Model model, bool per_element, Layouts layouts>
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     Shading uniform{};
@@ -124,20 +139,22 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
     auto at = [&](std::int64_t b) { return begin + b * kLanes; };
     std::int64_t b = 0;
     if constexpr (!per_element) {
-        if (batches >= 2) {
-            Chosen first, chosen;
-            if (!choose<model, layouts>(job, at(0), uniform, seed, first)) return first_bad_view(job, at(0), at(1));
-            if (!choose<model, layouts>(job, at(1), uniform, seed, chosen)) return first_bad_view(job, at(1), at(2));
-            Drawn drawn = draw(job, first, uniform);
-            // weigh first: drawn and chosen die before their successors are made, so
-            // the compiler keeps each in one place instead of copying it every batch
-            for (; b + 2 < batches; ++b) {
-                weigh<model, layouts>(job, at(b), drawn, uniform);
-                drawn = draw(job, chosen, uniform);  // batch b + 1
-                if (!choose<model, layouts>(job, at(b + 2), uniform, seed, chosen)) return first_bad_view(job, at(b + 2), at(b + 3));
+        if (batches >= 5) {
+            InFlight slot0, slot1, slot2;
+            if (!choose<model, layouts>(job, at(0), uniform, seed, slot0.chosen)) return first_bad_view(job, at(0), at(1));
+            if (!choose<model, layouts>(job, at(1), uniform, seed, slot1.chosen)) return first_bad_view(job, at(1), at(2));
+            slot0.drawn = draw(job, slot0.chosen, uniform);
+            // here and after each step: slot0 holds batch b, drawn, and slot1 batch b + 1, chosen
+            for (; b + 4 < batches; b += 3) {
+                if (!pipeline_step<model, layouts>(job, at(b), uniform, seed, slot0, slot1, slot2))
+                    return first_bad_view(job, at(b + 2), at(b + 3));
+                if (!pipeline_step<model, layouts>(job, at(b + 1), uniform, seed, slot1, slot2, slot0))
+                    return first_bad_view(job, at(b + 3), at(b + 4));
+                if (!pipeline_step<model, layouts>(job, at(b + 2), uniform, seed, slot2, slot0, slot1))
+                    return first_bad_view(job, at(b + 4), at(b + 5));
             }
-            weigh<model, layouts>(job, at(b), drawn, uniform);
-            weigh<model, layouts>(job, at(b + 1), draw(job, chosen, uniform), uniform);
+            weigh<model, layouts>(job, at(b), slot0.chosen, slot0.drawn, uniform);
+            weigh<model, layouts>(job, at(b + 1), slot1.chosen, draw(job, slot1.chosen, uniform), uniform);
             b += 2;
         }
     }

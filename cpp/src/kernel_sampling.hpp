@@ -87,12 +87,12 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> sincos_turns(Floats u) {
     const Floats z = t * t;
     Floats p(0.1098245158791542f);
     for (float coefficient : {-0.8461116552352905f, 3.606354236602783f, -7.308245658874512f, 4.442883014678955f})
-        p = xsimd::fma(p, z, Floats(coefficient));
+        p = mul_add(p, z, Floats(coefficient));
     Floats q(0.034501612186431885f);
     for (float coefficient : {-0.33225154876708984f, 1.888274908065796f, -5.73988151550293f, 6.9788641929626465f, -1.4142135381698608f})
-        q = xsimd::fma(q, z, Floats(coefficient));
+        q = mul_add(q, z, Floats(coefficient));
     const Floats root2_sin = t * p;
-    return {root2_sin * q, xsimd::fms(root2_sin, root2_sin, Floats(1.0f))};
+    return {root2_sin * q, mul_sub(root2_sin, root2_sin, Floats(1.0f))};
 }
 
 PB_KERNEL_INLINE Vec3 select(const Mask& m, const Vec3& a, const Vec3& b) {
@@ -106,12 +106,12 @@ PB_KERNEL_INLINE Vec3 select(const Mask& m, const Vec3& a, const Vec3& b) {
 PB_KERNEL_INLINE Floats exp_minus_one(Floats x) {
     const Ints k_int = xsimd::nearbyint_as_int(x * 1.44269504088896341f);  // one conversion on every instruction set
     const Floats k = xsimd::to_float(k_int);
-    const Floats r = xsimd::fnma(k, Floats(1.42860682030941723e-6f), xsimd::fnma(k, Floats(0.693145751953125f), x));
+    const Floats r = neg_mul_add(k, Floats(1.42860682030941723e-6f), neg_mul_add(k, Floats(0.693145751953125f), x));
     Floats series(1.0f / 5040.0f);
     for (float coefficient : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f})
-        series = xsimd::fma(series, r, Floats(coefficient));
+        series = mul_add(series, r, Floats(coefficient));
     const Floats two_to_k = xsimd::bitwise_cast<Floats>((k_int + Ints(127)) << 23);
-    return xsimd::fma(two_to_k, series * r, two_to_k - 1.0f);
+    return mul_add(two_to_k, series * r, two_to_k - 1.0f);
 }
 
 // What the draw returns: wi, and the visible-normal Smith denominator of wo
@@ -143,7 +143,7 @@ PB_KERNEL_INLINE Direction sample_direction(const Vec3& wo, const Uniforms& u, c
     // so V need not be normalised: L cosθ = (1 - u2)(L + V.z) - V.z, L² sin²θ = L² - (L cosθ)²;
     // cos θv + L is the View's smith_visible, which the weight needs anyway
     const Vec3 stretched{s.alpha_x * wo.x, s.alpha_y * wo.y, wo.z};
-    const Floats length2 = stretched.x * stretched.x + stretched.y * stretched.y + stretched.z * stretched.z;
+    const Floats length2 = mul_add(stretched.x, stretched.x, mul_add(stretched.y, stretched.y, stretched.z * stretched.z));
     const Floats length = square_root(length2);
     const Floats smith_visible = wo.z + length;
     const auto [sin_phi, cos_phi] = sincos_turns(u.u1);
@@ -159,8 +159,8 @@ PB_KERNEL_INLINE Direction sample_direction(const Vec3& wo, const Uniforms& u, c
     Floats scaled_cos = zero;  // L cosθ of the visible-normal specular
     Floats centre_x = zero, centre_y = zero;
     if (visible_normals && xsimd::any(lobe.specular)) {
-        scaled_cos = xsimd::fms(one - u.u2, length + stretched.z, stretched.z);
-        sin2_theta = xsimd::select(lobe.specular, xsimd::fnma(scaled_cos, scaled_cos, length2), sin2_theta);
+        scaled_cos = mul_sub(one - u.u2, length + stretched.z, stretched.z);
+        sin2_theta = xsimd::select(lobe.specular, neg_mul_add(scaled_cos, scaled_cos, length2), sin2_theta);
         centre_x = xsimd::select(lobe.specular, stretched.x, zero);
         centre_y = xsimd::select(lobe.specular, stretched.y, zero);
     }
@@ -173,11 +173,11 @@ PB_KERNEL_INLINE Direction sample_direction(const Vec3& wo, const Uniforms& u, c
     const Floats height = xsimd::select(visible_specular, scaled_cos + stretched.z, square_root(one - sin2_theta));
     const Floats stretch_x = xsimd::select(lobe.specular, s.alpha_x, one);
     const Floats stretch_y = xsimd::select(lobe.specular, s.alpha_y, one);
-    const Vec3 d{stretch_x * xsimd::fma(sin_theta, cos_phi, centre_x), stretch_y * xsimd::fma(sin_theta, sin_phi, centre_y), height};
+    const Vec3 d{stretch_x * mul_add(sin_theta, cos_phi, centre_x), stretch_y * mul_add(sin_theta, sin_phi, centre_y), height};
 
     // wi = 2 (wo·h) h - wo with h = d / |d|
-    const Floats d_len2 = d.x * d.x + d.y * d.y + d.z * d.z;
-    const Floats scale = xsimd::select(d_len2 > zero, 2.0f * (wo.x * d.x + wo.y * d.y + wo.z * d.z) * reciprocal(d_len2), zero);
-    const Vec3 reflected{xsimd::fms(scale, d.x, wo.x), xsimd::fms(scale, d.y, wo.y), xsimd::fms(scale, d.z, wo.z)};
+    const Floats d_len2 = mul_add(d.x, d.x, mul_add(d.y, d.y, d.z * d.z));
+    const Floats scale = xsimd::select(d_len2 > zero, 2.0f * mul_add(wo.x, d.x, mul_add(wo.y, d.y, wo.z * d.z)) * reciprocal(d_len2), zero);
+    const Vec3 reflected{mul_sub(scale, d.x, wo.x), mul_sub(scale, d.y, wo.y), mul_sub(scale, d.z, wo.z)};
     return {select(lobe.cosine, d, reflected), smith_visible};
 }

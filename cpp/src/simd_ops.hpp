@@ -46,6 +46,24 @@ struct Interleave3Permutation {
 template <int L, int k, bool for_store>
 inline constexpr Interleave3Permutation<L, k, for_store> kInterleave3Permutation{};
 
+// Fused multiply-adds: a b + c, a b - c and c - a b, one rounding where the
+// instruction set has them (two on SSE2). The kernels build with
+// -ffp-contract=off, so every rounding is one the code asks for and an
+// element's bits do not depend on the code around its batch: with contraction
+// the compiler fused a product in straight-line code but not the same product
+// hoisted out of a loop, and the pipelined loop's results changed with the
+// call's start, length and thread chunks. xsimd 8.1 has no AVX-512 fma of its
+// own (it writes x * y + z).
+#if defined(__AVX512F__)
+PB_KERNEL_INLINE Floats mul_add(Floats a, Floats b, Floats c) { return _mm512_fmadd_ps(a, b, c); }
+PB_KERNEL_INLINE Floats mul_sub(Floats a, Floats b, Floats c) { return _mm512_fmsub_ps(a, b, c); }
+PB_KERNEL_INLINE Floats neg_mul_add(Floats a, Floats b, Floats c) { return _mm512_fnmadd_ps(a, b, c); }
+#else
+PB_KERNEL_INLINE Floats mul_add(Floats a, Floats b, Floats c) { return xsimd::fma(a, b, c); }
+PB_KERNEL_INLINE Floats mul_sub(Floats a, Floats b, Floats c) { return xsimd::fms(a, b, c); }
+PB_KERNEL_INLINE Floats neg_mul_add(Floats a, Floats b, Floats c) { return xsimd::fnma(a, b, c); }
+#endif
+
 #if defined(__AVX512F__)
 
 PB_KERNEL_INLINE Floats reciprocal(Floats x) {
