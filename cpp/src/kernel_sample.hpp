@@ -123,11 +123,11 @@ PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const 
 // so run one after another the batches barely overlap; interleaved, the
 // independent work of three batches fills the wait. Each batch stays in one
 // of three slots from its choice to its weight, the slots' roles rotating
-// through a loop unrolled three times: nothing is copied from batch to batch
-// (GCC kept a moved state poorly, copying it through the stack: 1.25x slower
-// on AVX-512). The batches before and after the loop run the same operations
-// in other copies of the code, to the same bits (no contraction, see
-// simd_ops.hpp). Not for per-element materials: each batch's Shading in
+// through a loop unrolled three times, so nothing moves from variable to
+// variable (when it did, GCC copied the spilled part through the stack every
+// batch: 1.25x slower on AVX-512). The batches before and after the loop run
+// the same operations in other copies of the code, to the same bits (no
+// contraction, see simd_ops.hpp). Not for per-element materials: each batch's Shading in
 // flight would not fit in the registers (interleaved they ran 0.8x as fast as
 // one after another).
 template <Model model, bool per_element, Layouts layouts>
