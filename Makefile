@@ -3,7 +3,7 @@
 PYTHON ?= python3
 export PYTHON
 
-.PHONY: demo test install deps bench
+.PHONY: demo test install deps bench sanitize
 
 demo: install
 	$(PYTHON) -m principled_brdf demo
@@ -26,3 +26,8 @@ bench: deps
 	  --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
 	  --benchmark_out=bench/results.json --benchmark_out_format=json
 	$(PYTHON) bench/summarize.py bench/results.json
+
+# The extension under AddressSanitizer + UndefinedBehaviorSanitizer, running the
+# bad-input, batch, sampling and fuzz tests (scripts/sanitize.sh says how).
+sanitize: deps
+	bash scripts/sanitize.sh

@@ -1,5 +1,5 @@
 // Throughput of the batched evaluator (items = direction pairs), with the
-// yardsticks of DESIGN "Measuring" in the same run: the float64 reference,
+// yardsticks of bench/RESULTS.md in the same run: the float64 reference,
 // a -O3 -march=native -ffast-math loop of the same math, and a copy kernel
 // that moves the same bytes as eval (the memory roofline).
 #include <benchmark/benchmark.h>

@@ -112,3 +112,26 @@ def test_write_png_round_trips_through_matplotlib(tmp_path):
 
     read = matplotlib.image.imread(str(tmp_path / "x.png"))
     np.testing.assert_allclose(read[..., :3] * 255, image, atol=0.6)
+
+
+@pytest.mark.parametrize(
+    "args, option",
+    [
+        (["render", "--resolution", "999999999", "--output", "x.png"], "--resolution"),
+        (["bench", "--pairs", "99999999999"], "--pairs"),
+        (["demo", "--pairs", "99999999999"], "--pairs"),
+        (["render", "--exposure", "nan", "--output", "x.png"], "--exposure"),
+        (["render", "--exposure", "inf", "--output", "x.png"], "--exposure"),
+        (["render", "--exposure", "-1", "--output", "x.png"], "--exposure"),
+        (["render", "--light", "nan,0,1", "--output", "x.png"], "--light"),
+        (["render", "--light", "inf,0,1", "--output", "x.png"], "--light"),
+        (["render", "--light", "0,0,0", "--output", "x.png"], "--light"),
+    ],
+)
+def test_options_beyond_what_fits_or_makes_sense_are_one_line_errors(args, option, tmp_path):
+    result = subprocess.run([sys.executable, "-m", "principled_brdf", *args], capture_output=True, text=True,
+                            timeout=120, cwd=tmp_path)
+    assert result.returncode == 2
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert "Traceback" not in result.stderr and option in lines[-1] and "error" in lines[-1]
+    assert not (tmp_path / "x.png").exists()

@@ -5,6 +5,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -18,6 +20,14 @@ namespace {
 
 using Float32Array = py::array_t<float, py::array::c_style>;
 
+// The kernels read and write whole floats only (README "Bad input":
+// the Python side copies a misaligned input and refuses a misaligned out=).
+template <class T>
+void require_aligned(const T* data, const char* name) {
+    if (reinterpret_cast<std::uintptr_t>(data) % alignof(T) != 0)
+        throw std::invalid_argument(std::string(name) + ": array data is not aligned to its element size");
+}
+
 // A (N, 3), (3, N) or (3,) float32 array as a Vec3Array of n elements.
 Vec3Array vec3_view(const Float32Array& a, int layout, std::int64_t n, const char* name) {
     const auto kind = static_cast<Vec3Layout>(layout);
@@ -25,6 +35,7 @@ Vec3Array vec3_view(const Float32Array& a, int layout, std::int64_t n, const cha
                     (kind == Vec3Layout::kRows && a.ndim() == 2 && a.shape(0) == 3 && a.shape(1) == n) ||
                     (kind == Vec3Layout::kSingle && a.ndim() == 1 && a.shape(0) == 3);
     if (!ok) throw std::invalid_argument(std::string(name) + ": array shape does not match its layout and length");
+    require_aligned(a.data(), name);
     return {a.data(), kind, kind == Vec3Layout::kRows ? n : 0};
 }
 
@@ -50,6 +61,7 @@ void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, p
             const bool ok = info.slots == 3 ? (array.ndim() == 2 && array.shape(0) == n && array.shape(1) == 3)
                                             : (array.ndim() == 1 && array.shape(0) == n);
             if (!ok) throw std::invalid_argument(std::string(info.name) + ": per-element array of the wrong shape");
+            require_aligned(array.data(), info.name);
             for (int s = 0; s < info.slots; ++s)
                 slots[info.first_slot + s] = ParamSlot{0.0f, array.data() + s, info.slots};
         } else if (info.slots == 3) {
@@ -66,7 +78,7 @@ void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, p
 // wo is not a unit vector (the outputs are then partly written: pass fresh ones).
 std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                         const py::sequence& params, py::list outputs, int out_layout, std::int64_t n, int model,
-                        bool lobes, bool cosine, float check_tolerance, int threads, const std::string& isa) {
+                        bool lobes, bool cosine, double check_tolerance, int threads, const std::string& isa) {
     EvalJob job;
     job.wi = vec3_view(wi, wi_layout, n, "wi");
     job.wo = vec3_view(wo, wo_layout, n, "wo");
@@ -76,7 +88,7 @@ std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Arra
     job.model = static_cast<Model>(model);
     job.output = lobes ? Output::kLobes : Output::kTotal;
     job.cosine = cosine;
-    if (check_tolerance > 0.0f) set_direction_check(job, check_tolerance);
+    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
     const int expected = lobes ? kLobeCount : 1;
     if (py::len(outputs) != static_cast<std::size_t>(expected))
         throw std::invalid_argument("out: expected " + std::to_string(expected) + " arrays");
@@ -95,6 +107,7 @@ template <class T>
 T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const char* name) {
     if (a.ndim() != 1 || a.shape(0) != n || !a.writeable())
         throw std::invalid_argument(std::string(name) + ": expected a writeable array of N elements");
+    require_aligned(a.data(), name);
     return a.mutable_data();
 }
 
@@ -105,7 +118,7 @@ SpecularSampler specular_sampler(int sampler) {
 
 std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                        const py::sequence& params, Float32Array pdf, std::int64_t n, int sampler,
-                       float check_tolerance, int threads, const std::string& isa) {
+                       double check_tolerance, int threads, const std::string& isa) {
     EvalJob job;
     job.wi = vec3_view(wi, wi_layout, n, "wi");
     job.wo = vec3_view(wo, wo_layout, n, "wo");
@@ -114,7 +127,7 @@ std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array
     job.output = Output::kPdf;
     job.sampler = specular_sampler(sampler);
     job.pdf = scalar_output(pdf, n, "pdf");
-    if (check_tolerance > 0.0f) set_direction_check(job, check_tolerance);
+    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
     if (n == 0) return -1;
     py::gil_scoped_release release;
     return eval(job, n, threads, isa);
@@ -123,7 +136,7 @@ std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array
 std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::object& u, int u_layout,
                           std::uint64_t seed, const py::sequence& params, Float32Array wi, Float32Array weight,
                           int out_layout, Float32Array pdf, py::array_t<std::int32_t, py::array::c_style> lobe,
-                          std::int64_t n, int model, int sampler, float check_tolerance, int threads,
+                          std::int64_t n, int model, int sampler, double check_tolerance, int threads,
                           const std::string& isa) {
     SampleJob job;
     job.wo = vec3_view(wo, wo_layout, n, "wo");
@@ -142,14 +155,15 @@ std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::objec
     job.weight = output_view(weight, out_layout, n, "weight");
     job.pdf = scalar_output(pdf, n, "pdf");
     job.lobe = scalar_output(lobe, n, "lobe");
-    if (check_tolerance > 0.0f) set_direction_check(job, check_tolerance);
+    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
     if (n == 0) return -1;
     py::gil_scoped_release release;
     return sample(job, n, threads, isa);
 }
 
 py::array_t<float> uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n) {
-    if (n < 0 || first < 0) throw std::invalid_argument("uniforms: expected first >= 0 and n >= 0");
+    if (n < 0 || first < 0 || n > std::numeric_limits<std::int64_t>::max() - first)
+        throw std::invalid_argument("first, n: expected first >= 0, n >= 0 and first + n <= 2**63 - 1");
     py::array_t<float> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
     float* data = out.mutable_data();
     py::gil_scoped_release release;
@@ -157,10 +171,10 @@ py::array_t<float> uniforms(std::uint64_t seed, std::int64_t first, std::int64_t
     return out;
 }
 
-std::int64_t check_directions(const Float32Array& w, int layout, std::int64_t n, float tolerance, int threads) {
-    const Vec3Array view = vec3_view(w, layout, n, "directions");
-    py::gil_scoped_release release;
-    return first_bad_direction(view, n, tolerance, threads);
+// The squared-length bounds of the direction check for this tolerance.
+py::tuple direction_length2_bounds(double tolerance) {
+    const DirectionCheck check = direction_check(tolerance);
+    return py::make_tuple(check.length2_lowest, check.length2_highest);
 }
 
 void memory_roofline(const Float32Array& wi, const Float32Array& wo, Float32Array& out, int threads) {
@@ -199,9 +213,8 @@ void bind_batch(py::module_& m) {
           py::arg("threads"), py::arg("isa"), "SIMD sampling into preallocated outputs.");
     m.def("counter_uniforms", &uniforms, py::arg("seed"), py::arg("first"), py::arg("n"),
           "The counter-based uniforms (n, 3) that sampling uses for elements first .. first + n - 1.");
-    m.def("check_directions", &check_directions, py::arg("w"), py::arg("layout"), py::arg("n"),
-          py::arg("tolerance"), py::arg("threads"),
-          "Index of the first non-finite or non-unit direction, or -1.");
+    m.def("direction_length2_bounds", &direction_length2_bounds, py::arg("tolerance"),
+          "(lowest, highest): a direction passes the check when its float64 squared length lies within.");
     m.def("memory_roofline", &memory_roofline, py::arg("wi"), py::arg("wo"), py::arg("out"), py::arg("threads"),
           "out = wi + wo over (N, 3) float32 arrays: the bytes eval moves, at memory speed.");
     m.def("cpu_info", &cpu_info, "Instruction set in use, the available ones, SIMD width, hardware threads.");

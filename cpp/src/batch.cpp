@@ -83,7 +83,7 @@ namespace rng {
 void counter_uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n, float* out) {
     const rng::CounterSeed mixed = rng::counter_seed(seed);
     for (std::int64_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) out[3 * i + k] = rng::counter_uniform(static_cast<std::uint64_t>(first + i), mixed, k);
+        for (int k = 0; k < 3; ++k) out[3 * i + k] = rng::counter_uniform(static_cast<std::uint64_t>(first) + static_cast<std::uint64_t>(i), mixed, k);
 }
 
 void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int threads) {
@@ -95,19 +95,17 @@ void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int
     });
 }
 
-std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_t n, float tolerance, int threads) {
-    EvalJob bounds;
-    set_direction_check(bounds, tolerance);
-    const float lowest = bounds.length2_lowest, highest = bounds.length2_highest;
-    const kernel::KernelTable& kernels = kernel::active();
-    if (directions.layout == Vec3Layout::kSingle) {
-        const float* w = directions.data;
-        const float length2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-        return n > 0 && !(length2 >= lowest && length2 <= highest) ? 0 : -1;
-    }
-    return run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) {
-        return kernels.first_bad_direction(directions, begin, end, lowest, highest);
-    });
+DirectionCheck direction_check(double tolerance) {
+    DirectionCheck check;
+    check.enabled = true;
+    check.length2_lowest = (1.0 - tolerance) * (1.0 - tolerance);
+    check.length2_highest = (1.0 + tolerance) * (1.0 + tolerance);
+    // The float32 squared length is within 3 float roundings (2e-7 relative)
+    // of the float64 one; a margin of 1e-6 keeps the fast test inside the rule.
+    constexpr double margin = 1e-6;
+    check.fast_lowest = static_cast<float>(check.length2_lowest * (1.0 + margin));
+    check.fast_highest = static_cast<float>(check.length2_highest * (1.0 - margin));
+    return check;
 }
 
 }  // namespace principled_brdf

@@ -1,11 +1,11 @@
-// The SIMD kernel: SPEC §3 over xsimd::batch<float, Arch>, branch-free.
+// The SIMD kernel: the model of README "The model" over xsimd::batch<float, Arch>, branch-free.
 //
 // Included exactly once by each kernel_<isa>.cpp (which is nothing else), after it defines
 // PRINCIPLED_BRDF_ARCH (the xsimd arch tag) and PRINCIPLED_BRDF_ARCH_NS (a
 // namespace name). Everything here lives in that per-arch namespace, so code
 // compiled with one instruction set's flags is never linked into another's.
 //
-// Accuracy (SPEC §6.2): the half vector is kept unnormalised, H = wi + wo.
+// Accuracy (README "What is checked"): the half vector is kept unnormalised, H = wi + wo.
 // Its components are exact float sums where wi and wo nearly cancel, so
 // cos²θh = Hz²/|H|² and sin²θh = (Hx² + Hy²)/|H|² keep full relative precision
 // at the narrow GTR peaks, where 1 - cos²θh would cancel.
@@ -76,7 +76,7 @@ namespace principled_brdf::kernel {
 const KernelTable& PRINCIPLED_BRDF_JOIN(PRINCIPLED_BRDF_ARCH_NS, _kernels)() {
     namespace isa = PRINCIPLED_BRDF_ARCH_NS;
     static constexpr KernelTable table{PRINCIPLED_BRDF_QUOTE(PRINCIPLED_BRDF_ARCH_NS), static_cast<int>(isa::kLanes),
-                                       &isa::eval_range, &isa::sample_range, &isa::first_bad_direction};
+                                       &isa::eval_range, &isa::sample_range};
     return table;
 }
 

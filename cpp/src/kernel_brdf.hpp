@@ -1,17 +1,25 @@
-// Part of kernel.hpp, included inside the per-arch namespace: the lobes of SPEC §3 on the unnormalised half vector.
+// Part of kernel.hpp, included inside the per-arch namespace: the lobes of README "The model" on the unnormalised half vector.
 #pragma once  // (per translation unit)
 
 // n·w + sqrt(q), the denominator of the Smith factor S(w) = G1(w) / (2 n·w)
-// of SPEC §3, given q = (w·x ax)² + (w·y ay)² + (n·w)². Products of these
+// of README "The model", given q = (w·x ax)² + (w·y ay)² + (n·w)². Products of these
 // share one reciprocal.
 PB_KERNEL_INLINE Floats smith_denominator(Floats cos_theta, Floats q) { return mul_add(q, reciprocal_sqrt(q), cos_theta); }
 
-// Isotropic form, alpha² = a2: q = a2 + cos²(1 - a2)
+// Isotropic form for alpha² = a2 < 1 (the clearcoat's): q = a2 + cos²(1 - a2),
+// both terms >= 0.
 PB_KERNEL_INLINE Floats smith_denominator_iso(Floats cos_theta, Floats a2) {
     return smith_denominator(cos_theta, mul_add(cos_theta * cos_theta, Floats(1.0f) - a2, a2));
 }
 
-// The lobes as scalar factors of the material's colours (SPEC §3):
+// Isotropic form for any alpha² = a2 (the 2012 model's alpha_g² reaches 10^15 at
+// roughness 10^4): q = a2 ((w·x)² + (w·y)²) + (n·w)², where the form above
+// cancels to 0.
+PB_KERNEL_INLINE Floats smith_denominator_iso(const Vec3& w, Floats a2) {
+    return smith_denominator(w.z, mul_add(a2, mul_add(w.x, w.x, w.y * w.y), w.z * w.z));
+}
+
+// The lobes as scalar factors of the material's colours (README "The model"):
 //   diffuse   = D  base_color (1 - metallic) / π        (s.diffuse_color)
 //   sheen     = FH sheen Csheen (1 - metallic)          (s.sheen_color)
 //   specular  = S  mix(Cspec0, 1, FH),  S = Gs Ds
@@ -95,7 +103,7 @@ PB_KERNEL_INLINE View view_of(const Vec3& wo, const Shading& s, Floats smith_vis
     v.fv = fv;
     v.smith_visible = smith_visible;
     if constexpr (model == Model::kDisney2012) {
-        v.smith_specular = smith_denominator_iso(wo.z, s.alpha_g2);
+        v.smith_specular = smith_denominator_iso(wo, s.alpha_g2);
     } else {
         v.smith_specular = v.smith_visible;
     }
@@ -149,7 +157,7 @@ PB_KERNEL_INLINE LobeValues eval_lobes(const Geometry& g, const Shading& s, cons
     const Floats ds = gtr2_aniso_d(g, s);
     Floats gs_denominator;
     if constexpr (model == Model::kDisney2012) {
-        gs_denominator = smith_denominator_iso(cos_theta_l, s.alpha_g2) * view.smith_specular;
+        gs_denominator = smith_denominator_iso(wi, s.alpha_g2) * view.smith_specular;
     } else {
         gs_denominator = smith_denominator_aniso(wi, s) * view.smith_specular;
     }

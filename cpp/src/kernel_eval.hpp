@@ -5,7 +5,7 @@
 template <Model model, Output output, Layouts layouts>
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const Vec3& wo, const Shading& s) {
     const Geometry g = geometry_of(wi, wo);
-    // 0 unless both directions are strictly above the surface (SPEC §1);
+    // 0 unless both directions are strictly above the surface (README "The model");
     // select also discards whatever the formulas gave there (H may be 0).
     const Mask above = (wi.z > Floats(0.0f)) & (wo.z > Floats(0.0f)) & g.finite;
 
@@ -31,32 +31,27 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3&
     }
 }
 
-// One batch at i; false, with nothing stored, when the fused direction check fails.
+// One batch at i: -1, or with the direction check on the first lane whose wi
+// or wo fails it (and nothing stored).
 template <Model model, Output output, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const Shading& uniform) {
+PB_KERNEL_INLINE int eval_one_batch(const EvalJob& job, std::int64_t i, const Shading& uniform) {
     const Vec3 wi = load_vec3<layouts>(job.wi, i);
     const Vec3 wo = load_vec3<layouts>(job.wo, i);
-    if (job.check_directions) {
-        const Mask ok = unit_length(wi, job.length2_lowest, job.length2_highest) &
-                        unit_length(wo, job.length2_lowest, job.length2_highest);
-        if (!xsimd::all(ok)) return false;
+    if (job.check.enabled) {
+        const int bad = first_bad_lane(wi, wo, job.check);
+        if (bad >= 0) return bad;
     }
     if constexpr (per_element) {
         eval_batch<model, output, layouts>(job, i, wi, wo, shading_of(load_material(job.params, i)));
     } else {
         eval_batch<model, output, layouts>(job, i, wi, wo, uniform);
     }
-    return true;
+    return -1;
 }
 
-inline std::int64_t first_bad_pair(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    const std::int64_t in = first_bad_direction(job.wi, begin, end, job.length2_lowest, job.length2_highest);
-    const std::int64_t out = first_bad_direction(job.wo, begin, end, job.length2_lowest, job.length2_highest);
-    return in < 0 ? out : out < 0 ? in : std::min(in, out);
-}
-
+// The last pad.count < kLanes elements: -1, or the first bad lane as above.
 template <Model model, Output output, bool per_element>
-bool eval_tail(const EvalJob& job, const Padding& pad, const Shading& uniform) {
+int eval_tail(const EvalJob& job, const Padding& pad, const Shading& uniform) {
     alignas(64) PadBuffer wi, wo, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
     EvalJob padded = job;
@@ -67,22 +62,30 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const Shading& uniform) {
     for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
     padded.pdf = pdf;
 
-    if (!eval_one_batch<model, output, per_element, Layouts::kMixed>(padded, 0, uniform)) return false;
+    // the padding repeats the last element, so a bad lane is one of the first pad.count
+    const int bad = eval_one_batch<model, output, per_element, Layouts::kMixed>(padded, 0, uniform);
+    if (bad >= 0) return bad;
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf) unpad_scalars(job.pdf, pad, pdf);
-    return true;
+    return -1;
 }
 
+// -1 with every element of [begin, end) written, or the first element whose
+// direction fails the check (the elements from its batch on are not written).
 template <Model model, Output output, bool per_element, Layouts layouts>
 std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     Shading uniform{};
     if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
     std::int64_t i = begin;
-    for (; i + kLanes <= end; i += kLanes)
-        if (!eval_one_batch<model, output, per_element, layouts>(job, i, uniform)) return first_bad_pair(job, i, i + kLanes);
-    if (i < end && !eval_tail<model, output, per_element>(job, Padding{i, end - i}, uniform))
-        return first_bad_pair(job, i, end);
+    for (; i + kLanes <= end; i += kLanes) {
+        const int bad = eval_one_batch<model, output, per_element, layouts>(job, i, uniform);
+        if (bad >= 0) return i + bad;
+    }
+    if (i < end) {
+        const int bad = eval_tail<model, output, per_element>(job, Padding{i, end - i}, uniform);
+        if (bad >= 0) return i + bad;
+    }
     return -1;
 }
 

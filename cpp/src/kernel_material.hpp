@@ -1,4 +1,4 @@
-// Part of kernel.hpp, included inside the per-arch namespace: the material constants of SPEC §3 (per call when uniform, per batch otherwise).
+// Part of kernel.hpp, included inside the per-arch namespace: the material constants of README "The model" (per call when uniform, per batch otherwise).
 #pragma once  // (per translation unit)
 
 // The 13 parameter slots of one batch of elements.

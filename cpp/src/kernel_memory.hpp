@@ -1,4 +1,5 @@
-// Part of kernel.hpp, included inside the per-arch namespace: loads and stores in the three layouts, direction checks.
+// Part of kernel.hpp, included inside the per-arch namespace: loads and stores
+// in the three layouts, tails, the direction check.
 #pragma once  // (per translation unit)
 
 // Every array of a call in one layout lets the loop be compiled for it;
@@ -40,27 +41,35 @@ PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const
     }
 }
 
-// SPEC §7: squared length within [lowest, highest]; a NaN fails both
-// comparisons and an infinity the second.
-PB_KERNEL_INLINE Mask unit_length(const Vec3& w, float lowest, float highest) {
+// The direction check (DirectionCheck in batch.hpp). The fast test: true only
+// for lanes whose length the rule accepts.
+PB_KERNEL_INLINE Mask surely_unit_length(const Vec3& w, const DirectionCheck& check) {
     const Floats length2 = mul_add(w.x, w.x, mul_add(w.y, w.y, w.z * w.z));
-    return (length2 >= Floats(lowest)) & (length2 <= Floats(highest));
+    return (length2 >= Floats(check.fast_lowest)) & (length2 <= Floats(check.fast_highest));  // false for NaN
 }
 
-PB_KERNEL_INLINE bool unit_length(const Vec3Array& a, std::int64_t i, float lowest, float highest) {
-    const float* p = a.layout == Vec3Layout::kSingle ? a.data : a.layout == Vec3Layout::kRows ? a.data + i : a.data + 3 * i;
-    const std::int64_t stride = a.layout == Vec3Layout::kRows ? a.row_stride : 1;
-    const float length2 = p[0] * p[0] + p[stride] * p[stride] + p[2 * stride] * p[2 * stride];
-    return length2 >= lowest && length2 <= highest;
-}
-
-inline std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_t begin, std::int64_t end,
-                                        float lowest, float highest) {
-    std::int64_t i = begin;
-    while (i + kLanes <= end && xsimd::all(unit_length(load_vec3(directions, i), lowest, highest))) i += kLanes;
-    for (; i < end; ++i)
-        if (!unit_length(directions, i, lowest, highest)) return i;
+// The first lane of w that the rule rejects, or -1. Out of line: it runs only
+// for batches the fast test did not accept.
+[[gnu::noinline]] inline int first_rejected_lane(const Vec3& w, const DirectionCheck& check) {
+    alignas(64) float x[kLanes], y[kLanes], z[kLanes];
+    w.x.store_aligned(x);
+    w.y.store_aligned(y);
+    w.z.store_aligned(z);
+    for (int lane = 0; lane < kLanes; ++lane)
+        if (!unit_length(x[lane], y[lane], z[lane], check)) return lane;
     return -1;
+}
+
+// -1 when every lane of w passes the check, else the first lane that fails.
+PB_KERNEL_INLINE int first_bad_lane(const Vec3& w, const DirectionCheck& check) {
+    return xsimd::all(surely_unit_length(w, check)) ? -1 : first_rejected_lane(w, check);
+}
+
+// The same for a pair: the first lane where either fails.
+PB_KERNEL_INLINE int first_bad_lane(const Vec3& a, const Vec3& b, const DirectionCheck& check) {
+    if (xsimd::all(surely_unit_length(a, check) & surely_unit_length(b, check))) return -1;
+    const int in_a = first_rejected_lane(a, check), in_b = first_rejected_lane(b, check);
+    return in_a < 0 ? in_b : in_b < 0 ? in_a : std::min(in_a, in_b);
 }
 
 

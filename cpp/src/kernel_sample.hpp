@@ -18,21 +18,24 @@ struct Chosen {
     Floats fv;
 };
 
-// false, with nothing stored, when the fused direction check fails
+// -1, or with the direction check on the first lane whose wo fails it
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed, Chosen& c) {
+PB_KERNEL_INLINE int choose(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed, Chosen& c) {
     c.wo = load_vec3<layouts>(job.wo, i);
-    if (job.check_directions && !xsimd::all(unit_length(c.wo, job.length2_lowest, job.length2_highest))) return false;
+    if (job.check.enabled) {
+        const int bad = first_bad_lane(c.wo, job.check);
+        if (bad >= 0) return bad;
+    }
     if (job.u.data != nullptr) {
         const Vec3 given = load_vec3<layouts>(job.u, i);
         c.u = {given.x, given.y, given.z};
     } else {
-        c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index + i), seed);
+        c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index) + static_cast<std::uint64_t>(i), seed);
     }
     c.fv = schlick_weight(c.wo.z);
     c.weights = lobe_weights(c.fv, s);
     c.lobe = choose_lobe(c.u.u0, s, c.weights);
-    return true;
+    return -1;
 }
 
 PB_KERNEL_INLINE Direction draw(const SampleJob& job, const Chosen& c, const Shading& s) {
@@ -51,7 +54,9 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& 
     // select after multiplying: below the horizon f may be infinite or NaN
     auto weight = [&](Floats value) { return xsimd::select(valid, scale * value, Floats(0.0f)); };
 
-    store_rgb<layouts>(job.wi, i, Rgb{wi.x, wi.y, wi.z});
+    // wi = 0 where wo held NaN, infinity or a huge value (checks off): pdf and weight are 0 there too
+    auto drawn = [&](Floats value) { return xsimd::select(g.finite, value, Floats(0.0f)); };
+    store_rgb<layouts>(job.wi, i, Rgb{drawn(wi.x), drawn(wi.y), drawn(wi.z)});
     xsimd::select(valid, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     store_rgb<layouts>(job.weight, i, Rgb{weight(f.r), weight(f.g), weight(f.b)});
     // the indices' int32 bit patterns selected as floats: no conversion
@@ -61,22 +66,19 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& 
 }
 
 template <Model model, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterSeed& seed) {
+PB_KERNEL_INLINE int sample_one_batch(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterSeed& seed) {
     Shading per_batch;
     if constexpr (per_element) per_batch = shading_of(load_material(job.params, i));
     const Shading& s = per_element ? per_batch : uniform;
     Chosen chosen;
-    if (!choose<model, layouts>(job, i, s, seed, chosen)) return false;
+    const int bad = choose<model, layouts>(job, i, s, seed, chosen);
+    if (bad >= 0) return bad;
     weigh<model, layouts>(job, i, chosen, draw(job, chosen, s), s);
-    return true;
-}
-
-inline std::int64_t first_bad_view(const SampleJob& job, std::int64_t begin, std::int64_t end) {
-    return first_bad_direction(job.wo, begin, end, job.length2_lowest, job.length2_highest);
+    return -1;
 }
 
 template <Model model, bool per_element>
-bool sample_tail(const SampleJob& job, const Padding& pad, const Shading& uniform, const CounterSeed& seed) {
+int sample_tail(const SampleJob& job, const Padding& pad, const Shading& uniform, const CounterSeed& seed) {
     alignas(64) PadBuffer wo, u, params[kParamSlots], wi, weight;
     alignas(64) float pdf[kLanes];
     alignas(64) std::int32_t lobe[kLanes];
@@ -90,13 +92,14 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const Shading& unifor
     padded.lobe = lobe;
     padded.first_index = job.first_index + pad.begin;  // the generator sees the true element indices
 
-    if (!sample_one_batch<model, per_element, Layouts::kMixed>(padded, 0, uniform, seed)) return false;
+    const int bad = sample_one_batch<model, per_element, Layouts::kMixed>(padded, 0, uniform, seed);
+    if (bad >= 0) return bad;  // one of the first pad.count lanes, as in eval_tail
 
     unpad_vec3(job.wi, pad, wi);
     unpad_vec3(job.weight, pad, weight);
     unpad_scalars(job.pdf, pad, pdf);
     unpad_scalars(job.lobe, pad, lobe);
-    return true;
+    return -1;
 }
 
 // One batch between its stages: chosen, then drawn.
@@ -106,10 +109,10 @@ struct InFlight {
 };
 
 // One step of the pipeline: weigh the batch at i, draw the next one, choose
-// the one after it at i + 2 kLanes (false, with nothing stored for it, when
-// its directions fail the check).
+// the one after it at i + 2 kLanes (-1, or the lane of that batch whose wo
+// fails the check).
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed,
+PB_KERNEL_INLINE int pipeline_step(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed,
                                     InFlight& weighed, InFlight& drawn, InFlight& chosen) {
     weigh<model, layouts>(job, i, weighed.chosen, weighed.drawn, s);
     drawn.drawn = draw(job, drawn.chosen, s);
@@ -138,20 +141,21 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
     const std::int64_t batches = (end - begin) / kLanes;
     auto at = [&](std::int64_t b) { return begin + b * kLanes; };
     std::int64_t b = 0;
+    int bad = -1;
     if constexpr (!per_element) {
         if (batches >= 5) {
             InFlight slot0, slot1, slot2;
-            if (!choose<model, layouts>(job, at(0), uniform, seed, slot0.chosen)) return first_bad_view(job, at(0), at(1));
-            if (!choose<model, layouts>(job, at(1), uniform, seed, slot1.chosen)) return first_bad_view(job, at(1), at(2));
+            if ((bad = choose<model, layouts>(job, at(0), uniform, seed, slot0.chosen)) >= 0) return at(0) + bad;
+            if ((bad = choose<model, layouts>(job, at(1), uniform, seed, slot1.chosen)) >= 0) return at(1) + bad;
             slot0.drawn = draw(job, slot0.chosen, uniform);
             // here and after each step: slot0 holds batch b, drawn, and slot1 batch b + 1, chosen
             for (; b + 4 < batches; b += 3) {
-                if (!pipeline_step<model, layouts>(job, at(b), uniform, seed, slot0, slot1, slot2))
-                    return first_bad_view(job, at(b + 2), at(b + 3));
-                if (!pipeline_step<model, layouts>(job, at(b + 1), uniform, seed, slot1, slot2, slot0))
-                    return first_bad_view(job, at(b + 3), at(b + 4));
-                if (!pipeline_step<model, layouts>(job, at(b + 2), uniform, seed, slot2, slot0, slot1))
-                    return first_bad_view(job, at(b + 4), at(b + 5));
+                if ((bad = pipeline_step<model, layouts>(job, at(b), uniform, seed, slot0, slot1, slot2)) >= 0)
+                    return at(b + 2) + bad;
+                if ((bad = pipeline_step<model, layouts>(job, at(b + 1), uniform, seed, slot1, slot2, slot0)) >= 0)
+                    return at(b + 3) + bad;
+                if ((bad = pipeline_step<model, layouts>(job, at(b + 2), uniform, seed, slot2, slot0, slot1)) >= 0)
+                    return at(b + 4) + bad;
             }
             weigh<model, layouts>(job, at(b), slot0.chosen, slot0.drawn, uniform);
             weigh<model, layouts>(job, at(b + 1), slot1.chosen, draw(job, slot1.chosen, uniform), uniform);
@@ -159,10 +163,9 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
         }
     }
     for (; b < batches; ++b)
-        if (!sample_one_batch<model, per_element, layouts>(job, at(b), uniform, seed)) return first_bad_view(job, at(b), at(b + 1));
+        if ((bad = sample_one_batch<model, per_element, layouts>(job, at(b), uniform, seed)) >= 0) return at(b) + bad;
     const std::int64_t i = begin + batches * kLanes;
-    if (i < end && !sample_tail<model, per_element>(job, Padding{i, end - i}, uniform, seed))
-        return first_bad_view(job, i, end);
+    if (i < end && (bad = sample_tail<model, per_element>(job, Padding{i, end - i}, uniform, seed)) >= 0) return i + bad;
     return -1;
 }
 

@@ -1,6 +1,6 @@
 """Disney principled BRDF: evaluation and sampling over numpy arrays of directions.
 
-See the README for the model (SPEC §3) and the API tour.
+See the README for the model and the API tour.
 """
 
 from . import microfacet, plot, presets, reference, render

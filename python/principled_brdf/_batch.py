@@ -13,7 +13,6 @@ Input handling, once per call:
 
 from __future__ import annotations
 
-import operator
 
 import numpy as np
 
@@ -22,9 +21,15 @@ from ._validate import (
     DIRECTION_LENGTH_TOLERANCE,
     as_real_array,
     broadcast_leading,
+    direction_error,
     element_name,
+    flag,
+    integer,
     model_index,
+    require_float32,
     require_in_domain,
+    seed_value,
+    unit_length,
 )
 from .material import PARAMETERS, Material
 from .reference import Lobes, Sample
@@ -53,12 +58,11 @@ def _layout(layout) -> str:
 def _threads(threads) -> int:
     if threads is None:
         return 0
-    try:
-        count = operator.index(threads)
-    except TypeError:
-        raise TypeError(f"threads: expected an integer, got {type(threads).__name__}") from None
+    count = integer("threads", threads)
     if count < 1:
         raise ValueError(f"threads: expected at least 1, got {count}")
+    if count > 2**31 - 1:
+        raise ValueError(f"threads: expected at most 2**31 - 1, got {count}")
     return count
 
 
@@ -66,16 +70,6 @@ def _specular_sampler(name) -> int:
     if name not in _SPECULAR_SAMPLERS:
         raise ValueError(f"specular_sampler: expected one of {sorted(_SPECULAR_SAMPLERS)}, got {name!r}")
     return _SPECULAR_SAMPLERS[name]
-
-
-def _seed(seed) -> int:
-    try:
-        value = operator.index(seed)
-    except TypeError:
-        raise TypeError(f"seed: expected an integer, got {type(seed).__name__}") from None
-    if not 0 <= value < 2**64:
-        raise ValueError(f"seed: expected 0 <= seed < 2**64, got {value}")
-    return value
 
 
 def _isa(isa) -> str:
@@ -87,15 +81,26 @@ def _isa(isa) -> str:
     return isa
 
 
+def _float32_input(name: str, value) -> tuple:
+    """(float32 C-contiguous aligned array, the values as given): read in place
+    when ``value`` already is one, else converted once (after a check that the
+    values fit in float32, so that 1e300 is not reported as infinity)."""
+    if isinstance(value, np.ndarray) and value.dtype == np.float32:
+        if value.flags.c_contiguous and value.flags.aligned:
+            return value, value
+        return np.require(value, np.float32, ["C_CONTIGUOUS", "ALIGNED"]), value
+    given = as_real_array(name, value)
+    require_float32(name, given)
+    return np.ascontiguousarray(given, dtype=np.float32), given
+
+
 class _Directions:
     """A direction argument as float32, with its leading shape and layout."""
 
     def __init__(self, name: str, value, layout: str):
         self.name = name
-        if isinstance(value, np.ndarray) and value.dtype == np.float32:
-            array = value
-        else:
-            array = as_real_array(name, value).astype(np.float32)
+        self.array, self.given = _float32_input(name, value)
+        array = self.array
         if layout == "aos":
             if array.ndim == 0 or array.shape[-1] != 3:
                 raise ValueError(f"{name}: expected shape (..., 3) with layout='aos', got {array.shape}")
@@ -105,7 +110,6 @@ class _Directions:
                 raise ValueError(f"{name}: expected shape (3, ...) with layout='soa', got {array.shape}")
             self.leading = array.shape[1:]
         self.layout = layout
-        self.array = np.ascontiguousarray(array)  # no copy when already C-contiguous
 
     def flat(self, leading: tuple):
         """(array, layout code) with ``leading`` elements; broadcasts if needed."""
@@ -118,19 +122,30 @@ class _Directions:
         n = int(np.prod(leading, dtype=np.int64))
         return (array.reshape(n, 3), _INTERLEAVED) if self.layout == "aos" else (array.reshape(3, n), _ROWS)
 
-    def check(self, threads: int) -> None:
-        """SPEC §7: every direction finite and of unit length within tolerance."""
-        flat, code = self.flat(self.leading)
-        n = 1 if code == _SINGLE else int(np.prod(self.leading, dtype=np.int64))
-        bad = _core.check_directions(flat, code, n, DIRECTION_LENGTH_TOLERANCE, threads)
-        if bad < 0:
-            return
-        vector = flat[bad] if code == _INTERLEAVED else flat[:, bad] if code == _ROWS else flat
-        where = element_name(self.name, bad, self.leading)
-        if not np.all(np.isfinite(vector)):
-            raise ValueError(f"{where}: {vector.tolist()} is not a finite vector")
-        length = float(np.sqrt(np.sum(vector.astype(np.float64) ** 2)))
-        raise ValueError(f"{where}: length {length:.6g} is not 1 (within {DIRECTION_LENGTH_TOLERANCE:g})")
+    def _own_index(self, element: int, leading: tuple) -> tuple:
+        """The index into this argument's own leading shape of ``element`` of the broadcast ``leading``."""
+        index = np.unravel_index(element, leading) if leading else ()
+        trailing = index[len(index) - len(self.leading):]
+        return tuple(int(i) if size > 1 else 0 for i, size in zip(trailing, self.leading))
+
+    def error_at(self, element: int, leading: tuple):
+        """The ValueError for this argument at ``element``, or None when its vector passes."""
+        own = self._own_index(element, leading)
+        vector = self.array[own] if self.layout == "aos" else self.array[(slice(None),) + own]
+        if unit_length(vector):
+            return None
+        flat_index = int(np.ravel_multi_index(own, self.leading)) if own else 0
+        return direction_error(self.name, flat_index, self.leading, vector)
+
+
+def _direction_error(element: int, leading: tuple, *arguments: _Directions) -> ValueError:
+    """The error for the element the kernel rejected: the first argument whose vector fails."""
+    for argument in arguments:
+        error = argument.error_at(element, leading)
+        if error is not None:
+            return error
+    # The kernel and unit_length apply the same rule to the same floats.
+    raise AssertionError(f"element {element} was rejected by the kernel and accepted by the check")
 
 
 # The float32 kernels stay finite for parameters up to these bounds, all at
@@ -175,7 +190,23 @@ def _output(out, shape: tuple, name: str = "out") -> np.ndarray:
         raise ValueError(f"{name}: expected shape {shape}, got {out.shape}")
     if not out.flags.c_contiguous or not out.flags.writeable:
         raise ValueError(f"{name}: expected a writeable C-contiguous array")
+    if not out.flags.aligned:
+        raise ValueError(f"{name}: array data is not aligned to 4 bytes (the kernels write whole floats)")
     return out
+
+
+def _require_no_partial_overlap(out: np.ndarray, inputs: dict, name: str = "out") -> None:
+    """An ``out=`` that is exactly an input computes in place; one that partly overlaps
+    an input would read elements it has already overwritten: a ValueError."""
+    for input_name, array in inputs.items():
+        # Both are dense blocks (C-contiguous), so sharing bounds is sharing memory.
+        if array is None or not np.may_share_memory(out, array):
+            continue
+        same = (out.__array_interface__["data"][0] == array.__array_interface__["data"][0]
+                and out.shape == array.shape and out.strides == array.strides)
+        if not same:
+            raise ValueError(f"{name}: overlaps {input_name} without being the same array "
+                             "(only an exact alias computes in place)")
 
 
 def _require_material(material) -> None:
@@ -202,39 +233,36 @@ def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, o
     layout = _layout(layout)
     thread_count = _threads(threads)
     isa_name = _isa(isa)
+    cosine, check = flag("cosine", cosine), flag("check", check)
     wi_dirs = _Directions("wi", wi, layout)
     wo_dirs = _Directions("wo", wo, layout)
     leading = broadcast_leading(wi=wi_dirs.leading, wo=wo_dirs.leading, material=material.shape)
-    outputs, fresh = outputs_for_shape(leading, layout)
-    if check and not fresh:
-        # The caller's buffer must stay untouched on bad input: check first.
-        wi_dirs.check(thread_count)
-        wo_dirs.check(thread_count)
+    params = _params(material, leading)
+    outputs = outputs_for_shape(leading, layout)
     n = _size(leading)
     wi_flat, wi_code = wi_dirs.flat(leading)
     wo_flat, wo_code = wo_dirs.flat(leading)
-    # Into fresh outputs the check rides along with the evaluation (one pass
-    # over memory instead of two); on a bad direction the partial result is dropped.
-    fused_tolerance = DIRECTION_LENGTH_TOLERANCE if check and fresh else 0.0
-    params = _params(material, leading)
+    for output in outputs:
+        _require_no_partial_overlap(output, {"wi": wi_flat, "wo": wo_flat})
+    # The check rides along with the evaluation (README "Bad input"): on a bad
+    # direction the call raises, and an out= buffer may hold partial results.
+    tolerance = DIRECTION_LENGTH_TOLERANCE if check else 0.0
     if pdf_sampler is not None:
         bad = _core.batch_pdf(wi_flat, wi_code, wo_flat, wo_code, params, outputs[0].reshape(n), n, pdf_sampler,
-                              fused_tolerance, thread_count, isa_name)
+                              tolerance, thread_count, isa_name)
     else:
         flat_outputs = [_flat_vec3(o, layout)[0] for o in outputs]
         bad = _core.batch_eval(wi_flat, wi_code, wo_flat, wo_code, params, flat_outputs,
                                _INTERLEAVED if layout == "aos" else _ROWS, n, model_id, len(outputs) == 4,
-                               bool(cosine), fused_tolerance, thread_count, isa_name)
+                               cosine, tolerance, thread_count, isa_name)
     if bad >= 0:
-        wi_dirs.check(thread_count)
-        wo_dirs.check(thread_count)
-        raise RuntimeError("internal error: the kernel rejected a direction the checks accept")
+        raise _direction_error(bad, leading, wi_dirs, wo_dirs)
     return outputs
 
 
 def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False, layout: str = "aos",
          threads=None, out=None, check: bool = True, isa=None) -> np.ndarray:
-    """f(wi, wo) in 1/sr as float32, by the SIMD kernel (SPEC §3).
+    """f(wi, wo) in 1/sr as float32, by the SIMD kernel (README "The model").
 
     ``wi``, ``wo``: unit directions, ``(..., 3)`` or with ``layout="soa"``
     ``(3, ...)``; leading shapes broadcast with each other and with the
@@ -246,7 +274,7 @@ def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool 
     picks one of ``cpu_info()["available"]`` (for tests and benchmarks).
     """
     (f,) = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
-                     lambda leading, layout: ([_output(out, _vec3_shape(leading, layout))], out is None))
+                     lambda leading, layout: [_output(out, _vec3_shape(leading, layout))])
     return f
 
 
@@ -255,8 +283,7 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
     """The four lobes (diffuse, sheen, specular, clearcoat) as a :class:`Lobes`
     of float32 arrays, each shaped like :func:`eval`'s result."""
     outputs = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
-                        lambda leading, layout: ([np.empty(_vec3_shape(leading, layout), np.float32) for _ in range(4)],
-                                                 True))
+                        lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in range(4)])
     return Lobes(*outputs)
 
 
@@ -266,7 +293,7 @@ def pdf(material: Material, wi, wo, *, specular_sampler: str = "visible", layout
     the lobe mixture of README "Sampling and pdf", float32 ``(...)``; 0 when
     either direction is at or below the horizon. It does not depend on the model."""
     (density,) = _evaluate(material, wi, wo, 0, False, layout, threads, check, isa,
-                           lambda leading, layout: ([np.empty(leading, np.float32)], True),
+                           lambda leading, layout: [np.empty(leading, np.float32)],
                            pdf_sampler=_specular_sampler(specular_sampler))
     return density
 
@@ -274,10 +301,14 @@ def pdf(material: Material, wi, wo, *, specular_sampler: str = "visible", layout
 def random_uniforms(seed: int, n: int, first: int = 0) -> np.ndarray:
     """The ``(n, 3)`` uniforms :func:`sample` draws for elements ``first .. first + n - 1``
     when given ``seed`` and no ``u`` (a counter-based generator keyed by seed and index)."""
-    count, start = operator.index(n), operator.index(first)
+    count, start = integer("n", n), integer("first", first)
     if count < 0 or start < 0:
         raise ValueError(f"n, first: expected non-negative integers, got {count}, {start}")
-    return _core.counter_uniforms(_seed(seed), start, count)
+    if start + count > 2**63 - 1:
+        raise ValueError(f"first + n: expected at most 2**63 - 1 (the generator's index range), got {start + count}")
+    if 3 * count > np.iinfo(np.intp).max // 4:
+        raise ValueError(f"n: {count} rows of three float32 do not fit in memory")
+    return _core.counter_uniforms(seed_value(seed), start, count)
 
 
 def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disney2014",
@@ -297,13 +328,14 @@ def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disne
     layout = _layout(layout)
     thread_count = _threads(threads)
     isa_name = _isa(isa)
-    seed_value = _seed(seed)
+    seed = seed_value(seed)
+    check = flag("check", check)
     wo_dirs = _Directions("wo", wo, layout)
     shapes = dict(wo=wo_dirs.leading, material=material.shape)
     uniforms = None
     if u is not None:
         uniforms = _Directions("u", u, layout)  # shape and dtype handling of a 3-vector argument
-        require_in_domain("u", uniforms.array, 0.0, 1.0)
+        require_in_domain("u", uniforms.given, 0.0, 1.0)  # the values as given, as pb.reference checks them
         shapes["u"] = uniforms.leading
     leading = broadcast_leading(**shapes)
     n = _size(leading)
@@ -314,12 +346,11 @@ def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disne
     wo_flat, wo_code = wo_dirs.flat(leading)
     u_flat, u_code = uniforms.flat(leading) if uniforms is not None else (None, 0)
     bad = _core.batch_sample(
-        wo_flat, wo_code, u_flat, u_code, seed_value, _params(material, leading), _flat_vec3(wi_out, layout)[0],
+        wo_flat, wo_code, u_flat, u_code, seed, _params(material, leading), _flat_vec3(wi_out, layout)[0],
         _flat_vec3(weight_out, layout)[0], _INTERLEAVED if layout == "aos" else _ROWS, pdf_out.reshape(n),
         lobe_out.reshape(n), n, model_id, sampler, DIRECTION_LENGTH_TOLERANCE if check else 0.0, thread_count,
         isa_name,
     )
     if bad >= 0:
-        wo_dirs.check(thread_count)
-        raise RuntimeError("internal error: the kernel rejected a direction the checks accept")
+        raise _direction_error(bad, leading, wo_dirs)
     return Sample(wi_out, pdf_out, weight_out, lobe_out)

@@ -1,17 +1,53 @@
-"""Checks at the Python boundary (SPEC §7).
+"""Checks at the Python boundary (README "Bad input").
 
-Every check raises before any output exists, and names the argument and the
-first offending element, e.g. ``wi[2, 7]: length 1.2 is not 1 (within 1e-3)``.
+Every check names the argument and the first offending element, e.g.
+``wi[2, 7]: length 1.2 is not 1 (within 1e-3)``.
 """
 
 from __future__ import annotations
 
 import numbers
+import operator
 
 import numpy as np
 
+from . import _core
+
 DIRECTION_LENGTH_TOLERANCE = 1e-3
+# A direction passes when its float64 squared length, summed as x² + y² + z²,
+# lies within these: the rule the kernels apply (batch.hpp, DirectionCheck).
+DIRECTION_LENGTH2_BOUNDS = tuple(_core.direction_length2_bounds(DIRECTION_LENGTH_TOLERANCE))
 MODELS = {"disney2014": 0, "disney2012": 1}
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+_REAL_KINDS = "biuf"  # bool, signed and unsigned integers, floats
+
+
+def unit_length(array: np.ndarray) -> np.ndarray:
+    """Which vectors on the last axis pass the direction check (False for NaN)."""
+    w = array.astype(np.float64, copy=False)
+    with np.errstate(invalid="ignore", over="ignore"):
+        length2 = w[..., 0] * w[..., 0] + w[..., 1] * w[..., 1] + w[..., 2] * w[..., 2]
+        return (length2 >= DIRECTION_LENGTH2_BOUNDS[0]) & (length2 <= DIRECTION_LENGTH2_BOUNDS[1])
+
+
+def direction_error(name: str, flat_index: int, leading: tuple, vector: np.ndarray) -> ValueError:
+    """The error for a vector that fails the direction check."""
+    where = element_name(name, flat_index, leading)
+    vector = np.asarray(vector, dtype=np.float64)
+    if not np.all(np.isfinite(vector)):
+        return ValueError(f"{where}: {vector.tolist()} is not a finite vector")
+    length = float(np.sqrt(np.sum(vector ** 2)))
+    shown = f"{length:.7g}"  # float32's digits, more where that much looks within the tolerance
+    if abs(float(shown) - 1.0) <= DIRECTION_LENGTH_TOLERANCE:
+        shown = f"{length:.10g}"
+    return ValueError(f"{where}: length {shown} is not 1 (within {DIRECTION_LENGTH_TOLERANCE:g})")
+
+
+def flag(name: str, value) -> bool:
+    """A yes/no option: True, False (or numpy's bool); TypeError otherwise."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise TypeError(f"{name}: expected True or False, got {type(value).__name__}")
 
 
 def element_name(name: str, flat_index: int, shape: tuple) -> str:
@@ -36,16 +72,30 @@ def as_real_array(name: str, value) -> np.ndarray:
         array = np.asarray(value)
     except (TypeError, ValueError) as error:
         raise TypeError(f"{name}: cannot be read as an array of real numbers ({error})") from None
-    if array.dtype == object or not (np.issubdtype(array.dtype, np.number) or array.dtype == np.bool_):
-        raise TypeError(f"{name}: expected real numbers, got an array of dtype {array.dtype}")
     if np.issubdtype(array.dtype, np.complexfloating):
         raise TypeError(f"{name}: expected real numbers, got complex values")
-    return array.astype(np.float64, copy=False)
+    if array.dtype.kind not in _REAL_KINDS:  # objects, strings, datetime64, timedelta64, ...
+        raise TypeError(f"{name}: expected real numbers, got an array of dtype {array.dtype}")
+    array = array.astype(np.float64, copy=False)
+    return array if array.flags.aligned else array.copy()
 
 
 def _not_finite_message(name: str, flat_index: int, array: np.ndarray) -> str:
     # float() so the message reads "nan", not numpy 2's "np.float64(nan)"
     return f"{element_name(name, flat_index, array.shape)}: {float(array.ravel()[flat_index])!r} is not a finite number"
+
+
+def require_float32(name: str, array: np.ndarray) -> None:
+    """Every value finite and within float32's range (for the float32 kernels)."""
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.abs(array) <= FLOAT32_MAX)
+    if bad.any():
+        i = first_true(bad)
+        value = float(array.ravel()[i])
+        if np.isfinite(value):
+            raise ValueError(f"{element_name(name, i, array.shape)}: {value!r} is beyond float32's range "
+                             f"(|x| <= {FLOAT32_MAX:.7g})")
+        raise ValueError(_not_finite_message(name, i, array))
 
 
 def require_finite(name: str, array: np.ndarray) -> None:
@@ -73,19 +123,32 @@ def directions(name: str, value) -> np.ndarray:
     array = as_real_array(name, value)
     if array.ndim == 0 or array.shape[-1] != 3:
         raise ValueError(f"{name}: expected shape (..., 3) with unit 3-vectors on the last axis, got {array.shape}")
-    not_finite = ~np.isfinite(array)
-    with np.errstate(invalid="ignore", over="ignore"):
-        length = np.sqrt(np.einsum("...i,...i->...", array, array))
-        bad = not_finite.any(axis=-1) | (np.abs(length - 1.0) > DIRECTION_LENGTH_TOLERANCE)
+    bad = ~unit_length(array)
     if bad.any():
         i = first_true(bad)  # the first offending vector, whichever the fault
-        if not_finite.reshape(-1, 3)[i].any():
-            raise ValueError(_not_finite_message(name, 3 * i + first_true(not_finite.reshape(-1, 3)[i]), array))
-        raise ValueError(
-            f"{element_name(name, i, length.shape)}: length {length.ravel()[i]:.6g} is not 1 "
-            f"(within {DIRECTION_LENGTH_TOLERANCE:g})"
-        )
+        vector = array.reshape(-1, 3)[i]
+        not_finite = ~np.isfinite(vector)
+        if not_finite.any():
+            raise ValueError(_not_finite_message(name, 3 * i + first_true(not_finite), array))
+        raise direction_error(name, i, array.shape[:-1], vector)
     return array
+
+
+def integer(name: str, value) -> int:
+    """An integer (not a bool); TypeError otherwise."""
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name}: expected an integer, got {type(value).__name__}")
+    try:
+        return operator.index(value)
+    except TypeError:
+        raise TypeError(f"{name}: expected an integer, got {type(value).__name__}") from None
+
+
+def seed_value(seed) -> int:
+    value = integer("seed", seed)
+    if not 0 <= value < 2**64:
+        raise ValueError(f"seed: expected 0 <= seed < 2**64, got {value}")
+    return value
 
 
 def model_index(model) -> int:

@@ -4,18 +4,19 @@ in total, with its Monte Carlo standard error."""
 
 from __future__ import annotations
 
-import operator
 from typing import NamedTuple
 
 import numpy as np
 
-from ._batch import _seed, eval_lobes, random_uniforms, sample
-from ._validate import as_real_array, broadcast_leading, require_in_domain
+from ._batch import eval_lobes, random_uniforms, sample
+from ._validate import as_real_array, broadcast_leading, integer, require_in_domain, seed_value
 from .material import PARAMETERS, Material
 from .reference import Lobes
 
 __all__ = ["Albedo", "albedo"]
 
+# The most samples per albedo: beyond, one cos θo alone needs gigabytes.
+MAX_SAMPLES = 1 << 26
 # Elements per kernel call: bounds the memory of one chunk (about 150 bytes each).
 _CHUNK_ELEMENTS = 1 << 22
 
@@ -56,10 +57,10 @@ def albedo(material: Material, cos_theta_o, *, samples: int = 1 << 16, seed: int
     require_in_domain("cos_theta_o", cos_o, 0.0, 1.0)
     if np.any(cos_o == 0.0):
         raise ValueError("cos_theta_o: the albedo is defined for cos θo > 0")
-    count = operator.index(samples)
-    if count < 2:
-        raise ValueError(f"samples: expected at least 2, got {count}")
-    seed_value = _seed(seed)
+    count = integer("samples", samples)
+    if not 2 <= count <= MAX_SAMPLES:
+        raise ValueError(f"samples: expected 2 to {MAX_SAMPLES}, got {count}")
+    seed = seed_value(seed)
     leading = broadcast_leading(cos_theta_o=cos_o.shape, material=material.shape)
     expanded = _with_sample_axis(material, leading)
     cos_flat = np.broadcast_to(cos_o, leading).reshape(-1)
@@ -75,7 +76,7 @@ def albedo(material: Material, cos_theta_o, *, samples: int = 1 << 16, seed: int
         wo = np.stack([np.sqrt(1.0 - cos * cos), np.zeros_like(cos), cos], axis=-1).astype(np.float32)
         wo = np.broadcast_to(wo[:, None, :], (stop - start, count, 3))
         chunk_material = _slice(flat_material, start, stop)
-        u = random_uniforms(seed_value, (stop - start) * count, first=start * count).reshape(stop - start, count, 3)
+        u = random_uniforms(seed, (stop - start) * count, first=start * count).reshape(stop - start, count, 3)
         drawn = sample(chunk_material, wo, u=u, model=model, specular_sampler=specular_sampler, threads=threads,
                        check=False)
         values = eval_lobes(chunk_material, drawn.wi, wo, model=model, cosine=True, threads=threads, check=False)

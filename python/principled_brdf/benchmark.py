@@ -1,5 +1,5 @@
 """principled_brdf.eval against a straightforward numpy float32 implementation
-of SPEC §3 on the same pairs, both timed in this process (the CLI's ``bench``;
+of the model (README "The model") on the same pairs, both timed in this process (the CLI's ``bench``;
 ``bench/python_vs_numpy.py`` runs it too)."""
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ MATERIAL = dict(base_color=(0.82, 0.67, 0.16), metallic=0.2, subsurface=0.3, spe
 
 
 def numpy_eval(m: dict, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
-    """SPEC §3 (disney2014) written the obvious way with float32 numpy arrays."""
+    """The model (disney2014) written the obvious way with float32 numpy arrays."""
     f32 = np.float32
     base = np.asarray(m["base_color"], f32)
     lx, ly, lz = wi[:, 0], wi[:, 1], wi[:, 2]

@@ -14,6 +14,10 @@ import time
 import numpy as np
 
 from .material import PARAMETERS, Material
+from .render import MAX_RESOLUTION
+
+# Each pair holds about 100 bytes across the benchmarks' arrays: 2**27 pairs is 13 GB.
+MAX_PAIRS = 1 << 27
 
 
 class _Progress:
@@ -36,6 +40,26 @@ def _positive_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
+    return value
+
+
+def _at_most(upper: int, what: str):
+    """A positive integer option of at most ``upper`` (beyond it the job cannot fit in memory)."""
+    def parse(text: str) -> int:
+        value = _positive_int(text)
+        if value > upper:
+            raise argparse.ArgumentTypeError(f"expected at most {upper} {what}, got {value}")
+        return value
+    return parse
+
+
+def _exposure(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (np.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
     return value
 
 
@@ -109,7 +133,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo = commands.add_parser("demo", help="evaluate and sample millions of pairs, print throughput, write a picture",
                                description="The README's main job: evaluate and sample millions of random pairs, "
                                            "print throughput beside the memory roofline, write a picture.")
-    demo.add_argument("--pairs", type=_positive_int, default=1 << 22, help="pairs to evaluate (default 4194304)")
+    demo.add_argument("--pairs", type=_at_most(MAX_PAIRS, "pairs"), default=1 << 22,
+                      help="pairs to evaluate (default 4194304)")
     demo.add_argument("--repeats", type=_positive_int, default=5, help="timed runs, best kept (default 5)")
     demo.add_argument("--output", default="principled_brdf_demo.png", help="picture to write (PNG)")
     demo.set_defaults(run=_demo)
@@ -121,10 +146,11 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--preset", choices=presets.names(), help="start from a named preset")
     render.add_argument("--param", action="append", type=_parameter, metavar="NAME=VALUE",
                         help="set a parameter (repeatable), e.g. roughness=0.3 or base_color=0.9,0.6,0.2")
-    render.add_argument("--resolution", type=_positive_int, default=512, help="image size in pixels (default 512)")
+    render.add_argument("--resolution", type=_at_most(MAX_RESOLUTION, "pixels"), default=512,
+                        help="image size in pixels (default 512)")
     render.add_argument("--light", type=_vector, default=(-0.5, 0.6, 0.75),
                         help="direction towards the light, camera space x,y,z (default -0.5,0.6,0.75)")
-    render.add_argument("--exposure", type=float, default=1.0, help="scale before tone mapping (default 1)")
+    render.add_argument("--exposure", type=_exposure, default=1.0, help="scale before tone mapping (default 1)")
     render.add_argument("--model", choices=("disney2014", "disney2012"), default="disney2014")
     render.add_argument("--output", required=True, help="PNG file to write")
     render.set_defaults(run=_render)
@@ -132,7 +158,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench = commands.add_parser("bench", help="compare pb.eval with a numpy float32 implementation",
                                 description="Time pb.eval against a straightforward numpy float32 implementation "
                                             "of the model on the same pairs.")
-    bench.add_argument("--pairs", type=_positive_int, default=1 << 22, help="pairs (default 4194304)")
+    bench.add_argument("--pairs", type=_at_most(MAX_PAIRS, "pairs"), default=1 << 22, help="pairs (default 4194304)")
     bench.add_argument("--repeats", type=_positive_int, default=5, help="timed runs, best kept (default 5)")
     bench.set_defaults(run=_bench)
 
@@ -150,5 +176,8 @@ def main(argv=None) -> int:
         args.run(args, report)
     except (ValueError, TypeError, OSError) as error:
         print(f"{parser.prog} {args.command}: error: {error}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"{parser.prog} {args.command}: error: not enough memory for this job", file=sys.stderr)
         return 2
     return 0

@@ -1,4 +1,4 @@
-"""The material: the 11 parameters of SPEC §2, each uniform or per element."""
+"""The material: the 11 parameters of README "The model", each uniform or per element."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
 
 
 class Material:
-    """Disney principled BRDF parameters (SPEC §2).
+    """Disney principled BRDF parameters (README "The model").
 
     Each parameter is a number or an array broadcastable to the directions'
     leading shape; ``base_color`` is linear RGB, shape ``(3,)`` or ``(..., 3)``.
@@ -89,7 +89,7 @@ class Material:
 
     @staticmethod
     def mix(a: "Material", b: "Material", t) -> "Material":
-        """Every parameter linearly interpolated, ``a + (b - a) t`` (seed 000 §5.7).
+        """Every parameter linearly interpolated, ``a + (b - a) t`` (Burley 2012 §5.7).
 
         ``t`` is a number or a per-element mask in [0, 1], broadcast against the
         materials' leading shapes (it applies to all three channels of base_color).

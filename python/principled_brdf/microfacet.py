@@ -1,4 +1,4 @@
-"""Microfacet toolkit (SPEC §4), float64: GTR, anisotropic GGX with Smith masking, Beckmann.
+"""Microfacet toolkit (README "Microfacet toolkit"), float64: GTR, anisotropic GGX with Smith masking, Beckmann.
 
 Every function takes numbers or arrays, broadcasts them numpy-style (a
 direction contributes its leading shape ``(...)`` of ``(..., 3)``) and returns
@@ -8,7 +8,7 @@ tangent (``alpha_x``), ``y`` bitangent (``alpha_y``); they are checked to be of
 length 1 within 1e-3 and normalised before use. ``alpha_y`` defaults to
 ``alpha_x`` (isotropic).
 
-Domains (SPEC §7: anything else raises ``ValueError``/``TypeError`` naming the
+Domains (README "Bad input": anything else raises ``ValueError``/``TypeError`` naming the
 argument and its first offending element): ``cos_theta_h`` in [-1, 1];
 uniforms ``u1``, ``u2`` in [0, 1]; GTR ``alpha`` in (0, 1] and ``gamma`` in
 (0, 1e6]; GGX and Beckmann ``alpha_x``, ``alpha_y`` > 0. Roughness is clamped
@@ -127,7 +127,7 @@ def _run(core_function, *args, returns_vector: bool = False, **arguments):
 
 
 # --------------------------------------------------------------------------
-# GTR (seed 000 appendix B)
+# GTR (Burley 2012 appendix B)
 
 
 def gtr_d(cos_theta_h, alpha, gamma, *, closed_forms: bool = True) -> np.ndarray:
@@ -278,11 +278,11 @@ def ggx_g2_height_correlated(wi, wo, alpha_x, alpha_y=None) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------
-# anisotropic Beckmann (seed 003)
+# anisotropic Beckmann (Walter et al. 2007)
 
 
 def beckmann_d(h, alpha_x, alpha_y=None) -> np.ndarray:
-    """Anisotropic Beckmann, seed 003 eq. (3-29) with the stretch of eq. (3-24)::
+    """Anisotropic Beckmann (Walter et al. 2007), stretched as in Heitz 2014::
 
         D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴),  0 for h·n <= 0.
     """
@@ -312,7 +312,7 @@ def beckmann_sample(u1, u2, alpha_x, alpha_y=None) -> np.ndarray:
 
 
 def beckmann_lambda(w, alpha_x, alpha_y=None) -> np.ndarray:
-    """Smith Λ for Beckmann, seed 003 eq. (3-30), exact (not the rational fit 3-31)::
+    """Smith Λ for Beckmann (Heitz 2014), exact (not Walter's rational fit)::
 
         Λ = (erf(a) - 1) / 2 + exp(-a²) / (2 a sqrt(π)),   a = |wz| / sqrt(αx² wx² + αy² wy²)
 

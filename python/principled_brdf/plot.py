@@ -44,7 +44,7 @@ from .render import DEFAULT_LIGHT, render_sphere, sphere_frames, to_srgb8
 __all__ = ["brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves", "parameter_sweep", "blend_demo",
            "sky_environment", "slice_directions", "SCALAR_PARAMETERS", "CHANNELS"]
 
-#: The ten scalar parameters of SPEC §2, in the library's order.
+#: The ten scalar parameters of the model, in the library's order.
 SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items() if info.slots == 1)
 
 #: Channel names accepted by the scalar plots and their weights on linear RGB.

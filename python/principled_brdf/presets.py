@@ -1,4 +1,4 @@
-"""A small library of named materials (linear base colours, within SPEC §2).
+"""A small library of named materials (linear base colours, within the parameters' domains).
 
     pb.presets.get("gold")            # a Material
     pb.presets.names()                # what there is

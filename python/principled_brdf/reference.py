@@ -1,4 +1,4 @@
-"""The float64 reference (SPEC §3): slow, plain, and the yardstick for everything else."""
+"""The float64 reference (README "The model"): slow, plain, and the yardstick for everything else."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
-from ._validate import as_real_array, broadcast_leading, directions, model_index, require_in_domain
+from ._validate import as_real_array, broadcast_leading, directions, flag, model_index, require_in_domain
 from .material import Material
 
 __all__ = ["eval", "eval_lobes", "Lobes", "sample", "pdf", "lobe_probabilities", "Sample", "SPECULAR_SAMPLERS"]
@@ -17,7 +17,7 @@ SPECULAR_SAMPLERS = {"visible": 0, "distribution": 1}
 
 
 class Lobes(NamedTuple):
-    """The four lobes of SPEC §3, each ``(..., 3)``, already weighted as they enter the sum."""
+    """The four lobes of README "The model", each ``(..., 3)``, already weighted as they enter the sum."""
 
     diffuse: np.ndarray  # diffuse + subsurface, times (1 - metallic)
     sheen: np.ndarray  # times (1 - metallic)
@@ -42,6 +42,7 @@ def _prepare(material, wi, wo, model):
 def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False) -> np.ndarray:
     """f(wi, wo) in 1/sr as float64 ``(..., 3)``; times cos θl if ``cosine``."""
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, wi, wo, model)
+    cosine = flag("cosine", cosine)
     f = _core.reference_eval(wi_rows, wo_rows, params, model_id, False)
     if cosine:
         f *= np.maximum(wi_rows[:, 2:3], 0.0)
@@ -51,6 +52,7 @@ def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool 
 def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False) -> Lobes:
     """The four lobes as a :class:`Lobes` of float64 ``(..., 3)`` arrays."""
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, wi, wo, model)
+    cosine = flag("cosine", cosine)
     lobes = _core.reference_eval(wi_rows, wo_rows, params, model_id, True)
     if cosine:
         lobes *= np.maximum(wi_rows[:, None, 2:3], 0.0)
@@ -77,7 +79,7 @@ def specular_sampler_index(specular_sampler) -> int:
 
 
 def uniforms(name: str, value) -> np.ndarray:
-    """A float64 ``(..., 3)`` array of numbers in [0, 1], checked (SPEC §7)."""
+    """A float64 ``(..., 3)`` array of numbers in [0, 1], checked (README "Bad input")."""
     array = as_real_array(name, value)
     if array.ndim == 0 or array.shape[-1] != 3:
         raise ValueError(f"{name}: expected shape (..., 3) with (u0, u1, u2) on the last axis, got {array.shape}")

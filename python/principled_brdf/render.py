@@ -8,15 +8,47 @@ directional light plus a constant ambient term. Returns linear RGB; use
 
 from __future__ import annotations
 
+import numbers
 import struct
 import zlib
 
 import numpy as np
 
+from ._validate import as_real_array, require_finite, require_in_domain
 from ._batch import eval as _eval
 from .material import Material
 
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
+
+
+MAX_RESOLUTION = 16384
+
+
+def _resolution(value) -> int:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Integral, np.integer)):
+        raise TypeError(f"resolution: expected an integer, got {type(value).__name__}")
+    if not 2 <= value <= MAX_RESOLUTION:
+        raise ValueError(f"resolution: expected 2 to {MAX_RESOLUTION} pixels, got {value}")
+    return int(value)
+
+
+def _light_direction(value) -> np.ndarray:
+    light = as_real_array("light", value)
+    if light.shape != (3,):
+        raise ValueError(f"light: expected a 3-vector towards the light, got shape {light.shape}")
+    require_finite("light", light)
+    length = float(np.linalg.norm(light))
+    if not 0.0 < length < np.inf:
+        raise ValueError(f"light: expected a non-zero direction, got {light.tolist()}")
+    return light / length
+
+
+def _non_negative(name: str, value) -> float:
+    array = as_real_array(name, value)
+    if array.shape != ():
+        raise ValueError(f"{name}: expected one number, got shape {array.shape}")
+    require_in_domain(name, array, 0.0, np.inf)
+    return float(array)
 
 
 def sphere_frames(resolution: int):
@@ -27,8 +59,7 @@ def sphere_frames(resolution: int):
     vector ``d`` (3,) to each pixel's local shading frame, ``(H, W, 3)`` float32
     (pixels off the sphere get the normal, so every vector is valid).
     """
-    if int(resolution) != resolution or resolution < 2:
-        raise ValueError(f"resolution: expected an integer >= 2, got {resolution!r}")
+    resolution = _resolution(resolution)
     coords = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
     x, y = np.meshgrid(coords, -coords)  # row 0 at the top
     r2 = x * x + y * y
@@ -59,10 +90,13 @@ def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT
     renders one sphere per material, ``S + (resolution, resolution, 3)``, in one
     kernel call. Background is 0.
     """
+    light = _light_direction(light)
+    light_intensity = _non_negative("light_intensity", light_intensity)
+    ambient = _non_negative("ambient", ambient)
     inside, to_local = sphere_frames(resolution)
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
-    radiance = light_intensity * _eval(material, wi, wo, cosine=True, model=model)
-    radiance += ambient * np.asarray(material.base_color, dtype=np.float32)
+    radiance = np.float32(light_intensity) * _eval(material, wi, wo, cosine=True, model=model)
+    radiance += np.float32(ambient) * np.asarray(material.base_color, dtype=np.float32)
     radiance[..., ~inside, :] = 0.0
     return radiance
 

@@ -60,6 +60,31 @@ inline bool uniform_material(const ParamSlot* params) {
     return true;
 }
 
+// The direction check of README "Bad input": a direction w passes when
+//     (1 - tolerance)² <= wx² + wy² + wz² <= (1 + tolerance)²,
+// the squares and sums taken in float64 in this order. The squares of floats
+// are exact in float64, so the result does not depend on contraction into
+// fused multiply-adds, and the Python side (numpy, float64) reaches the same
+// decision for every vector: a direction passes everywhere or fails everywhere.
+// The kernels first test the float32 squared length against bounds narrowed
+// by far more than its rounding error (fast_lowest, fast_highest), which only
+// accepts what the rule accepts, and decide any other batch lane by lane by
+// the rule itself.
+struct DirectionCheck {
+    bool enabled = false;
+    double length2_lowest = 0.0, length2_highest = 0.0;
+    float fast_lowest = 0.0f, fast_highest = 0.0f;
+};
+
+DirectionCheck direction_check(double tolerance);
+
+// The rule (scalar). `static`: one copy per translation unit, so a copy
+// compiled with AVX-512 flags is never linked into baseline code.
+static inline bool unit_length(float x, float y, float z, const DirectionCheck& check) {
+    const double length2 = static_cast<double>(x) * x + static_cast<double>(y) * y + static_cast<double>(z) * z;
+    return length2 >= check.length2_lowest && length2 <= check.length2_highest;  // false for NaN
+}
+
 struct EvalJob {
     Vec3Array wi, wo;
     ParamSlot params[kParamSlots];
@@ -71,11 +96,9 @@ struct EvalJob {
     // Output::kPdf: one float per element, for this specular sampler.
     float* pdf = nullptr;
     SpecularSampler sampler = SpecularSampler::kVisibleNormals;
-    // Direction check fused into the evaluation: squared lengths must lie in
-    // [length2_lowest, length2_highest]. Outputs are then written up to the
-    // first bad element only, so use it on outputs nobody else sees yet.
-    bool check_directions = false;
-    float length2_lowest = 0.0f, length2_highest = 0.0f;
+    // The direction check, fused into the evaluation. On a bad direction the
+    // outputs hold the results of some other elements only.
+    DirectionCheck check;
 
     bool uniform_material() const { return principled_brdf::uniform_material(params); }
 };
@@ -92,8 +115,7 @@ struct SampleJob {
     MutableVec3Array wi, weight;  // outputs, (N, 3) or (3, N)
     float* pdf = nullptr;         // output, N
     std::int32_t* lobe = nullptr; // output, N: 0 cosine, 1 specular, 2 clearcoat
-    bool check_directions = false;  // wo, as in EvalJob
-    float length2_lowest = 0.0f, length2_highest = 0.0f;
+    DirectionCheck check;  // of wo, as in EvalJob
 };
 
 // Instruction sets compiled into this build and supported by this CPU, best
@@ -106,28 +128,18 @@ int float_lanes(const std::string& isa);
 
 // Evaluates elements [0, n) with `threads` threads (0: all cores) on `isa`
 // ("" for the active one). Results are bit-identical for every thread count.
-// Returns -1, or with job.check_directions an element with a bad direction.
+// Returns -1 when every element was written, or with job.check enabled the
+// first element whose wi or wo fails it (then some elements are unwritten).
 std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa = "");
 
 // As eval, for sampling; returns -1 or an element whose wo is bad.
 std::int64_t sample(const SampleJob& job, std::int64_t n, int threads, const std::string& isa = "");
 
-// Squared-length bounds for directions within `tolerance` of unit length.
-template <class Job>
-void set_direction_check(Job& job, float tolerance) {
-    // |w| within [1 - tol, 1 + tol]  <=>  |w|² within [(1 - tol)², (1 + tol)²]
-    job.check_directions = true;
-    job.length2_lowest = (1.0f - tolerance) * (1.0f - tolerance);
-    job.length2_highest = (1.0f + tolerance) * (1.0f + tolerance);
-}
 
 // The counter-based uniforms sample() uses for elements first .. first + n - 1,
 // written as (n, 3) interleaved into out (scalar code, bit-identical to the kernels').
 void counter_uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n, float* out);
 
-// Index of the first element whose length differs from 1 by more than
-// `tolerance` or which is not finite, or -1 if there is none.
-std::int64_t first_bad_direction(const Vec3Array& directions, std::int64_t n, float tolerance, int threads);
 
 int hardware_threads();
 

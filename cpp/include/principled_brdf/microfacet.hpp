@@ -1,6 +1,6 @@
-// Microfacet toolkit in float64 (SPEC §4): the GTR family of Burley 2012
-// (seed 000, appendix B), anisotropic GGX with Smith masking, and anisotropic
-// Beckmann (seed 003, eq. 3-29/3-30). One small function per formula; each
+// Microfacet toolkit in float64 (README "Microfacet toolkit"): the GTR family of
+// Burley 2012 (appendix B), anisotropic GGX with Smith masking, and anisotropic
+// Beckmann (Walter et al. 2007; its Smith Λ as in Heitz 2014). One small function per formula; each
 // names the equation it implements.
 //
 // Conventions: local shading frame, n = (0,0,1), tangent x, bitangent y; every
@@ -270,7 +270,7 @@ inline double ggx_g1(const Vec3& w, double alpha_x, double alpha_y) {
     return 2.0 * cos_abs / (cos_abs + std::sqrt(cos_abs * cos_abs + p2));
 }
 
-// G1(w) / |wz| = 2 / (|wz| + sqrt(wz² + p²)): finite at grazing (it is 2 S(w) of SPEC §3).
+// G1(w) / |wz| = 2 / (|wz| + sqrt(wz² + p²)): finite at grazing (it is 2 S(w) of README "The model").
 inline double ggx_g1_over_cos(const Vec3& w, double alpha_x, double alpha_y) {
     const double p2 = projected_roughness2_sin2(w, alpha_x, alpha_y);
     const double cos_abs = std::abs(w.z);
@@ -283,7 +283,7 @@ inline double ggx_g2_separable(const Vec3& wi, const Vec3& wo, double alpha_x, d
 }
 
 // Height-correlated Smith G2 = 1 / (1 + Λ(wi) + Λ(wo)), with Λ = (r - |z|) / (2|z|),
-// r = sqrt(z² + p²):  G2 = 2 |zi| |zo| / (|zi| ro + |zo| ri)  (cf. seed 003 eq. 3-37).
+// r = sqrt(z² + p²):  G2 = 2 |zi| |zo| / (|zi| ro + |zo| ri)  (cf. Heitz 2014, the height-correlated form).
 inline double ggx_g2_height_correlated(const Vec3& wi, const Vec3& wo, double alpha_x, double alpha_y) {
     const double zi = std::abs(wi.z);
     const double zo = std::abs(wo.z);
@@ -329,7 +329,7 @@ inline double ggx_pdf_visible_h(const Vec3& h, const Vec3& wo, double alpha_x, d
 }
 
 // ---------------------------------------------------------------------------
-// Anisotropic Beckmann (seed 003): slope density P22 = exp(-(x²/αx² + y²/αy²)) / (π αx αy).
+// Anisotropic Beckmann (Walter et al. 2007, Heitz 2014 §5.2): slope density P22 = exp(-(x²/αx² + y²/αy²)) / (π αx αy).
 
 // Eq. (3-29) made anisotropic by eq. (3-24):
 //   D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴),

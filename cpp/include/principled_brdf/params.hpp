@@ -1,4 +1,4 @@
-// The 11 parameters of SPEC §2: names, defaults, domains.
+// The 11 parameters of README "The model": names, defaults, domains.
 // Shared by the reference, the batch layer and (through the bindings) Python,
 // so the table exists exactly once.
 #pragma once
@@ -34,12 +34,12 @@ struct ParamInfo {
     int slots;  // 3 for base_color, else 1
     double default_value[3];
     double lower;
-    double upper;  // +inf where SPEC §2 gives no upper bound
+    double upper;  // +inf where the domain has no upper bound
 };
 
 inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
-// Defaults are the BRDF Explorer's (seed 002, disney.brdf header).
+// Defaults are the BRDF Explorer's (disney.brdf's parameter block).
 inline constexpr std::array<ParamInfo, 11> kParams{{
     {"base_color", kBaseColorR, 3, {0.82, 0.67, 0.16}, 0.0, kUnbounded},
     {"metallic", kMetallic, 1, {0.0}, 0.0, 1.0},
@@ -54,7 +54,7 @@ inline constexpr std::array<ParamInfo, 11> kParams{{
     {"clearcoat_gloss", kClearcoatGloss, 1, {1.0}, 0.0, 1.0},
 }};
 
-// Which specular masking term the model uses (SPEC §3).
+// Which specular masking term the model uses (README "The model").
 enum class Model : int {
     kDisney2014 = 0,  // anisotropic Smith GGX with the material's alpha_x, alpha_y
     kDisney2012 = 1,  // isotropic Smith GGX with alpha_g = (0.5 + roughness / 2)^2

@@ -1,4 +1,4 @@
-// Float64 reference of the Disney principled BRDF (SPEC §3), one function per
+// Float64 reference of the Disney principled BRDF (README "The model"), one function per
 // lobe, then their sum. Plain on purpose: this is the yardstick the SIMD kernel
 // is measured against, so it reads like the spec. Two liberties keep it
 // accurate to the last digits where the literal form cancels, both exact for
@@ -51,7 +51,7 @@ struct Material {
     }
 };
 
-// The four lobes of SPEC §3, each already weighted as it enters the sum.
+// The four lobes of README "The model", each already weighted as it enters the sum.
 struct Lobes {
     Vector3d diffuse = Vector3d::Zero();    // diffuse + subsurface, times (1 - metallic)
     Vector3d sheen = Vector3d::Zero();      // times (1 - metallic)
@@ -138,7 +138,7 @@ inline Vector3d sheen_lobe(const Material& m, const Geometry& g) {
     return schlick_weight_of_complement(g.one_minus_cos_theta_d) * m.sheen * sheen_color * (1.0 - m.metallic);
 }
 
-// Anisotropic GTR2 (GGX), seed 000 eq. 13.
+// Anisotropic GTR2 (GGX), Burley 2012 eq. 13.
 inline double gtr2_aniso_d(const Geometry& g, double alpha_x, double alpha_y) {
     const double hx = g.h.x() / alpha_x;
     const double hy = g.h.y() / alpha_y;
@@ -153,14 +153,15 @@ inline double smith_ggx_aniso_s(const Vector3d& w, double alpha_x, double alpha_
     return 1.0 / (w.z() + std::sqrt(sx * sx + sy * sy + w.z() * w.z()));
 }
 
-// Siso(w, g) = G1(w) / (2 n·w) for isotropic Smith GGX with alpha g.
-inline double smith_ggx_iso_s(double cos_theta, double alpha) {
+// Siso(w, g) = 1 / (n·w + sqrt(g² + (n·w)² - g² (n·w)²)) = G1(w) / (2 n·w) for
+// isotropic Smith GGX with alpha g. For a unit w, g² (1 - (n·w)²) is
+// g² ((w·x)² + (w·y)²): written so, nothing cancels when g is large.
+inline double smith_ggx_iso_s(const Vector3d& w, double alpha) {
     const double a2 = alpha * alpha;
-    const double c2 = cos_theta * cos_theta;
-    return 1.0 / (cos_theta + std::sqrt(a2 + c2 - a2 * c2));
+    return 1.0 / (w.z() + std::sqrt(a2 * (w.x() * w.x() + w.y() * w.y()) + w.z() * w.z()));
 }
 
-// Primary specular Gs Fs Ds; the model chooses Gs (SPEC §3).
+// Primary specular Gs Fs Ds; the model chooses Gs (README "The model").
 inline Vector3d specular_lobe(const Material& m, const Vector3d& wi, const Vector3d& wo, const Geometry& g,
                               Model model) {
     double alpha_x, alpha_y;
@@ -170,7 +171,7 @@ inline Vector3d specular_lobe(const Material& m, const Vector3d& wi, const Vecto
     double gs;
     if (model == Model::kDisney2012) {
         const double alpha_g = (0.5 + 0.5 * m.roughness) * (0.5 + 0.5 * m.roughness);
-        gs = smith_ggx_iso_s(g.cos_theta_l, alpha_g) * smith_ggx_iso_s(g.cos_theta_v, alpha_g);
+        gs = smith_ggx_iso_s(wi, alpha_g) * smith_ggx_iso_s(wo, alpha_g);
     } else {
         gs = smith_ggx_aniso_s(wi, alpha_x, alpha_y) * smith_ggx_aniso_s(wo, alpha_x, alpha_y);
     }
@@ -185,10 +186,10 @@ inline double gtr1_d(const Geometry& g, double alpha) {
 }
 
 // Clearcoat 0.25 clearcoat Gr Fr Dr, alpha = mix(0.1, 0.001, clearcoat_gloss).
-inline Vector3d clearcoat_lobe(const Material& m, const Geometry& g) {
+inline Vector3d clearcoat_lobe(const Material& m, const Vector3d& wi, const Vector3d& wo, const Geometry& g) {
     const double dr = gtr1_d(g, mix(0.1, 0.001, m.clearcoat_gloss));
     const double fr = mix(0.04, 1.0, schlick_weight_of_complement(g.one_minus_cos_theta_d));
-    const double gr = smith_ggx_iso_s(g.cos_theta_l, 0.25) * smith_ggx_iso_s(g.cos_theta_v, 0.25);
+    const double gr = smith_ggx_iso_s(wi, 0.25) * smith_ggx_iso_s(wo, 0.25);
     return Vector3d::Constant(0.25 * m.clearcoat * gr * fr * dr);
 }
 
@@ -201,7 +202,7 @@ inline Lobes eval_lobes(const Material& m, const Vector3d& wi, const Vector3d& w
     lobes.diffuse = diffuse_lobe(m, g);
     lobes.sheen = sheen_lobe(m, g);
     lobes.specular = specular_lobe(m, wi, wo, g, model);
-    lobes.clearcoat = clearcoat_lobe(m, g);
+    lobes.clearcoat = clearcoat_lobe(m, wi, wo, g);
     return lobes;
 }
 

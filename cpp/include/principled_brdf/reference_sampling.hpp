@@ -1,4 +1,4 @@
-// Float64 reference of importance sampling and its pdf (SPEC §5), exactly as
+// Float64 reference of importance sampling and its pdf (README "Sampling and pdf"), exactly as
 // the README section "Sampling and pdf" defines them: a mixture of three lobes
 // (0 cosine, 1 primary specular, 2 clearcoat), the lobe chosen by u0, the
 // direction drawn from u1, u2. The SIMD kernel implements the same definition
@@ -24,7 +24,7 @@ namespace principled_brdf::reference {
 // How the primary specular lobe draws its half vector (README "Sampling and pdf").
 enum class SpecularSampler : int {
     kVisibleNormals = 0,  // Dupuy & Benyoub 2023 spherical caps (default)
-    kDistribution = 1,    // seed 000 eq. 14-15, the paper's own
+    kDistribution = 1,    // Burley 2012 eq. 14-15, the paper's own
 };
 
 // One drawn direction with its mixture pdf and weight f cos θl / pdf.
@@ -35,10 +35,10 @@ struct Sample {
     int lobe = 0;  // 0 cosine, 1 primary specular, 2 clearcoat
 };
 
-// lum(c) = 0.3 R + 0.6 G + 0.1 B (the shader's luminance, Cdlum of SPEC §3).
+// lum(c) = 0.3 R + 0.6 G + 0.1 B (the shader's luminance, Cdlum of README "The model").
 inline double luminance(const Vector3d& c) { return 0.3 * c.x() + 0.6 * c.y() + 0.1 * c.z(); }
 
-// Clearcoat GTR1 alpha, ac = mix(0.1, 0.001, clearcoat_gloss) (SPEC §3).
+// Clearcoat GTR1 alpha, ac = mix(0.1, 0.001, clearcoat_gloss) (README "The model").
 inline double clearcoat_alpha(const Material& m) { return mix(0.1, 0.001, m.clearcoat_gloss); }
 
 // ---------------------------------------------------------------------------
@@ -99,7 +99,7 @@ inline Vector3d sample_visible_normal(const Vector3d& wo, double alpha_x, double
     return length2 > 0.0 ? Vector3d(h_unnormalised / std::sqrt(length2)) : Vector3d::Zero();
 }
 
-// Lobe 1 option, the paper's distribution sampling (seed 000 eq. 14-15, multiplied
+// Lobe 1 option, the paper's distribution sampling (Burley 2012 eq. 14-15, multiplied
 // through by sqrt(1 - u2)): h ∝ (sqrt(u2) ax cos 2πu1, sqrt(u2) ay sin 2πu1, sqrt(1 - u2)).
 // Never the zero vector (ax, ay >= 0.001); u2 = 1 gives a horizontal h.
 inline Vector3d sample_distribution_normal(double alpha_x, double alpha_y, double u1, double u2) {
@@ -109,7 +109,7 @@ inline Vector3d sample_distribution_normal(double alpha_x, double alpha_y, doubl
         .normalized();
 }
 
-// Lobe 2, GTR1 (gamma = 1, SPEC §4 / seed 000 appendix B eq. 5) with a = ac, φ = 2π u1:
+// Lobe 2, GTR1 (gamma = 1, Burley 2012 appendix B eq. 5) with a = ac, φ = 2π u1:
 //   cos²θh = (1 - a^(2(1 - u2))) / (1 - a²),   sin²θh = a² (a^(-2 u2) - 1) / (1 - a²),
 // each written as a ratio of expm1 (a^x = exp(x ln a)) so that neither cancels,
 // not even as a -> 1; a >= 1 is the uniform limit cos²θh = 1 - u2, sin²θh = u2
@@ -136,7 +136,7 @@ inline Vector3d sample_gtr1_normal(double alpha, double u1, double u2) {
 // Lobe 0: cos θl / π.
 inline double pdf_cosine(const Geometry& g) { return g.cos_theta_l / kPi; }
 
-// Lobe 1, visible normals: G1(wo) Ds(h) / (4 cos θv) with anisotropic Smith G1 (SPEC §4),
+// Lobe 1, visible normals: G1(wo) Ds(h) / (4 cos θv) with anisotropic Smith G1 (Heitz 2014),
 // = Ds(h) / (2 (cos θv + sqrt((wo·x ax)² + (wo·y ay)² + cos²θv))) = Ds S(wo) / 2.
 inline double pdf_specular_visible(const Geometry& g, const Vector3d& wo, double alpha_x, double alpha_y) {
     return 0.5 * gtr2_aniso_d(g, alpha_x, alpha_y) * smith_ggx_aniso_s(wo, alpha_x, alpha_y);

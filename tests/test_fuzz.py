@@ -1,0 +1,435 @@
+"""A fuzz of every public entry point with hostile arguments (README "Bad input").
+
+Hypothesis draws shapes, dtypes, layouts, strides, misalignment, aliasing,
+NaN/inf, values at and beyond the domains' edges and option values. Every call
+must either
+
+* return finite results, every element written (``out=`` buffers start as
+  NaN), that agree with the float64 reference where one exists, or
+* raise ``ValueError`` or ``TypeError`` whose message names an argument,
+
+and nothing else: no other exception, no NaN for in-domain input, no crash.
+Derandomised (the same examples every run) and bounded, so it stays fast.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import principled_brdf as pb
+from principled_brdf._validate import unit_length
+
+FUZZ = settings(derandomize=True, max_examples=150, deadline=None, database=None,
+                suppress_health_check=list(HealthCheck))
+ISAS = pb.cpu_info()["available"]
+
+# Names an error message may start with or mention.
+ARGUMENT_NAMES = ("wi", "wo", "u", "out", "material", "model", "layout", "threads", "check", "cosine", "isa",
+                  "seed", "specular_sampler", "n", "first", "samples", "cos_theta_o", "resolution", "light",
+                  "light_intensity", "ambient", "leading shapes", "h", "w", "u1", "u2", "alpha", "alpha_x",
+                  "alpha_y", "gamma", "cos_theta_h", "closed_forms", "params", *pb.PARAMETERS)
+
+
+def assert_names_an_argument(error: Exception) -> None:
+    message = str(error)
+    assert any(re.search(rf"(^|[\s,(]){re.escape(name)}(\[|:|\s|,|$)", message) for name in ARGUMENT_NAMES), message
+
+
+def outcome(call):
+    """The call's result, or None after a ValueError/TypeError that names an argument."""
+    try:
+        return call()
+    except (ValueError, TypeError) as error:
+        assert_names_an_argument(error)
+        return None
+
+
+# ------------------------------------------------------------------ hostile arrays
+
+def unit_vectors(rng, leading) -> np.ndarray:
+    v = rng.normal(size=tuple(leading) + (3,))
+    v[..., 2] = np.abs(v[..., 2]) + 0.05 * rng.random()
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def misaligned(array: np.ndarray) -> np.ndarray:
+    raw = np.empty(array.nbytes + 1, np.uint8)
+    view = raw[1:].view(array.dtype).reshape(array.shape)
+    view[...] = array
+    return view
+
+
+def strided(array: np.ndarray) -> np.ndarray:
+    bigger = np.repeat(array[None], 2, axis=0)
+    return bigger[0] if array.ndim == 0 else np.stack([array, array], axis=-1)[..., 0]
+
+
+def fortran(array: np.ndarray) -> np.ndarray:
+    return np.asfortranarray(array)
+
+
+FAULTS = ("none", "nan", "inf", "huge", "long", "short", "edge", "zero", "below")
+
+
+def inject(array: np.ndarray, fault: str, rng) -> np.ndarray:
+    """One element of a float (..., 3) array made hostile."""
+    if fault == "none" or array.size == 0 or array.shape[-1] != 3:
+        return array
+    flat = array.reshape(-1, 3).copy()
+    i = int(rng.integers(len(flat)))
+    if fault == "nan":
+        flat[i, int(rng.integers(3))] = np.nan
+    elif fault == "inf":
+        flat[i, int(rng.integers(3))] = -np.inf
+    elif fault == "huge":
+        flat[i] = (1e300, 0, 1e300)
+    elif fault == "long":
+        flat[i] *= 1.0 + 1e-3 * (1 + rng.random())
+    elif fault == "short":
+        flat[i] *= 1.0 - 1e-3 * (1 + rng.random())
+    elif fault == "edge":  # at the tolerance, on either side once rounded to float32
+        flat[i] *= 1.001 if rng.random() < 0.5 else 0.999
+    elif fault == "zero":
+        flat[i] = 0
+    elif fault == "below":
+        flat[i, 2] = -abs(flat[i, 2])
+    return flat.reshape(array.shape)
+
+
+DTYPES = ("float32", "float64", "float16", "int64", "bool", "object", "str", "complex", "timedelta", "list")
+LAYOUT_FAULTS = ("contiguous", "contiguous", "misaligned", "strided", "fortran")
+
+
+def convert(array: np.ndarray, dtype: str, layout: str):
+    if dtype == "list":
+        return array.tolist()
+    if dtype == "str":
+        return array.astype(str)
+    if dtype == "timedelta":
+        return array.astype(np.int64).astype("timedelta64[s]")
+    if dtype == "object":
+        return array.astype(object)
+    converted = array.astype({"complex": np.complex64}.get(dtype, dtype))
+    if layout == "misaligned" and converted.dtype.itemsize > 1:
+        return misaligned(converted)
+    if layout == "strided":
+        return strided(converted)
+    if layout == "fortran":
+        return fortran(converted)
+    return converted
+
+
+@st.composite
+def direction_argument(draw, leading, rng):
+    """A direction argument of (about) ``leading`` shape, possibly hostile."""
+    shape_kind = draw(st.sampled_from(("same", "same", "same", "single", "broadcast", "wrong")))
+    if shape_kind == "single":
+        shape = ()
+    elif shape_kind == "broadcast" and leading:
+        shape = (1,) + tuple(leading[1:])
+    else:
+        shape = tuple(leading)
+    array = unit_vectors(rng, shape)
+    if shape_kind == "wrong":
+        array = array[..., : draw(st.sampled_from((0, 2)))]
+    array = inject(array, draw(st.sampled_from(FAULTS)), rng)
+    dtype = draw(st.sampled_from(DTYPES[:2] * 4 + DTYPES))
+    return convert(array, dtype, draw(st.sampled_from(LAYOUT_FAULTS)))
+
+
+PARAMETER_VALUES = {
+    "good": lambda rng, info, n: rng.random(3) if info.slots == 3 else float(rng.random()),
+    "per_element": lambda rng, info, n: rng.random((n, 3) if info.slots == 3 else (n,)),
+    "edge": lambda rng, info, n: np.full(3, info.lower) if info.slots == 3 else info.upper if np.isfinite(info.upper) else 1e4,
+    "nan": lambda rng, info, n: np.nan,
+    "negative": lambda rng, info, n: -1e-9,
+    "above": lambda rng, info, n: 1.0 + 1e-9 if np.isfinite(info.upper) else 1e30,
+    "string": lambda rng, info, n: "0.5",
+    "wrong_shape": lambda rng, info, n: rng.random((n + 1,)),
+    "float32_array": lambda rng, info, n: misaligned(rng.random((n, 3) if info.slots == 3 else (n,)).astype(np.float32)),
+}
+
+
+@st.composite
+def material_argument(draw, n, rng):
+    kwargs = {}
+    for name in draw(st.lists(st.sampled_from(list(pb.PARAMETERS)), max_size=4, unique=True)):
+        kind = draw(st.sampled_from(("good", "good", "per_element", "edge") + tuple(PARAMETER_VALUES)))
+        kwargs[name] = PARAMETER_VALUES[kind](rng, pb.PARAMETERS[name], n)
+    return kwargs
+
+
+OPTION_VALUES = {
+    "model": ("disney2014", "disney2012", "disney2015", None, 2014),
+    "threads": (None, 1, 2, 3, 0, -1, 2**31, 1.5, "2", True),
+    "check": (True, True, True, False, np.True_, None, "no", np.array([True, False])),
+    "cosine": (False, True, np.bool_(True), 1, np.array([True])),
+    "isa": (None, *ISAS, "avx1024", 3),
+    "layout": ("aos", "aos", "aos", "soa", "AOS", None),
+    "specular_sampler": ("visible", "distribution", "best"),
+    "seed": (0, 7, 2**64 - 1, 2**64, -1, 1.0, None),
+}
+
+
+@st.composite
+def options(draw, names):
+    chosen = {}
+    for name in names:
+        if draw(st.booleans()):
+            chosen[name] = draw(st.sampled_from(OPTION_VALUES[name]))
+    return chosen
+
+
+def rng_from(seed: int) -> np.random.Generator:
+    return np.random.default_rng(seed)
+
+
+LEADING = st.sampled_from([(0,), (1,), (5,), (17,), (2, 9), (40,), (3, 1, 4)])
+
+
+def soa(argument, layout):
+    """An aos argument moved to soa when the call asks for it (hostile ones included)."""
+    if layout == "soa" and isinstance(argument, np.ndarray) and argument.ndim >= 1 and argument.dtype.kind == "f":
+        return np.moveaxis(argument, -1, 0).copy()
+    return argument
+
+
+def float32_pairs(wi, wo, layout):
+    """What the kernel read, as float32 (..., 3), for comparison with the reference."""
+    to = lambda w: np.moveaxis(np.asarray(w, np.float32), 0, -1) if layout == "soa" else np.asarray(w, np.float32)  # noqa: E731
+    return to(wi), to(wo)
+
+
+def assert_matches_reference(actual, expected, wi, wo):
+    """SIMD vs float64 on the same float32 inputs, where both directions are clear of the horizon."""
+    actual, expected = np.broadcast_arrays(np.asarray(actual, np.float64), expected)
+    clear = np.broadcast_to(((wi[..., 2] > 0.05) & (wo[..., 2] > 0.05))[..., None], expected.shape)
+    scale = np.maximum(np.abs(expected), 1e-6 * max(1.0, float(np.abs(expected).max(initial=0.0))))
+    error = np.where(clear, np.abs(actual - expected) / scale, 0.0)
+    assert error.max(initial=0.0) <= 1e-3, error.max()
+
+
+# ------------------------------------------------------------------ the batched calls
+
+@FUZZ
+@given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1),
+       entry=st.sampled_from(("eval", "eval_out", "eval_lobes", "pdf")))
+def test_fuzz_evaluation(data, leading, seed, entry):
+    rng = rng_from(seed)
+    n = int(np.prod(leading))
+    opts = data.draw(options(["model", "threads", "check", "cosine", "isa", "layout"] if entry != "pdf"
+                             else ["threads", "check", "isa", "layout", "specular_sampler"]))
+    layout = opts.get("layout", "aos")
+    wi = soa(data.draw(direction_argument(leading, rng)), layout)
+    wo = soa(data.draw(direction_argument(leading, rng)), layout)
+    material = outcome(lambda: pb.Material(**data.draw(material_argument(n, rng))))
+    if material is None:
+        return
+    out = None
+    if entry == "eval_out":
+        out_kind = data.draw(st.sampled_from(("fresh", "fresh", "alias_wi", "shifted", "misaligned", "float64",
+                                              "readonly", "wrong_shape")))
+        shape = tuple(leading) + (3,) if layout == "aos" else (3,) + tuple(leading)
+        out = np.full(shape, np.nan, np.float32)
+        if out_kind == "alias_wi" and isinstance(wi, np.ndarray) and wi.dtype == np.float32 and wi.shape == shape \
+                and wi.flags.c_contiguous and wi.flags.aligned:
+            out = wi
+        elif out_kind == "shifted" and out.size:
+            out = np.full(out.size + 1, np.nan, np.float32)[1:].reshape(shape)
+            if isinstance(wi, np.ndarray) and wi.dtype == np.float32 and wi.shape == shape:
+                base = np.empty(out.size + 1, np.float32)
+                base[:-1] = np.asarray(wi).ravel()
+                wi, out = base[:-1].reshape(shape), base[1:].reshape(shape)
+                out[...] = np.nan
+        elif out_kind == "misaligned":
+            out = misaligned(out)
+        elif out_kind == "float64":
+            out = out.astype(np.float64)
+        elif out_kind == "readonly":
+            out.flags.writeable = False
+        elif out_kind == "wrong_shape":
+            out = out[..., :2]
+    wi_seen = np.array(wi, dtype=np.float32, copy=True) if isinstance(wi, np.ndarray) and wi.dtype.kind == "f" else None
+    wo_seen = np.array(wo, dtype=np.float32, copy=True) if isinstance(wo, np.ndarray) and wo.dtype.kind == "f" else None
+
+    call = {"eval": lambda: pb.eval(material, wi, wo, **opts),
+            "eval_out": lambda: pb.eval(material, wi, wo, out=out, **opts),
+            "eval_lobes": lambda: pb.eval_lobes(material, wi, wo, **opts),
+            "pdf": lambda: pb.pdf(material, wi, wo, **opts)}[entry]
+    result = outcome(call)
+    if result is None:
+        return
+    arrays = list(result) if entry == "eval_lobes" else [result]
+    for array in arrays:
+        assert array.dtype == np.float32
+        assert np.isfinite(array).all(), "non-finite output for accepted input"
+    if entry == "eval_out":
+        assert result is out
+    if wi_seen is None or wo_seen is None or entry == "pdf":
+        return
+    a, b = float32_pairs(wi_seen, wo_seen, layout)
+    if not (unit_length(a).all() and unit_length(b).all()):
+        return  # check=False on non-unit directions: finite is all that is promised
+    reference = pb.reference.eval_lobes if entry == "eval_lobes" else pb.reference.eval
+    expected = reference(material, a, b, model=opts.get("model", "disney2014"),
+                         cosine=bool(opts.get("cosine", False)))
+    for actual, wanted in zip(arrays, list(expected) if entry == "eval_lobes" else [expected]):
+        actual = np.moveaxis(actual, 0, -1) if layout == "soa" else actual
+        assert_matches_reference(actual, wanted, *np.broadcast_arrays(a, b))
+
+
+@FUZZ
+@given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1), given_u=st.booleans())
+def test_fuzz_sampling(data, leading, seed, given_u):
+    rng = rng_from(seed)
+    n = int(np.prod(leading))
+    opts = data.draw(options(["model", "threads", "check", "isa", "layout", "specular_sampler", "seed"]))
+    layout = opts.get("layout", "aos")
+    wo = soa(data.draw(direction_argument(leading, rng)), layout)
+    if given_u:
+        u = rng.random(tuple(leading) + (3,))
+        fault = data.draw(st.sampled_from(("none", "none", "one", "above", "below", "nan")))
+        if fault != "none" and u.size:
+            u.reshape(-1)[int(rng.integers(u.size))] = {"one": 1.0, "above": 1 + 1e-12, "below": -1e-300,
+                                                       "nan": np.nan}[fault]
+        opts["u"] = soa(convert(u, data.draw(st.sampled_from(("float32", "float64", "int64", "str"))),
+                                data.draw(st.sampled_from(LAYOUT_FAULTS))), layout)
+    material = outcome(lambda: pb.Material(**data.draw(material_argument(n, rng))))
+    if material is None:
+        return
+    s = outcome(lambda: pb.sample(material, wo, **opts))
+    if s is None:
+        return
+    for array in (s.wi, s.pdf, s.weight):
+        assert np.isfinite(array).all(), "non-finite sample for accepted input"
+    assert np.isin(s.lobe, (0, 1, 2)).all()
+    assert (s.pdf >= 0).all() and (s.weight >= 0).all()
+
+
+@FUZZ
+@given(data=st.data(), seed=st.integers(0, 2**32 - 1))
+def test_fuzz_albedo_and_uniforms(data, seed):
+    rng = rng_from(seed)
+    cos = data.draw(st.sampled_from((0.5, 1.0, 0.0, -0.1, 1.5, np.nan, "0.5", np.array([0.2, 0.9]),
+                                     np.array([[0.3], [0.7]]))))
+    samples = data.draw(st.sampled_from((2, 64, 1, 0, 2**40, 3.0, None)))
+    material = outcome(lambda: pb.Material(**data.draw(material_argument(2, rng))))
+    if material is not None:
+        result = outcome(lambda: pb.albedo(material, cos, samples=samples,
+                                           **data.draw(options(["model", "threads", "seed", "specular_sampler"]))))
+        if result is not None:
+            assert np.isfinite(result.total).all() and np.isfinite(result.total_error).all()
+    n = data.draw(st.sampled_from((0, 1, 5, -1, 2**62, 2.0, None)))
+    first = data.draw(st.sampled_from((0, 7, 2**63 - 6, 2**63, -1, "0")))
+    u = outcome(lambda: pb.random_uniforms(data.draw(st.sampled_from(OPTION_VALUES["seed"])), n, first))
+    if u is not None:
+        assert u.shape == (n, 3) and np.all((u >= 0) & (u < 1))
+
+
+# ------------------------------------------------------------------ the float64 reference and the toolkit
+
+@FUZZ
+@given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1),
+       entry=st.sampled_from(("eval", "eval_lobes", "pdf", "sample", "lobe_probabilities")))
+def test_fuzz_reference(data, leading, seed, entry):
+    rng = rng_from(seed)
+    n = int(np.prod(leading))
+    wi = data.draw(direction_argument(leading, rng))
+    wo = data.draw(direction_argument(leading, rng))
+    material = outcome(lambda: pb.Material(**data.draw(material_argument(n, rng))))
+    if material is None:
+        return
+    opts = data.draw(options(["model"] + (["cosine"] if entry.startswith("eval") else [])
+                             + (["specular_sampler"] if entry in ("pdf", "sample") else [])))
+    u = convert(rng.random(tuple(leading) + (3,)), data.draw(st.sampled_from(("float64", "float32", "str"))),
+                data.draw(st.sampled_from(LAYOUT_FAULTS)))
+    if entry == "lobe_probabilities":
+        opts.pop("model", None)
+    call = {"eval": lambda: pb.reference.eval(material, wi, wo, **opts),
+            "eval_lobes": lambda: pb.reference.eval_lobes(material, wi, wo, **opts),
+            "pdf": lambda: pb.reference.pdf(material, wi, wo, **opts),
+            "sample": lambda: pb.reference.sample(material, wo, u, **opts),
+            "lobe_probabilities": lambda: pb.reference.lobe_probabilities(material, wo)}[entry]
+    result = outcome(call)
+    if result is not None:
+        for array in (result if isinstance(result, tuple) else [result]):
+            assert np.isfinite(array).all()
+
+
+TOOLKIT = {
+    "gtr_d": ("cos_theta_h", "alpha", "gamma"),
+    "gtr_pdf": ("h", "alpha", "gamma"),
+    "gtr_sample": ("u1", "u2", "alpha", "gamma"),
+    "ggx_d": ("h", "alpha_x", "alpha_y"),
+    "ggx_pdf": ("h", "alpha_x", "alpha_y"),
+    "ggx_sample": ("u1", "u2", "alpha_x", "alpha_y"),
+    "ggx_sample_visible": ("wo", "u1", "u2", "alpha_x", "alpha_y"),
+    "ggx_pdf_visible": ("h", "wo", "alpha_x", "alpha_y"),
+    "ggx_lambda": ("w", "alpha_x", "alpha_y"),
+    "ggx_g1": ("w", "alpha_x", "alpha_y"),
+    "ggx_g2_separable": ("wi", "wo", "alpha_x", "alpha_y"),
+    "ggx_g2_height_correlated": ("wi", "wo", "alpha_x", "alpha_y"),
+    "beckmann_d": ("h", "alpha_x", "alpha_y"),
+    "beckmann_pdf": ("h", "alpha_x", "alpha_y"),
+    "beckmann_sample": ("u1", "u2", "alpha_x", "alpha_y"),
+    "beckmann_lambda": ("w", "alpha_x", "alpha_y"),
+    "beckmann_g1": ("w", "alpha_x", "alpha_y"),
+}
+SCALAR_VALUES = (0.5, 1.0, 1e-6, 0.0, -0.5, 1.5, np.nan, np.inf, "a", None, 1e300)
+
+
+@FUZZ
+@given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1), name=st.sampled_from(sorted(TOOLKIT)))
+def test_fuzz_toolkit(data, leading, seed, name):
+    rng = rng_from(seed)
+    arguments = []
+    for argument in TOOLKIT[name]:
+        if argument in ("h", "w", "wi", "wo"):
+            arguments.append(data.draw(direction_argument(leading, rng)))
+        elif data.draw(st.booleans()):
+            arguments.append(convert(rng.random(leading) * 0.98 + 0.01, data.draw(st.sampled_from(DTYPES[:4])),
+                                     data.draw(st.sampled_from(LAYOUT_FAULTS))))
+        else:
+            arguments.append(data.draw(st.sampled_from(SCALAR_VALUES)))
+    if TOOLKIT[name][-1] == "gamma" and isinstance(arguments[-1], float) and arguments[-1] == 0.5:
+        arguments[-1] = 2.0
+    result = outcome(lambda: getattr(pb.microfacet, name)(*arguments))
+    if result is not None:
+        assert np.isfinite(result).all()
+
+
+# ------------------------------------------------------------------ Material and render_sphere
+
+@FUZZ
+@given(data=st.data(), seed=st.integers(0, 2**32 - 1))
+def test_fuzz_material_and_render(data, seed):
+    rng = rng_from(seed)
+    material = outcome(lambda: pb.Material(**data.draw(material_argument(3, rng))))
+    if material is None:
+        return
+    resolution = data.draw(st.sampled_from((8, 2, 1, 0, None, 2.5, 10**9, "8")))
+    kwargs = {}
+    if data.draw(st.booleans()):
+        kwargs["light"] = data.draw(st.sampled_from(((0, 0, 1), (0, 0, 0), (np.nan, 0, 1), (1, 2), "up",
+                                                     (1e300, 0, 1e300))))
+    if data.draw(st.booleans()):
+        kwargs["ambient"] = data.draw(st.sampled_from((0.0, 0.1, -1.0, np.nan)))
+    if data.draw(st.booleans()):
+        kwargs["light_intensity"] = data.draw(st.sampled_from((3.0, 0.0, -1.0, np.inf)))
+    if not material.is_uniform:
+        return  # per-element materials need the image's shape; the batched calls cover them
+    image = outcome(lambda: pb.render.render_sphere(material, resolution, **kwargs))
+    if image is not None:
+        assert image.shape == (resolution, resolution, 3) and np.isfinite(image).all()
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_fuzz_sees_every_isa(isa):
+    # the option draws include each available isa; make sure each one ran at least on good input
+    wi = unit_vectors(rng_from(1), (33,)).astype(np.float32)
+    assert np.isfinite(pb.eval(pb.Material(), wi, wi[::-1].copy(), isa=isa)).all()

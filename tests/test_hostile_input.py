@@ -1,0 +1,306 @@
+"""Regression tests for hostile input (README "Bad input"): every element or an
+error, the direction check decided once, aliasing, alignment, the edges of the
+integer options, and finite float32 results over the whole parameter range.
+
+Each test here failed before the fix it guards.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import principled_brdf as pb
+from principled_brdf._validate import DIRECTION_LENGTH2_BOUNDS, unit_length
+
+ISAS = pb.cpu_info()["available"]
+UP = np.float32([0, 0, 1])
+
+
+def directions_at_length(rng, n, length):
+    """Random upper-hemisphere float32 directions scaled to about ``length``."""
+    v = rng.normal(size=(n, 3))
+    v[:, 2] = np.abs(v[:, 2]) + 0.1
+    return (v / np.linalg.norm(v, axis=1, keepdims=True) * length).astype(np.float32)
+
+
+def misaligned(array: np.ndarray) -> np.ndarray:
+    """A C-contiguous copy of ``array`` whose data starts one byte off alignment."""
+    raw = np.empty(array.nbytes + 1, np.uint8)
+    view = raw[1:].view(array.dtype).reshape(array.shape)
+    view[...] = array
+    assert view.flags.c_contiguous and not view.flags.aligned
+    return view
+
+
+# ------------------------------------------------------------------ the tolerance edge
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("length", [1.001, 0.999])
+def test_directions_at_the_tolerance_edge_are_decided_once(isa, length):
+    # About half of these lie on each side of the edge: the call must raise,
+    # naming the first one the rule rejects, and the rest must evaluate fully.
+    rng = np.random.default_rng(3)
+    wi = directions_at_length(rng, 100_000, length)
+    passes = unit_length(wi)
+    assert 0 < passes.sum() < len(wi)
+    first_bad = int(np.flatnonzero(~passes)[0])
+    for call in (lambda: pb.eval(pb.Material(), wi, UP, isa=isa),
+                 lambda: pb.eval(pb.Material(), wi, UP, isa=isa, out=np.empty_like(wi)),
+                 lambda: pb.eval_lobes(pb.Material(), wi, UP, isa=isa),
+                 lambda: pb.pdf(pb.Material(), wi, UP, isa=isa),
+                 lambda: pb.pdf(pb.Material(), UP, wi, isa=isa)):
+        with pytest.raises(ValueError, match=rf"w[io]\[{first_bad}\]: length"):
+            call()
+    with pytest.raises(ValueError, match=rf"wo\[{first_bad}\]: length"):
+        pb.sample(pb.Material(), wi, isa=isa)
+    # The reference applies the same rule.
+    with pytest.raises(ValueError, match=rf"wi\[{first_bad}\]: length"):
+        pb.reference.eval(pb.Material(), wi, UP)
+
+    good = wi[passes]
+    for threads in (1, 2):
+        out = np.full_like(good, np.nan)
+        pb.eval(pb.Material(), good, UP, isa=isa, out=out, threads=threads)
+        assert np.isfinite(out).all()
+        s = pb.sample(pb.Material(), good, isa=isa, threads=threads)
+        assert np.isfinite(s.wi).all() and np.isfinite(s.weight).all() and np.isfinite(s.pdf).all()
+        assert np.isfinite(pb.pdf(pb.Material(), good, UP, isa=isa, threads=threads)).all()
+    pb.reference.eval(pb.Material(), good[:100], UP)
+
+
+def test_the_rule_is_float64_squared_length_within_the_bounds():
+    lowest, highest = DIRECTION_LENGTH2_BOUNDS
+    assert lowest == (1 - 1e-3) * (1 - 1e-3) and highest == (1 + 1e-3) * (1 + 1e-3)
+    # the largest float32 x with x² inside the upper bound, and the next one
+    x = np.float32(np.sqrt(highest))
+    while float(x) * float(x) > highest:
+        x = np.nextafter(x, np.float32(0))
+    inside, outside = x, np.nextafter(x, np.float32(2))
+    for isa in ISAS:
+        pb.eval(pb.Material(), np.float32([0, 0, inside]), UP, isa=isa)
+        with pytest.raises(ValueError, match="wi: length"):
+            pb.eval(pb.Material(), np.float32([0, 0, outside]), UP, isa=isa)
+    pb.reference.eval(pb.Material(), np.float32([0, 0, inside]), UP)
+    with pytest.raises(ValueError, match="wi: length"):
+        pb.reference.eval(pb.Material(), np.float32([0, 0, outside]), UP)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("n", [1, 7, 16, 17, 100, 1000])
+def test_a_bad_direction_anywhere_is_found_and_named(isa, n):
+    rng = np.random.default_rng(n)
+    for position in sorted({0, n // 2, n - 1}):
+        wi = directions_at_length(rng, n, 1.0)
+        wi[position] *= 1.01
+        with pytest.raises(ValueError, match=rf"wi\[{position}\]"):
+            pb.eval(pb.Material(), wi, UP, isa=isa, out=np.empty_like(wi))
+        with pytest.raises(ValueError, match=rf"wo\[{position}\]"):
+            pb.sample(pb.Material(), wi, isa=isa)
+
+
+def test_a_bad_direction_is_named_in_its_own_shape_when_broadcast():
+    wo = directions_at_length(np.random.default_rng(1), 4, 1.0).reshape(4, 1, 3)
+    wo[2, 0] *= 2
+    wi = directions_at_length(np.random.default_rng(2), 5, 1.0)
+    with pytest.raises(ValueError, match=r"wo\[2, 0\]: length 2"):
+        pb.eval(pb.Material(), wi, wo)
+
+
+def test_out_holds_partial_results_after_an_error_and_is_right_where_written():
+    wi = directions_at_length(np.random.default_rng(5), 10_000, 1.0)
+    wi[7000] = np.nan
+    out = np.full_like(wi, -1.0)
+    with pytest.raises(ValueError, match=r"wi\[7000\]"):
+        pb.eval(pb.Material(), wi, UP, out=out, threads=1)
+    written = out[:, 0] != -1.0
+    assert written[:6000].all()  # the elements before the bad one's batch
+    expected = pb.eval(pb.Material(), wi[written], UP)
+    np.testing.assert_array_equal(out[written], expected)
+
+
+# ------------------------------------------------------------------ disney2012 at high roughness
+
+@pytest.mark.parametrize("model", ["disney2014", "disney2012"])
+def test_high_roughness_at_the_normal_is_finite_and_matches_the_reference(model):
+    material = pb.Material(roughness=200)
+    wi, wo = np.float32([0.6, 0, 0.8]), np.float32([0, 0, 1])
+    expected = pb.reference.eval(material, wi, wo, model=model)
+    for isa in ISAS:
+        for a, b in ((wi, wo), (wo, wi)):
+            f = pb.eval(material, a, b, model=model, isa=isa)
+            np.testing.assert_allclose(f, expected, rtol=1e-5)
+
+
+def float32_range_materials(rng, n):
+    """Per-element materials over the whole range the float32 kernels accept."""
+    limits = pb._batch.FLOAT32_LIMITS
+
+    def log_uniform(high, size):
+        values = 10.0 ** rng.uniform(-8, np.log10(high), size)
+        values[rng.random(size) < 0.1] = 0.0
+        values[rng.random(size) < 0.1] = high
+        return values
+
+    unit = lambda: np.where(rng.random(n) < 0.2, rng.integers(0, 2, n), rng.random(n))  # noqa: E731
+    return pb.Material(
+        base_color=log_uniform(limits["base_color"], (n, 3)), metallic=unit(), subsurface=unit(),
+        specular=log_uniform(limits["specular"], n), specular_tint=unit(), roughness=log_uniform(limits["roughness"], n),
+        anisotropic=unit(), sheen=log_uniform(limits["sheen"], n), sheen_tint=unit(),
+        clearcoat=log_uniform(limits["clearcoat"], n), clearcoat_gloss=unit())
+
+
+@pytest.mark.parametrize("model", ["disney2014", "disney2012"])
+def test_every_output_is_finite_over_the_whole_float32_parameter_range(model):
+    rng = np.random.default_rng(12)
+    n = 200_000
+    material = float32_range_materials(rng, n)
+    wi = directions_at_length(rng, n, 1.0)
+    wo = directions_at_length(rng, n, 1.0)
+    # a third of the pairs with one direction at the normal, where 2012's Smith term cancelled
+    wi[: n // 6] = UP
+    wo[n // 6: n // 3] = UP
+    for isa in ISAS:
+        assert np.isfinite(pb.eval(material, wi, wo, model=model, isa=isa)).all()
+        assert np.isfinite(pb.eval(material, wi, wo, model=model, cosine=True, isa=isa)).all()
+        for lobe in pb.eval_lobes(material, wi, wo, model=model, isa=isa):
+            assert np.isfinite(lobe).all()
+        for sampler in ("visible", "distribution"):
+            assert np.isfinite(pb.pdf(material, wi, wo, specular_sampler=sampler, isa=isa)).all()
+            s = pb.sample(material, wo, seed=4, model=model, specular_sampler=sampler, isa=isa)
+            for array in (s.wi, s.pdf, s.weight):
+                assert np.isfinite(array).all()
+
+
+# ------------------------------------------------------------------ aliasing
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_out_partly_overlapping_an_input_is_refused(isa):
+    buffer = directions_at_length(np.random.default_rng(8), 1001, 1.0)
+    wi, shifted = buffer[:-1], buffer[1:]
+    for argument in ("wi", "wo"):
+        kwargs = {"wi": wi, "wo": UP} if argument == "wi" else {"wi": UP, "wo": wi}
+        with pytest.raises(ValueError, match=f"out: overlaps {argument}"):
+            pb.eval(pb.Material(), **kwargs, out=shifted, isa=isa)
+    single = buffer[:1].reshape(3)  # one vector for every element, inside out
+    with pytest.raises(ValueError, match="out: overlaps wo"):
+        pb.eval(pb.Material(), wi[:500], single, out=buffer[:500], isa=isa)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("layout", ["aos", "soa"])
+def test_out_that_is_an_input_computes_in_place(isa, layout):
+    rng = np.random.default_rng(9)
+    wi = directions_at_length(rng, 999, 1.0)
+    wo = directions_at_length(rng, 999, 1.0)
+    if layout == "soa":
+        wi, wo = np.ascontiguousarray(wi.T), np.ascontiguousarray(wo.T)
+    material = pb.Material(roughness=0.3, clearcoat=1.0, sheen=0.5)
+    expected = pb.eval(material, wi, wo, layout=layout, isa=isa)
+    in_place = wi.copy()
+    result = pb.eval(material, in_place, wo, layout=layout, isa=isa, out=in_place)
+    assert result is in_place
+    np.testing.assert_array_equal(in_place, expected)
+
+
+# ------------------------------------------------------------------ alignment
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_misaligned_inputs_are_converted(isa):
+    rng = np.random.default_rng(10)
+    wi = directions_at_length(rng, 101, 1.0)
+    wo = directions_at_length(rng, 101, 1.0)
+    u = rng.random((101, 3)).astype(np.float32)
+    m = pb.Material(roughness=0.4)
+    np.testing.assert_array_equal(pb.eval(m, misaligned(wi), misaligned(wo), isa=isa), pb.eval(m, wi, wo, isa=isa))
+    np.testing.assert_array_equal(pb.pdf(m, misaligned(wi), misaligned(wo), isa=isa), pb.pdf(m, wi, wo, isa=isa))
+    s, t = pb.sample(m, misaligned(wo), u=misaligned(u), isa=isa), pb.sample(m, wo, u=u, isa=isa)
+    np.testing.assert_array_equal(s.weight, t.weight)
+    np.testing.assert_array_equal(pb.reference.eval(m, misaligned(wi), wo), pb.reference.eval(m, wi, wo))
+    per_element = pb.Material(roughness=misaligned(rng.random(101).astype(np.float32)))
+    pb.eval(per_element, wi, wo, isa=isa)
+
+
+def test_misaligned_out_is_refused():
+    wi = directions_at_length(np.random.default_rng(11), 10, 1.0)
+    with pytest.raises(ValueError, match="out: array data is not aligned"):
+        pb.eval(pb.Material(), wi, UP, out=misaligned(np.zeros_like(wi)))
+
+
+# ------------------------------------------------------------------ integer options and flags
+
+@pytest.mark.parametrize("threads", [2**31, 2**63, -1, 0])
+def test_threads_out_of_range(threads):
+    with pytest.raises(ValueError, match="threads"):
+        pb.eval(pb.Material(), UP, UP, threads=threads)
+
+
+def test_a_huge_thread_count_in_range_works():
+    wi = directions_at_length(np.random.default_rng(1), 100_000, 1.0)
+    np.testing.assert_array_equal(pb.eval(pb.Material(), wi, UP, threads=2**31 - 1), pb.eval(pb.Material(), wi, UP))
+
+
+@pytest.mark.parametrize("first, n", [(2**63, 1), (2**63 - 1, 2), (2**64, 0), (2**62, 2**62)])
+def test_random_uniforms_index_range(first, n):
+    with pytest.raises(ValueError, match="first"):
+        pb.random_uniforms(1, n, first)
+
+
+def test_random_uniforms_at_the_end_of_the_index_range():
+    u = pb.random_uniforms(1, 1, 2**63 - 2)
+    assert u.shape == (1, 3) and np.all((u >= 0) & (u < 1))
+
+
+@pytest.mark.parametrize("value", [np.array([1, 2], dtype="timedelta64[s]"), np.array(["2020-01-01"], dtype="datetime64[D]")])
+def test_time_arrays_are_not_numbers(value):
+    with pytest.raises(TypeError, match="wi"):
+        pb.eval(pb.Material(), value, UP)
+    with pytest.raises(TypeError, match="roughness"):
+        pb.Material(roughness=value)
+
+
+@pytest.mark.parametrize("option", ["cosine", "check"])
+@pytest.mark.parametrize("value", [np.array([True, False]), "yes", None, 1.0])
+def test_flags_take_booleans_only(option, value):
+    with pytest.raises(TypeError, match=option):
+        pb.eval(pb.Material(), UP, UP, **{option: value})
+
+
+def test_beyond_float32_is_not_called_infinite():
+    with pytest.raises(ValueError, match=r"wi\[0\]: 1e\+300 is beyond float32"):
+        pb.eval(pb.Material(), np.array([1e300, 0, 1]), UP)
+
+
+def test_render_sphere_names_its_own_arguments():
+    with pytest.raises(ValueError, match="light"):
+        pb.render.render_sphere(pb.Material(), 16, light=(0, 0, 0))
+    with pytest.raises(ValueError, match="light"):
+        pb.render.render_sphere(pb.Material(), 16, light=(np.nan, 0, 1))
+    with pytest.raises(TypeError, match="resolution"):
+        pb.render.render_sphere(pb.Material(), None)
+    with pytest.raises(ValueError, match="resolution"):
+        pb.render.render_sphere(pb.Material(), 10**9)
+    with pytest.raises(ValueError, match="ambient"):
+        pb.render.render_sphere(pb.Material(), 16, ambient=-1)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("bad", [np.nan, np.inf, 1e30])
+def test_unchecked_sampling_of_a_bad_view_gives_zeros_not_nan(isa, bad):
+    wo = directions_at_length(np.random.default_rng(2), 50, 1.0)
+    wo[[0, 17, 49], 1] = bad
+    s = pb.sample(pb.Material(metallic=1.0, clearcoat=1.0), wo, check=False, isa=isa, seed=3)
+    for array in (s.wi, s.pdf, s.weight):
+        assert np.isfinite(array).all()
+    assert (s.weight[[0, 17, 49]] == 0).all() and (s.pdf[[0, 17, 49]] == 0).all()
+    f = pb.eval(pb.Material(), wo, wo[::-1], check=False, isa=isa)
+    assert np.isfinite(f).all()
+
+
+@pytest.mark.parametrize("u", [1 + 1e-12, -1e-300])
+def test_uniforms_are_checked_as_given_by_both_paths(u):
+    values = np.array([[0.5, u, 0.5]])
+    with pytest.raises(ValueError, match=r"u\[0, 1\]"):
+        pb.sample(pb.Material(), UP, u=values)
+    with pytest.raises(ValueError, match=r"u\[0, 1\]"):
+        pb.reference.sample(pb.Material(), UP, values)
