@@ -85,9 +85,10 @@ int threads_of(const benchmark::State& state) {
     return state.range(1) == 0 ? pb::hardware_threads() : static_cast<int>(state.range(1));
 }
 
-void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_element) {
+void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_element, bool checked) {
     Data& d = data_for(state.range(0));
-    const pb::EvalJob job = make_job(d, soa, per_element);
+    pb::EvalJob job = make_job(d, soa, per_element);
+    if (checked) job.check = pb::direction_check(1e-3);  // what pb.eval does by default
     const int threads = threads_of(state);
     for (auto _ : state) {
         pb::eval(job, d.n, threads, isa);
@@ -176,10 +177,17 @@ void register_all() {
                     for (bool per_element : {false, true}) {
                         const std::string name = "eval/" + isa + (soa ? "/soa" : "/aos") +
                                                  (per_element ? "/per_element" : "/uniform");
-                        benchmark::RegisterBenchmark(name.c_str(), simd_eval, isa, soa, per_element)
+                        benchmark::RegisterBenchmark(name.c_str(), simd_eval, isa, soa, per_element, false)
                             ->Args({n, threads})
                             ->UseRealTime()
                             ->Unit(benchmark::kMicrosecond);
+                        if (!soa && !per_element) {  // the default call: the direction check on
+                            const std::string checked_name = "eval_checked/" + isa + "/aos/uniform";
+                            benchmark::RegisterBenchmark(checked_name.c_str(), simd_eval, isa, false, false, true)
+                                ->Args({n, threads})
+                                ->UseRealTime()
+                                ->Unit(benchmark::kMicrosecond);
+                        }
                         if (n == kSizes[0] && threads == 1 && !soa) {
                             const std::string sample_name = "sample/" + isa + "/aos" +
                                                             (per_element ? "/per_element" : "/uniform");

@@ -48,7 +48,9 @@ class Lobes(NamedTuple):
 
 
 def mix(a, b, t):
-    return a + (b - a) * t
+    """a + (b - a) t, written a (1 - t) + b t: the same number, without the loss of
+    b's digits when b << a and t -> 1 (e.g. a saturated colour's Ctint at tint 1)."""
+    return a * (1.0 - t) + b * t
 
 
 def schlick(u):

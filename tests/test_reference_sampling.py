@@ -621,17 +621,19 @@ def test_below_the_horizon_pdf_and_weight_are_zero(sampler):
 def test_end_of_unit_interval_conventions():
     """u2 = 1 sends the specular and clearcoat lobes to a horizontal h, hence wi.z = -wo.z:
     below the horizon (pdf 0, weight 0); the one 0/0 of the caps construction (u2 = 1,
-    φ opposite the stretched view; or wo = n) gives h = 0, i.e. wi = -wo."""
+    φ opposite the stretched view; or wo = n) gives h = 0, i.e. wi = -wo. The clearcoat
+    draw takes cos θh = sqrt(1 - sin²θh) (one exponential per lane), so its h is
+    horizontal to the rounding of sin²θh: |wi.z + wo.z| ~ sqrt(eps)."""
     material = pb.Material(roughness=0.5, clearcoat=1.0, metallic=1.0)  # P0 = 0: lobe 1 if u0 < P1
     for theta in (0.0, 40.0):
         wo = view(theta, 0.0)
         p1 = pb.reference.lobe_probabilities(material, wo)[1]
         for sampler in SAMPLERS:
-            for u0 in (0.0, p1 + 1e-9):  # specular, clearcoat
+            for u0, tolerance in ((0.0, 1e-12), (p1 + 1e-9, 1e-7)):  # specular, clearcoat
                 for u1 in (0.0, 0.25, 0.5, 0.9):
                     s = pb.reference.sample(material, wo, [u0, u1, 1.0], specular_sampler=sampler)
                     assert s.pdf == 0 and np.all(s.weight == 0)
-                    assert s.wi[2] == pytest.approx(-wo[2], abs=1e-12)
+                    assert s.wi[2] == pytest.approx(-wo[2], abs=tolerance)
     s = pb.reference.sample(material, [0.0, 0.0, 1.0], [0.0, 0.3, 1.0])
     np.testing.assert_array_equal(s.wi, [0.0, 0.0, -1.0])
     # u2 = 1 (cosine lobe) is the horizon itself

@@ -84,8 +84,7 @@ std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Arra
     job.wo = vec3_view(wo, wo_layout, n, "wo");
     py::list keep_alive;
     fill_params(params, n, job.params, keep_alive);
-    if (model != 0 && model != 1) throw std::invalid_argument("model: expected 0 (disney2014) or 1 (disney2012)");
-    job.model = static_cast<Model>(model);
+    job.model = model_from(model);
     job.output = lobes ? Output::kLobes : Output::kTotal;
     job.cosine = cosine;
     if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
@@ -111,11 +110,6 @@ T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const ch
     return a.mutable_data();
 }
 
-SpecularSampler specular_sampler(int sampler) {
-    if (sampler != 0 && sampler != 1) throw std::invalid_argument("specular_sampler: expected 0 or 1");
-    return static_cast<SpecularSampler>(sampler);
-}
-
 std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                        const py::sequence& params, Float32Array pdf, std::int64_t n, int sampler,
                        double check_tolerance, int threads, const std::string& isa) {
@@ -125,7 +119,7 @@ std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array
     py::list keep_alive;
     fill_params(params, n, job.params, keep_alive);
     job.output = Output::kPdf;
-    job.sampler = specular_sampler(sampler);
+    job.sampler = sampler_from(sampler);
     job.pdf = scalar_output(pdf, n, "pdf");
     if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
     if (n == 0) return -1;
@@ -137,7 +131,7 @@ std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::objec
                           std::uint64_t seed, const py::sequence& params, Float32Array wi, Float32Array weight,
                           int out_layout, Float32Array pdf, py::array_t<std::int32_t, py::array::c_style> lobe,
                           std::int64_t n, int model, int sampler, double check_tolerance, int threads,
-                          const std::string& isa) {
+                          const std::string& isa, const py::object& lobe_weights) {
     SampleJob job;
     job.wo = vec3_view(wo, wo_layout, n, "wo");
     Float32Array u_array;
@@ -148,13 +142,23 @@ std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::objec
     job.seed = seed;
     py::list keep_alive;
     fill_params(params, n, job.params, keep_alive);
-    if (model != 0 && model != 1) throw std::invalid_argument("model: expected 0 (disney2014) or 1 (disney2012)");
-    job.model = static_cast<Model>(model);
-    job.sampler = specular_sampler(sampler);
+    job.model = model_from(model);
+    job.sampler = sampler_from(sampler);
     job.wi = output_view(wi, out_layout, n, "wi");
     job.weight = output_view(weight, out_layout, n, "weight");
     job.pdf = scalar_output(pdf, n, "pdf");
     job.lobe = scalar_output(lobe, n, "lobe");
+    std::vector<Float32Array> lobe_arrays;
+    if (!lobe_weights.is_none()) {
+        const py::sequence arrays = lobe_weights.cast<py::sequence>();
+        if (py::len(arrays) != static_cast<std::size_t>(kLobeCount))
+            throw std::invalid_argument("lobe_weights: expected " + std::to_string(kLobeCount) + " arrays");
+        for (int k = 0; k < kLobeCount; ++k) {
+            lobe_arrays.push_back(py::cast<Float32Array>(arrays[k]));
+            if (!lobe_arrays.back().is(arrays[k])) throw std::invalid_argument("lobe_weights: expected C-contiguous float32 arrays");
+            job.lobe_weight[k] = output_view(lobe_arrays.back(), out_layout, n, "lobe_weights");
+        }
+    }
     if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
     if (n == 0) return -1;
     py::gil_scoped_release release;
@@ -210,7 +214,8 @@ void bind_batch(py::module_& m) {
     m.def("batch_sample", &batch_sample, py::arg("wo"), py::arg("wo_layout"), py::arg("u"), py::arg("u_layout"),
           py::arg("seed"), py::arg("params"), py::arg("wi"), py::arg("weight"), py::arg("out_layout"), py::arg("pdf"),
           py::arg("lobe"), py::arg("n"), py::arg("model"), py::arg("sampler"), py::arg("check_tolerance"),
-          py::arg("threads"), py::arg("isa"), "SIMD sampling into preallocated outputs.");
+          py::arg("threads"), py::arg("isa"), py::arg("lobe_weights") = py::none(),
+          "SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given).");
     m.def("counter_uniforms", &uniforms, py::arg("seed"), py::arg("first"), py::arg("n"),
           "The counter-based uniforms (n, 3) that sampling uses for elements first .. first + n - 1.");
     m.def("direction_length2_bounds", &direction_length2_bounds, py::arg("tolerance"),

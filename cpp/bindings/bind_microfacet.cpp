@@ -164,7 +164,7 @@ py::array_t<double> ggx_sample_visible(const Float64Array& wo, const Float64Arra
 }  // namespace
 
 void bind_microfacet(py::module_& m) {
-    py::module_ sub = m.def_submodule("microfacet", "Microfacet toolkit (README "Microfacet toolkit") over packed float64 rows.");
+    py::module_ sub = m.def_submodule("microfacet", "Microfacet toolkit (README \"Microfacet toolkit\") over packed float64 rows.");
     const auto closed = py::arg("closed_forms");
 
     sub.def("gtr_d", &gtr_d, py::arg("cos_theta_h"), py::arg("alpha"), py::arg("gamma"), closed);

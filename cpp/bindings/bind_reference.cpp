@@ -14,7 +14,6 @@
 #include "bindings.hpp"
 #include "principled_brdf/params.hpp"
 #include "principled_brdf/reference.hpp"
-#include "principled_brdf/reference_sampling.hpp"
 
 namespace py = pybind11;
 
@@ -31,6 +30,15 @@ void bind_params(py::module_& m) {
     }
     m.attr("PARAMETER_TABLE") = table;
     m.attr("PARAM_SLOTS") = static_cast<int>(kParamSlots);
+    auto names = [](const auto& table) {
+        py::tuple tuple(table.size());
+        for (std::size_t i = 0; i < table.size(); ++i) tuple[i] = table[i];
+        return tuple;
+    };
+    m.attr("MODEL_NAMES") = names(kModelNames);
+    m.attr("LOBE_NAMES") = names(kLobeNames);
+    m.attr("SAMPLED_LOBE_NAMES") = names(kSampledLobeNames);
+    m.attr("SAMPLER_NAMES") = names(kSpecularSamplerNames);
 }
 
 namespace {
@@ -48,10 +56,10 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
     require_rows(wi, n, 3, "wi");
     require_rows(wo, n, 3, "wo");
     require_rows(params, n, kParamSlots, "params");
-    if (model != 0 && model != 1) throw std::invalid_argument("model: expected 0 (disney2014) or 1 (disney2012)");
+    const Model which_model = model_from(model);
 
     std::vector<py::ssize_t> shape{n};
-    if (lobes) shape.push_back(4);
+    if (lobes) shape.push_back(kLobeCount);
     shape.push_back(3);
     py::array_t<double> out(shape);
     const double* wi_data = wi.data();
@@ -63,15 +71,15 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
         for (py::ssize_t i = 0; i < n; ++i) {
             const auto material = reference::Material::from_slots(param_data + i * kParamSlots);
             const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
-            const auto result = reference::eval_lobes(material, in, view, static_cast<Model>(model));
             if (lobes) {
-                double* row = out_data + 12 * i;
+                const auto result = reference::eval_lobes(material, in, view, which_model);
+                double* row = out_data + 3 * kLobeCount * i;
                 Eigen::Map<Eigen::Vector3d>(row + 0) = result.diffuse;
                 Eigen::Map<Eigen::Vector3d>(row + 3) = result.sheen;
                 Eigen::Map<Eigen::Vector3d>(row + 6) = result.specular;
                 Eigen::Map<Eigen::Vector3d>(row + 9) = result.clearcoat;
             } else {
-                Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = result.total();
+                Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, which_model);
             }
         }
     }
@@ -102,17 +110,6 @@ Rows shared_or_rows(const Float64Array& a, py::ssize_t n, py::ssize_t columns, c
     return {a.data(), a.shape(0) == 1 ? 0 : columns};
 }
 
-Model model_from(int model) {
-    if (model != 0 && model != 1) throw std::invalid_argument("model: expected 0 (disney2014) or 1 (disney2012)");
-    return static_cast<Model>(model);
-}
-
-reference::SpecularSampler sampler_from(int sampler) {
-    if (sampler != 0 && sampler != 1)
-        throw std::invalid_argument("specular_sampler: expected 0 (visible normals) or 1 (distribution)");
-    return static_cast<reference::SpecularSampler>(sampler);
-}
-
 // README "Sampling and pdf": wo (N,3), u (N,3) = (u0, u1, u2), params (N,13); each may be one shared row.
 py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const Float64Array& params, int model,
                            int sampler) {
@@ -121,7 +118,7 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
     const Rows uniforms = shared_or_rows(u, n, 3, "u");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
     const Model which_model = model_from(model);
-    const reference::SpecularSampler which_sampler = sampler_from(sampler);
+    const SpecularSampler which_sampler = sampler_from(sampler);
 
     py::array_t<double> wi_out({n, py::ssize_t(3)}), pdf_out(n), weight_out({n, py::ssize_t(3)});
     py::array_t<std::int32_t> lobe_out(n);
@@ -153,7 +150,7 @@ py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo
     const Rows view = shared_or_rows(wo, n, 3, "wo");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
     model_from(model);
-    const reference::SpecularSampler which_sampler = sampler_from(sampler);
+    const SpecularSampler which_sampler = sampler_from(sampler);
 
     py::array_t<double> out(n);
     double* out_data = out.mutable_data();

@@ -3,7 +3,26 @@
 
 #include <pybind11/pybind11.h>
 
+#include <stdexcept>
+#include <string>
+
+#include "principled_brdf/params.hpp"
+
 namespace principled_brdf::bindings {
+
+// An index into one of params.hpp's name tables, as the enum it numbers: the
+// Python side validated the name; this keeps a bad index from reaching C++.
+template <class Enum, std::size_t N>
+Enum enum_from(int index, const std::array<const char*, N>& names, const char* what) {
+    if (index < 0 || index >= static_cast<int>(N))
+        throw std::invalid_argument(std::string(what) + ": expected an index below " + std::to_string(N));
+    return static_cast<Enum>(index);
+}
+
+inline Model model_from(int index) { return enum_from<Model>(index, kModelNames, "model"); }
+inline SpecularSampler sampler_from(int index) {
+    return enum_from<SpecularSampler>(index, kSpecularSamplerNames, "specular_sampler");
+}
 
 void bind_params(pybind11::module_& m);
 void bind_reference(pybind11::module_& m);

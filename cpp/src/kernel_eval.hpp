@@ -3,28 +3,24 @@
 #pragma once  // (per translation unit)
 
 template <Model model, Output output, Layouts layouts>
-PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3& wi, const Vec3& wo, const Shading& s) {
-    const Geometry g = geometry_of(wi, wo);
-    // 0 unless both directions are strictly above the surface (README "The model");
-    // select also discards whatever the formulas gave there (H may be 0).
-    const Mask above = (wi.z > Floats(0.0f)) & (wo.z > Floats(0.0f)) & g.finite;
-
-    const View view = view_of<model>(wo, s);
+PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
+                                 const Shading<Floats>& s) {
+    const Geometry<Floats> g = geometry_of(wi, wo);
+    // select discards whatever the formulas gave below the surface (H may be 0)
+    const Mask above = above_surface(g);
+    const View<Floats> view = view_of<model>(wo, s);
     if constexpr (output == Output::kPdf) {
         const Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
-        xsimd::select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
+        select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     } else {
-        const LobeValues lobes = eval_lobes<model>(g, s, view);
-        auto masked = [&](Rgb c) {
-            if (job.cosine) c = wi.z * c;
-            return Rgb{xsimd::select(above, c.r, Floats(0.0f)), xsimd::select(above, c.g, Floats(0.0f)),
-                       xsimd::select(above, c.b, Floats(0.0f))};
-        };
+        const LobeValues<Floats> lobes = eval_lobes<model>(g, s, view);
+        const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+        auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };
         if constexpr (output == Output::kLobes) {
             store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse_rgb(s)));
             store_rgb<layouts>(job.out[1], i, masked(lobes.sheen_rgb(s)));
             store_rgb<layouts>(job.out[2], i, masked(lobes.specular_rgb(s)));
-            store_rgb<layouts>(job.out[3], i, masked(Rgb{lobes.clearcoat, lobes.clearcoat, lobes.clearcoat}));
+            store_rgb<layouts>(job.out[3], i, masked(lobes.clearcoat_rgb()));
         } else {
             store_rgb<layouts>(job.out[0], i, masked(lobes.total(s)));
         }
@@ -34,9 +30,9 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3&
 // One batch at i: -1, or with the direction check on the first lane whose wi
 // or wo fails it (and nothing stored).
 template <Model model, Output output, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE int eval_one_batch(const EvalJob& job, std::int64_t i, const Shading& uniform) {
-    const Vec3 wi = load_vec3<layouts>(job.wi, i);
-    const Vec3 wo = load_vec3<layouts>(job.wo, i);
+PB_KERNEL_INLINE int eval_one_batch(const EvalJob& job, std::int64_t i, const Shading<Floats>& uniform) {
+    const Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
+    const Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled) {
         const int bad = first_bad_lane(wi, wo, job.check);
         if (bad >= 0) return bad;
@@ -51,7 +47,7 @@ PB_KERNEL_INLINE int eval_one_batch(const EvalJob& job, std::int64_t i, const Sh
 
 // The last pad.count < kLanes elements: -1, or the first bad lane as above.
 template <Model model, Output output, bool per_element>
-int eval_tail(const EvalJob& job, const Padding& pad, const Shading& uniform) {
+int eval_tail(const EvalJob& job, const Padding& pad, const Shading<Floats>& uniform) {
     alignas(64) PadBuffer wi, wo, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
     EvalJob padded = job;
@@ -75,7 +71,7 @@ int eval_tail(const EvalJob& job, const Padding& pad, const Shading& uniform) {
 // direction fails the check (the elements from its batch on are not written).
 template <Model model, Output output, bool per_element, Layouts layouts>
 std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    Shading uniform{};
+    Shading<Floats> uniform{};
     if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
     std::int64_t i = begin;
     for (; i + kLanes <= end; i += kLanes) {

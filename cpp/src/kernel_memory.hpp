@@ -7,9 +7,9 @@
 enum class Layouts { kInterleaved, kRows, kMixed };
 
 template <Layouts layouts = Layouts::kMixed>
-PB_KERNEL_INLINE Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
+PB_KERNEL_INLINE Vec3<Floats> load_vec3(const Vec3Array& a, std::int64_t i) {
     if constexpr (layouts == Layouts::kInterleaved) {
-        Vec3 v;
+        Vec3<Floats> v;
         load_interleaved(a.data + 3 * i, v.x, v.y, v.z);
         return v;
     } else if constexpr (layouts == Layouts::kRows) {
@@ -18,7 +18,7 @@ PB_KERNEL_INLINE Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
     }
     switch (a.layout) {
         case Vec3Layout::kInterleaved: {
-            Vec3 v;
+            Vec3<Floats> v;
             load_interleaved(a.data + 3 * i, v.x, v.y, v.z);
             return v;
         }
@@ -31,7 +31,7 @@ PB_KERNEL_INLINE Vec3 load_vec3(const Vec3Array& a, std::int64_t i) {
 }
 
 template <Layouts layouts = Layouts::kMixed>
-PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb& c) {
+PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb<Floats>& c) {
     if (layouts == Layouts::kInterleaved || (layouts == Layouts::kMixed && a.layout == Vec3Layout::kInterleaved)) {
         store_interleaved(a.data + 3 * i, c.r, c.g, c.b);
     } else {
@@ -43,14 +43,14 @@ PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const
 
 // The direction check (DirectionCheck in batch.hpp). The fast test: true only
 // for lanes whose length the rule accepts.
-PB_KERNEL_INLINE Mask surely_unit_length(const Vec3& w, const DirectionCheck& check) {
+PB_KERNEL_INLINE Mask surely_unit_length(const Vec3<Floats>& w, const DirectionCheck& check) {
     const Floats length2 = mul_add(w.x, w.x, mul_add(w.y, w.y, w.z * w.z));
     return (length2 >= Floats(check.fast_lowest)) & (length2 <= Floats(check.fast_highest));  // false for NaN
 }
 
 // The first lane of w that the rule rejects, or -1. Out of line: it runs only
 // for batches the fast test did not accept.
-[[gnu::noinline]] inline int first_rejected_lane(const Vec3& w, const DirectionCheck& check) {
+[[gnu::noinline]] inline int first_rejected_lane(const Vec3<Floats>& w, const DirectionCheck& check) {
     alignas(64) float x[kLanes], y[kLanes], z[kLanes];
     w.x.store_aligned(x);
     w.y.store_aligned(y);
@@ -61,12 +61,12 @@ PB_KERNEL_INLINE Mask surely_unit_length(const Vec3& w, const DirectionCheck& ch
 }
 
 // -1 when every lane of w passes the check, else the first lane that fails.
-PB_KERNEL_INLINE int first_bad_lane(const Vec3& w, const DirectionCheck& check) {
+PB_KERNEL_INLINE int first_bad_lane(const Vec3<Floats>& w, const DirectionCheck& check) {
     return xsimd::all(surely_unit_length(w, check)) ? -1 : first_rejected_lane(w, check);
 }
 
 // The same for a pair: the first lane where either fails.
-PB_KERNEL_INLINE int first_bad_lane(const Vec3& a, const Vec3& b, const DirectionCheck& check) {
+PB_KERNEL_INLINE int first_bad_lane(const Vec3<Floats>& a, const Vec3<Floats>& b, const DirectionCheck& check) {
     if (xsimd::all(surely_unit_length(a, check) & surely_unit_length(b, check))) return -1;
     const int in_a = first_rejected_lane(a, check), in_b = first_rejected_lane(b, check);
     return in_a < 0 ? in_b : in_b < 0 ? in_a : std::min(in_a, in_b);

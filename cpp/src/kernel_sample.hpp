@@ -11,23 +11,23 @@
 // batches' work (see sample_loop).
 
 struct Chosen {
-    Vec3 wo;
-    Uniforms u;
-    LobeWeights weights;
-    LobeChoice lobe;
+    Vec3<Floats> wo;
+    Uniforms<Floats> u;
+    LobeWeights<Floats> weights;
+    LobeChoice<Floats> lobe;
     Floats fv;
 };
 
 // -1, or with the direction check on the first lane whose wo fails it
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE int choose(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed, Chosen& c) {
+PB_KERNEL_INLINE int choose(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed, Chosen& c) {
     c.wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled) {
         const int bad = first_bad_lane(c.wo, job.check);
         if (bad >= 0) return bad;
     }
     if (job.u.data != nullptr) {
-        const Vec3 given = load_vec3<layouts>(job.u, i);
+        const Vec3<Floats> given = load_vec3<layouts>(job.u, i);
         c.u = {given.x, given.y, given.z};
     } else {
         c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index) + static_cast<std::uint64_t>(i), seed);
@@ -38,38 +38,34 @@ PB_KERNEL_INLINE int choose(const SampleJob& job, std::int64_t i, const Shading&
     return -1;
 }
 
-PB_KERNEL_INLINE Direction draw(const SampleJob& job, const Chosen& c, const Shading& s) {
+PB_KERNEL_INLINE Direction<Floats> draw(const SampleJob& job, const Chosen& c, const Shading<Floats>& s) {
     return sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
 }
 
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction& d, const Shading& s) {
-    const Vec3& wi = d.wi;
-    const View view = view_of<model>(c.wo, s, d.smith_visible, c.fv);
-    const Geometry g = geometry_of(wi, c.wo);
-    const Floats pdf = mixture_pdf(g, s, view, c.weights, job.sampler);
-    const Mask valid = (xsimd::min(wi.z, c.wo.z) > Floats(0.0f)) & g.finite & (pdf > Floats(0.0f));
-    const Rgb f = eval_lobes<model>(g, s, view).total(s);
-    const Floats scale = wi.z * reciprocal(pdf);  // cos θl / pdf
-    // select after multiplying: below the horizon f may be infinite or NaN
-    auto weight = [&](Floats value) { return xsimd::select(valid, scale * value, Floats(0.0f)); };
-
-    // wi = 0 where wo held NaN, infinity or a huge value (checks off): pdf and weight are 0 there too
-    auto drawn = [&](Floats value) { return xsimd::select(g.finite, value, Floats(0.0f)); };
-    store_rgb<layouts>(job.wi, i, Rgb{drawn(wi.x), drawn(wi.y), drawn(wi.z)});
-    xsimd::select(valid, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
-    store_rgb<layouts>(job.weight, i, Rgb{weight(f.r), weight(f.g), weight(f.b)});
+PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction<Floats>& d,
+                            const Shading<Floats>& s) {
+    const Weighed<Floats> w = weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler);
+    store_rgb<layouts>(job.wi, i, Rgb<Floats>{w.wi.x, w.wi.y, w.wi.z});
+    w.pdf.store_unaligned(job.pdf + i);
+    store_rgb<layouts>(job.weight, i, w.weight);
+    if (job.lobe_weight[0].data != nullptr) {  // each lobe's share (the albedo's split)
+        store_rgb<layouts>(job.lobe_weight[0], i, w.share(w.lobes.diffuse_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[1], i, w.share(w.lobes.sheen_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
+    }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
-    const Floats lobe_index = xsimd::select(c.lobe.cosine, index_bits(0), xsimd::select(c.lobe.specular, index_bits(1), index_bits(2)));
+    const Floats lobe_index = select(c.lobe.cosine, index_bits(0), select(c.lobe.specular, index_bits(1), index_bits(2)));
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
 template <Model model, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE int sample_one_batch(const SampleJob& job, std::int64_t i, const Shading& uniform, const CounterSeed& seed) {
-    Shading per_batch;
+PB_KERNEL_INLINE int sample_one_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform, const CounterSeed& seed) {
+    Shading<Floats> per_batch;
     if constexpr (per_element) per_batch = shading_of(load_material(job.params, i));
-    const Shading& s = per_element ? per_batch : uniform;
+    const Shading<Floats>& s = per_element ? per_batch : uniform;
     Chosen chosen;
     const int bad = choose<model, layouts>(job, i, s, seed, chosen);
     if (bad >= 0) return bad;
@@ -78,8 +74,8 @@ PB_KERNEL_INLINE int sample_one_batch(const SampleJob& job, std::int64_t i, cons
 }
 
 template <Model model, bool per_element>
-int sample_tail(const SampleJob& job, const Padding& pad, const Shading& uniform, const CounterSeed& seed) {
-    alignas(64) PadBuffer wo, u, params[kParamSlots], wi, weight;
+int sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>& uniform, const CounterSeed& seed) {
+    alignas(64) PadBuffer wo, u, params[kParamSlots], wi, weight, lobe_weight[kLobeCount];
     alignas(64) float pdf[kLanes];
     alignas(64) std::int32_t lobe[kLanes];
     SampleJob padded = job;
@@ -88,6 +84,9 @@ int sample_tail(const SampleJob& job, const Padding& pad, const Shading& uniform
     pad_params(job.params, padded.params, pad, params);
     padded.wi = MutableVec3Array{wi, Vec3Layout::kInterleaved, 0};
     padded.weight = MutableVec3Array{weight, Vec3Layout::kInterleaved, 0};
+    const bool lobe_weights = job.lobe_weight[0].data != nullptr;
+    if (lobe_weights)
+        for (int k = 0; k < kLobeCount; ++k) padded.lobe_weight[k] = MutableVec3Array{lobe_weight[k], Vec3Layout::kInterleaved, 0};
     padded.pdf = pdf;
     padded.lobe = lobe;
     padded.first_index = job.first_index + pad.begin;  // the generator sees the true element indices
@@ -97,6 +96,8 @@ int sample_tail(const SampleJob& job, const Padding& pad, const Shading& uniform
 
     unpad_vec3(job.wi, pad, wi);
     unpad_vec3(job.weight, pad, weight);
+    if (lobe_weights)
+        for (int k = 0; k < kLobeCount; ++k) unpad_vec3(job.lobe_weight[k], pad, lobe_weight[k]);
     unpad_scalars(job.pdf, pad, pdf);
     unpad_scalars(job.lobe, pad, lobe);
     return -1;
@@ -105,14 +106,14 @@ int sample_tail(const SampleJob& job, const Padding& pad, const Shading& uniform
 // One batch between its stages: chosen, then drawn.
 struct InFlight {
     Chosen chosen;
-    Direction drawn;
+    Direction<Floats> drawn;
 };
 
 // One step of the pipeline: weigh the batch at i, draw the next one, choose
 // the one after it at i + 2 kLanes (-1, or the lane of that batch whose wo
 // fails the check).
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE int pipeline_step(const SampleJob& job, std::int64_t i, const Shading& s, const CounterSeed& seed,
+PB_KERNEL_INLINE int pipeline_step(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed,
                                     InFlight& weighed, InFlight& drawn, InFlight& chosen) {
     weigh<model, layouts>(job, i, weighed.chosen, weighed.drawn, s);
     drawn.drawn = draw(job, drawn.chosen, s);
@@ -122,20 +123,20 @@ PB_KERNEL_INLINE int pipeline_step(const SampleJob& job, std::int64_t i, const S
 // Software-pipelined over batches: while batch b is weighed, batch b + 1
 // draws its direction and batch b + 2 chooses its lobe. The stages of one
 // batch are one long dependency chain (uniforms, lobe, direction, f and pdf)
-// and a batch alone has more instructions than the out-of-order window holds,
-// so run one after another the batches barely overlap; interleaved, the
-// independent work of three batches fills the wait. Each batch stays in one
-// of three slots from its choice to its weight, the slots' roles rotating
-// through a loop unrolled three times, so nothing moves from variable to
-// variable (when it did, GCC copied the spilled part through the stack every
-// batch: 1.25x slower on AVX-512). The batches before and after the loop run
-// the same operations in other copies of the code, to the same bits (no
-// contraction, see simd_ops.hpp). Not for per-element materials: each batch's Shading in
-// flight would not fit in the registers (interleaved they ran 0.8x as fast as
-// one after another).
+// longer than the out-of-order window, so batches run one after another
+// barely overlap; interleaved, the independent work of three batches fills
+// the wait. Each batch stays in one of three slots from its choice to its
+// weight, the slots' roles rotating through a loop unrolled three times, so
+// nothing is copied from variable to variable (a copy of the spilled part of
+// a batch's state through the stack, every batch, is what the rotation
+// avoids). The batches before and after the loop run the same operations in
+// other copies of the code, to the same bits (no contraction, see
+// simd_ops.hpp). Uniform materials only: with per-element materials each
+// batch's Shading in flight would not fit in the registers, so their batches
+// run one after another (bench/RESULTS.md has the figures).
 template <Model model, bool per_element, Layouts layouts>
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
-    Shading uniform{};
+    Shading<Floats> uniform{};
     if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
     const CounterSeed seed = counter_seed(job.seed);
     const std::int64_t batches = (end - begin) / kLanes;
@@ -174,7 +175,8 @@ std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int
     const Vec3Layout layout = job.wo.layout;
     const bool uniform_layout = (layout == Vec3Layout::kInterleaved || layout == Vec3Layout::kRows) &&
                                 job.wi.layout == layout && job.weight.layout == layout &&
-                                (job.u.data == nullptr || job.u.layout == layout);
+                                (job.u.data == nullptr || job.u.layout == layout) &&
+                                (job.lobe_weight[0].data == nullptr || job.lobe_weight[0].layout == layout);
     if (uniform_layout && layout == Vec3Layout::kInterleaved)
         return sample_loop<model, per_element, Layouts::kInterleaved>(job, begin, end);
     if (uniform_layout && layout == Vec3Layout::kRows)

@@ -250,3 +250,49 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
 }
 
 #endif
+
+// ---------------------------------------------------------------- what the model calls
+// (docs/model.md: the same names for double are in model/scalar_ops.hpp)
+
+PB_KERNEL_INLINE Floats select(const Mask& m, Floats a, Floats b) { return xsimd::select(m, a, b); }
+PB_KERNEL_INLINE Floats min(Floats a, Floats b) { return xsimd::min(a, b); }
+PB_KERNEL_INLINE Floats max(Floats a, Floats b) { return xsimd::max(a, b); }
+PB_KERNEL_INLINE bool any(const Mask& m) { return xsimd::any(m); }
+PB_KERNEL_INLINE bool all(const Mask& m) { return xsimd::all(m); }
+PB_KERNEL_INLINE Floats log(Floats x) { return xsimd::log(x); }
+PB_KERNEL_INLINE Floats largest_finite(Floats) { return Floats(std::numeric_limits<float>::max()); }
+
+// (sin 2πu, cos 2πu) for u in [0, 1] by the double angle, without quadrant
+// selects: with t = u - 1/2 and θ = πt in [-π/2, π/2], 2πu = 2θ + π, so
+//   sin 2πu = -2 sinθ cosθ = T C,  cos 2πu = 2 sin²θ - 1 = T² - 1,
+// T = √2 sinθ = t P(t²) and C = -√2 cosθ = Q(t²), near-minimax polynomials
+// of degrees 9 and 10 in t (Chebyshev least squares; 3e-8 in exact arithmetic,
+// under 8e-7 absolute after float rounding, against about 1e-7 for a
+// quadrant-reduced sincos; wi, pdf and weight stay consistent whatever φ is).
+PB_KERNEL_INLINE std::pair<Floats, Floats> sincos_turns(Floats u) {
+    const Floats t = u - 0.5f;
+    const Floats z = t * t;
+    Floats p(0.1098245158791542f);
+    for (float coefficient : {-0.8461116552352905f, 3.606354236602783f, -7.308245658874512f, 4.442883014678955f})
+        p = mul_add(p, z, Floats(coefficient));
+    Floats q(0.034501612186431885f);
+    for (float coefficient : {-0.33225154876708984f, 1.888274908065796f, -5.73988151550293f, 6.9788641929626465f, -1.4142135381698608f})
+        q = mul_add(q, z, Floats(coefficient));
+    const Floats root2_sin = t * p;
+    return {root2_sin * q, mul_sub(root2_sin, root2_sin, Floats(1.0f))};
+}
+
+// e^x - 1 for x in [0, 14] (the clearcoat draw): x = k ln 2 + r with k = round(x / ln 2)
+// (ln 2 in two parts, Cody-Waite, so r is exact to float precision) and |r| <= ln 2 / 2;
+// then e^x - 1 = 2^k (e^r - 1) + (2^k - 1), both terms of one sign for k >= 1, and
+// e^r - 1 = r (1 + r/2 + ... + r^6/7!) (Taylor). Relative error < 2e-7 over [0, 14].
+PB_KERNEL_INLINE Floats exp_minus_one(Floats x) {
+    const Ints k_int = xsimd::nearbyint_as_int(x * 1.44269504088896341f);  // one conversion on every instruction set
+    const Floats k = xsimd::to_float(k_int);
+    const Floats r = neg_mul_add(k, Floats(1.42860682030941723e-6f), neg_mul_add(k, Floats(0.693145751953125f), x));
+    Floats series(1.0f / 5040.0f);
+    for (float coefficient : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f})
+        series = mul_add(series, r, Floats(coefficient));
+    const Floats two_to_k = xsimd::bitwise_cast<Floats>((k_int + Ints(127)) << 23);
+    return mul_add(two_to_k, series * r, two_to_k - 1.0f);
+}

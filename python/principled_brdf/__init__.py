@@ -4,10 +4,9 @@ See the README for the model and the API tour.
 """
 
 from . import microfacet, plot, presets, reference, render
-from ._batch import Sample, cpu_info, eval, eval_lobes, pdf, random_uniforms, sample
+from ._batch import Lobes, Sample, cpu_info, eval, eval_lobes, pdf, random_uniforms, sample
 from .albedo import Albedo, albedo
 from .material import PARAMETERS, Material, gamma22_to_linear
-from .reference import Lobes
 
 __all__ = ["Material", "PARAMETERS", "Lobes", "Sample", "Albedo", "albedo", "gamma22_to_linear", "eval", "eval_lobes", "pdf", "sample",
            "random_uniforms", "cpu_info", "reference", "microfacet", "presets", "render", "plot"]

@@ -14,6 +14,8 @@ Input handling, once per call:
 from __future__ import annotations
 
 
+from typing import NamedTuple
+
 import numpy as np
 
 from . import _core
@@ -24,23 +26,43 @@ from ._validate import (
     direction_error,
     element_name,
     flag,
+    LOBE_NAMES,
     integer,
     model_index,
     require_float32,
+    sampler_index,
     require_in_domain,
     seed_value,
     unit_length,
 )
 from .material import PARAMETERS, Material
-from .reference import Lobes, Sample
 
-__all__ = ["eval", "eval_lobes", "pdf", "sample", "random_uniforms", "Sample", "cpu_info"]
+__all__ = ["eval", "eval_lobes", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
 
 _INTERLEAVED, _ROWS, _SINGLE = 0, 1, 2
+
+
+class Lobes(NamedTuple("LobeArrays", [(name, np.ndarray) for name in LOBE_NAMES])):
+    """The lobes of f (README "The model"), in the C++ table's order: ``diffuse``
+    (with subsurface, times 1 - metallic), ``sheen`` (times 1 - metallic),
+    ``specular`` and ``clearcoat`` (grey), each shaped like :func:`eval`'s
+    result, already weighted as they enter the sum."""
+
+    __slots__ = ()
+
+    def total(self) -> np.ndarray:
+        return sum(self[1:], self[0])
+
+
+class Sample(NamedTuple):
+    """What :func:`sample` and ``pb.reference.sample`` return."""
+
+    wi: np.ndarray  # (..., 3) drawn direction towards the light
+    pdf: np.ndarray  # (...) mixture density in solid angle; 0 at or below the horizon
+    weight: np.ndarray  # (..., 3) f(wi, wo) cos θl / pdf; 0 where pdf is 0
+    lobe: np.ndarray  # (...) int32, an index into SAMPLED_LOBE_NAMES: 0 cosine, 1 primary specular, 2 clearcoat
 _LAYOUTS = ("aos", "soa")
 
-
-_SPECULAR_SAMPLERS = {"visible": 0, "distribution": 1}
 
 
 def cpu_info() -> dict:
@@ -64,12 +86,6 @@ def _threads(threads) -> int:
     if count > 2**31 - 1:
         raise ValueError(f"threads: expected at most 2**31 - 1, got {count}")
     return count
-
-
-def _specular_sampler(name) -> int:
-    if name not in _SPECULAR_SAMPLERS:
-        raise ValueError(f"specular_sampler: expected one of {sorted(_SPECULAR_SAMPLERS)}, got {name!r}")
-    return _SPECULAR_SAMPLERS[name]
 
 
 def _isa(isa) -> str:
@@ -253,7 +269,7 @@ def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, o
     else:
         flat_outputs = [_flat_vec3(o, layout)[0] for o in outputs]
         bad = _core.batch_eval(wi_flat, wi_code, wo_flat, wo_code, params, flat_outputs,
-                               _INTERLEAVED if layout == "aos" else _ROWS, n, model_id, len(outputs) == 4,
+                               _INTERLEAVED if layout == "aos" else _ROWS, n, model_id, len(outputs) == len(LOBE_NAMES),
                                cosine, tolerance, thread_count, isa_name)
     if bad >= 0:
         raise _direction_error(bad, leading, wi_dirs, wo_dirs)
@@ -283,7 +299,7 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
     """The four lobes (diffuse, sheen, specular, clearcoat) as a :class:`Lobes`
     of float32 arrays, each shaped like :func:`eval`'s result."""
     outputs = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
-                        lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in range(4)])
+                        lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in LOBE_NAMES])
     return Lobes(*outputs)
 
 
@@ -294,7 +310,7 @@ def pdf(material: Material, wi, wo, *, specular_sampler: str = "visible", layout
     either direction is at or below the horizon. It does not depend on the model."""
     (density,) = _evaluate(material, wi, wo, 0, False, layout, threads, check, isa,
                            lambda leading, layout: [np.empty(leading, np.float32)],
-                           pdf_sampler=_specular_sampler(specular_sampler))
+                           pdf_sampler=sampler_index(specular_sampler))
     return density
 
 
@@ -313,23 +329,25 @@ def random_uniforms(seed: int, n: int, first: int = 0) -> np.ndarray:
 
 def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disney2014",
            specular_sampler: str = "visible", layout: str = "aos", threads=None, check: bool = True,
-           isa=None) -> Sample:
+           isa=None, with_lobes: bool = False):
     """Importance-sample ``wi`` for each ``wo`` (README "Sampling and pdf").
 
     ``u``: three uniforms in [0, 1] per element, ``(..., 3)`` (``(3, ...)`` for
     ``layout="soa"``), broadcast with ``wo`` and the material; without it they
     come from a counter-based generator keyed by ``(seed, element index)``
     (C order over the broadcast leading shape), independent of ``threads``.
-    Returns a :class:`Sample` of float32 ``wi``, ``pdf``, ``weight`` and int32 ``lobe``.
+    Returns a :class:`Sample` of float32 ``wi``, ``pdf``, ``weight`` and int32 ``lobe``;
+    with ``with_lobes=True``, ``(Sample, Lobes)``: each lobe's share of the weight,
+    ``f_k(wi, wo) cos θl / pdf``, from the same pass (they sum to ``weight``).
     """
     _require_material(material)
     model_id = model_index(model)
-    sampler = _specular_sampler(specular_sampler)
+    sampler = sampler_index(specular_sampler)
     layout = _layout(layout)
     thread_count = _threads(threads)
     isa_name = _isa(isa)
     seed = seed_value(seed)
-    check = flag("check", check)
+    check, with_lobes = flag("check", check), flag("with_lobes", with_lobes)
     wo_dirs = _Directions("wo", wo, layout)
     shapes = dict(wo=wo_dirs.leading, material=material.shape)
     uniforms = None
@@ -343,14 +361,16 @@ def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disne
     weight_out = np.empty_like(wi_out)
     pdf_out = np.empty(leading, np.float32)
     lobe_out = np.empty(leading, np.int32)
+    shares = [np.empty_like(wi_out) for _ in LOBE_NAMES] if with_lobes else None
     wo_flat, wo_code = wo_dirs.flat(leading)
     u_flat, u_code = uniforms.flat(leading) if uniforms is not None else (None, 0)
     bad = _core.batch_sample(
         wo_flat, wo_code, u_flat, u_code, seed, _params(material, leading), _flat_vec3(wi_out, layout)[0],
         _flat_vec3(weight_out, layout)[0], _INTERLEAVED if layout == "aos" else _ROWS, pdf_out.reshape(n),
         lobe_out.reshape(n), n, model_id, sampler, DIRECTION_LENGTH_TOLERANCE if check else 0.0, thread_count,
-        isa_name,
+        isa_name, None if shares is None else [_flat_vec3(share, layout)[0] for share in shares],
     )
     if bad >= 0:
         raise _direction_error(bad, leading, wo_dirs)
-    return Sample(wi_out, pdf_out, weight_out, lobe_out)
+    drawn = Sample(wi_out, pdf_out, weight_out, lobe_out)
+    return (drawn, Lobes(*shares)) if with_lobes else drawn

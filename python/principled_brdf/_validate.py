@@ -17,7 +17,11 @@ DIRECTION_LENGTH_TOLERANCE = 1e-3
 # A direction passes when its float64 squared length, summed as x² + y² + z²,
 # lies within these: the rule the kernels apply (batch.hpp, DirectionCheck).
 DIRECTION_LENGTH2_BOUNDS = tuple(_core.direction_length2_bounds(DIRECTION_LENGTH_TOLERANCE))
-MODELS = {"disney2014": 0, "disney2012": 1}
+# The C++ side's name tables (params.hpp), each in its enum's order.
+MODELS = {name: index for index, name in enumerate(_core.MODEL_NAMES)}
+SAMPLERS = {name: index for index, name in enumerate(_core.SAMPLER_NAMES)}  # of the primary specular lobe
+LOBE_NAMES = tuple(_core.LOBE_NAMES)  # of f, as eval_lobes returns them
+SAMPLED_LOBE_NAMES = tuple(_core.SAMPLED_LOBE_NAMES)  # by the index a sample reports
 FLOAT32_MAX = float(np.finfo(np.float32).max)
 _REAL_KINDS = "biuf"  # bool, signed and unsigned integers, floats
 
@@ -155,6 +159,12 @@ def model_index(model) -> int:
     if not isinstance(model, str) or model not in MODELS:
         raise ValueError(f"model: expected one of {sorted(MODELS)}, got {model!r}")
     return MODELS[model]
+
+
+def sampler_index(specular_sampler) -> int:
+    if not isinstance(specular_sampler, str) or specular_sampler not in SAMPLERS:
+        raise ValueError(f"specular_sampler: expected one of {sorted(SAMPLERS)}, got {specular_sampler!r}")
+    return SAMPLERS[specular_sampler]
 
 
 def broadcast_leading(**shapes: tuple) -> tuple:

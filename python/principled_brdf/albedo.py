@@ -8,10 +8,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._batch import eval_lobes, random_uniforms, sample
-from ._validate import as_real_array, broadcast_leading, integer, require_in_domain, seed_value
+from ._batch import Lobes, random_uniforms, sample
+from ._validate import LOBE_NAMES, as_real_array, broadcast_leading, integer, require_in_domain, seed_value
 from .material import PARAMETERS, Material
-from .reference import Lobes
 
 __all__ = ["Albedo", "albedo"]
 
@@ -66,8 +65,8 @@ def albedo(material: Material, cos_theta_o, *, samples: int = 1 << 16, seed: int
     cos_flat = np.broadcast_to(cos_o, leading).reshape(-1)
     m = cos_flat.size
 
-    sums = np.zeros((5, m, 3))  # total, then the four lobes
-    squares = np.zeros((5, m, 3))
+    sums = np.zeros((1 + len(LOBE_NAMES), m, 3))  # total, then the lobes
+    squares = np.zeros_like(sums)
     per_chunk = max(1, _CHUNK_ELEMENTS // count)
     flat_material = _flatten(expanded, leading)
     for start in range(0, m, per_chunk):
@@ -77,17 +76,13 @@ def albedo(material: Material, cos_theta_o, *, samples: int = 1 << 16, seed: int
         wo = np.broadcast_to(wo[:, None, :], (stop - start, count, 3))
         chunk_material = _slice(flat_material, start, stop)
         u = random_uniforms(seed, (stop - start) * count, first=start * count).reshape(stop - start, count, 3)
-        drawn = sample(chunk_material, wo, u=u, model=model, specular_sampler=specular_sampler, threads=threads,
-                       check=False)
-        values = eval_lobes(chunk_material, drawn.wi, wo, model=model, cosine=True, threads=threads, check=False)
-        inv_pdf = np.divide(1.0, drawn.pdf, out=np.zeros_like(drawn.pdf), where=drawn.pdf > 0)[..., None]
-        for k, lobe in enumerate(values):
-            weight = lobe.astype(np.float64) * inv_pdf
-            sums[k + 1, start:stop] = weight.sum(axis=1)
-            squares[k + 1, start:stop] = np.square(weight).sum(axis=1)
-        total = drawn.weight.astype(np.float64)
-        sums[0, start:stop] = total.sum(axis=1)
-        squares[0, start:stop] = np.square(total).sum(axis=1)
+        # one kernel pass: the weight and each lobe's share of it
+        drawn, shares = sample(chunk_material, wo, u=u, model=model, specular_sampler=specular_sampler,
+                               threads=threads, check=False, with_lobes=True)
+        for k, weight in enumerate((drawn.weight, *shares)):
+            weight = weight.astype(np.float64)
+            sums[k, start:stop] = weight.sum(axis=1)
+            squares[k, start:stop] = np.square(weight).sum(axis=1)
 
     mean = sums / count
     variance = np.maximum(squares / count - mean * mean, 0.0) * count / (count - 1)
@@ -95,9 +90,9 @@ def albedo(material: Material, cos_theta_o, *, samples: int = 1 << 16, seed: int
     shape = leading + (3,)
     return Albedo(
         total=mean[0].reshape(shape),
-        lobes=Lobes(*(mean[k].reshape(shape) for k in range(1, 5))),
+        lobes=Lobes(*(mean[k].reshape(shape) for k in range(1, len(sums)))),
         total_error=error[0].reshape(shape),
-        lobe_errors=Lobes(*(error[k].reshape(shape) for k in range(1, 5))),
+        lobe_errors=Lobes(*(error[k].reshape(shape) for k in range(1, len(sums)))),
     )
 
 

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._validate import as_real_array, broadcast_leading, directions, element_name, first_true, require_in_domain
+from . import _validate
 
 __all__ = [
     "MIN_ALPHA",
@@ -65,20 +65,20 @@ _core_mf = _core.microfacet
 
 def _positive(name: str, value, upper: float = np.inf) -> np.ndarray:
     """Finite values in (0, upper]."""
-    array = as_real_array(name, value)
-    require_in_domain(name, array, 0.0, upper)
+    array = _validate.as_real_array(name, value)
+    _validate.require_in_domain(name, array, 0.0, upper)
     bad = array <= 0.0
     if bad.any():
-        i = first_true(bad)
+        i = _validate.first_true(bad)
         domain = "(0, inf)" if np.isinf(upper) else f"(0, {upper:g}]"
         value = float(array.ravel()[i])
-        raise ValueError(f"{element_name(name, i, array.shape)}: {value!r} is outside its domain {domain}")
+        raise ValueError(f"{_validate.element_name(name, i, array.shape)}: {value!r} is outside its domain {domain}")
     return array
 
 
 def _in_range(name: str, value, lower: float, upper: float) -> np.ndarray:
-    array = as_real_array(name, value)
-    require_in_domain(name, array, lower, upper)
+    array = _validate.as_real_array(name, value)
+    _validate.require_in_domain(name, array, lower, upper)
     return array
 
 
@@ -106,7 +106,7 @@ def _run(core_function, *args, returns_vector: bool = False, **arguments):
         name: (value.array.shape[:-1] if isinstance(value, _Vector) else value.shape)
         for name, value in arguments.items()
     }
-    shape = broadcast_leading(**leading)
+    shape = _validate.broadcast_leading(**leading)
     trailing = (3,) if returns_vector else ()
     if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape + trailing)
@@ -153,7 +153,7 @@ def gtr_pdf(h, alpha, gamma, *, closed_forms: bool = True) -> np.ndarray:
     ``cos²θh`` and ``sin²θh`` are taken from the components of ``h``, so narrow
     peaks stay accurate where ``1 - cos²θh`` would cancel.
     """
-    hv = directions("h", h)
+    hv = _validate.directions("h", h)
     a = _positive("alpha", alpha, 1.0)
     g = _positive("gamma", gamma, MAX_GAMMA)
     return _run(_core_mf.gtr_pdf, bool(closed_forms), h=_Vector(hv), alpha=a, gamma=g)
@@ -183,14 +183,14 @@ def ggx_d(h, alpha_x, alpha_y=None) -> np.ndarray:
 
         D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²),  0 for h·n <= 0.
     """
-    hv = directions("h", h)
+    hv = _validate.directions("h", h)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
 
 
 def ggx_pdf(h, alpha_x, alpha_y=None) -> np.ndarray:
     """Density in solid angle of :func:`ggx_sample`: ``D(h) (h·n)``."""
-    hv = directions("h", h)
+    hv = _validate.directions("h", h)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
 
@@ -216,7 +216,7 @@ def ggx_sample_visible(wo, u1, u2, alpha_x, alpha_y=None) -> np.ndarray:
     warped towards the visible half), lifted and unstretched. A ``wo`` below the
     horizon is mirrored to ``-wo`` (two-sided use).
     """
-    w = directions("wo", wo)
+    w = _validate.directions("wo", wo)
     v1 = _uniform("u1", u1)
     v2 = _uniform("u2", u2)
     ax, ay = _alphas(alpha_x, alpha_y)
@@ -231,8 +231,8 @@ def ggx_pdf_visible(h, wo, alpha_x, alpha_y=None) -> np.ndarray:
     with ``G1 / |wo·n|`` written ``2 / (|wo·n| + sqrt((wo·n)² + αx² wox² + αy² woy²))``, finite at
     grazing ``wo``; ``wo`` below the horizon is mirrored to ``-wo`` as in the sampler.
     """
-    hv = directions("h", h)
-    w = directions("wo", wo)
+    hv = _validate.directions("h", h)
+    w = _validate.directions("wo", wo)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_pdf_visible, h=_Vector(hv), wo=_Vector(w), alpha_x=ax, alpha_y=ay)
 
@@ -245,22 +245,22 @@ def ggx_lambda(w, alpha_x, alpha_y=None) -> np.ndarray:
     evaluated as ``p² / (2|wz| (sqrt(wz² + p²) + |wz|))``, ``p² = αx² wx² + αy² wy²``:
     no cancellation and no overflow as ``wz -> 0``; +inf at exactly ``wz = 0``.
     """
-    wv = directions("w", w)
+    wv = _validate.directions("w", w)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
 
 
 def ggx_g1(w, alpha_x, alpha_y=None) -> np.ndarray:
     """Smith masking ``G1 = 1 / (1 + Λ(w)) = 2|wz| / (|wz| + sqrt(wz² + αx² wx² + αy² wy²))``."""
-    wv = directions("w", w)
+    wv = _validate.directions("w", w)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
 
 
 def ggx_g2_separable(wi, wo, alpha_x, alpha_y=None) -> np.ndarray:
     """Separable masking-shadowing ``G2 = G1(wi) G1(wo)`` (what the model uses)."""
-    a = directions("wi", wi)
-    b = directions("wo", wo)
+    a = _validate.directions("wi", wi)
+    b = _validate.directions("wo", wo)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_g2_separable, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay)
 
@@ -271,8 +271,8 @@ def ggx_g2_height_correlated(wi, wo, alpha_x, alpha_y=None) -> np.ndarray:
     Evaluated as ``2|zi||zo| / (|zi| ro + |zo| ri)``, ``r = sqrt(z² + αx² x² + αy² y²)``;
     0 when either direction is grazing.
     """
-    a = directions("wi", wi)
-    b = directions("wo", wo)
+    a = _validate.directions("wi", wi)
+    b = _validate.directions("wo", wo)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_g2_height_correlated, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay)
 
@@ -286,14 +286,14 @@ def beckmann_d(h, alpha_x, alpha_y=None) -> np.ndarray:
 
         D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴),  0 for h·n <= 0.
     """
-    hv = directions("h", h)
+    hv = _validate.directions("h", h)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.beckmann_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
 
 
 def beckmann_pdf(h, alpha_x, alpha_y=None) -> np.ndarray:
     """Density in solid angle of :func:`beckmann_sample`: ``D(h) (h·n)``."""
-    hv = directions("h", h)
+    hv = _validate.directions("h", h)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.beckmann_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
 
@@ -318,13 +318,13 @@ def beckmann_lambda(w, alpha_x, alpha_y=None) -> np.ndarray:
 
     (``a = 1 / (α_o tan θ)`` by eq. (3-25)); 0 at the normal, +inf at exactly grazing.
     """
-    wv = directions("w", w)
+    wv = _validate.directions("w", w)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.beckmann_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
 
 
 def beckmann_g1(w, alpha_x, alpha_y=None) -> np.ndarray:
     """Smith masking for Beckmann, ``G1 = 1 / (1 + Λ(w))``."""
-    wv = directions("w", w)
+    wv = _validate.directions("w", w)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.beckmann_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay)

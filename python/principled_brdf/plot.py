@@ -34,15 +34,13 @@ import numpy as np
 from . import presets as _presets
 from ._batch import eval as _eval
 from ._batch import eval_lobes as _eval_lobes
-from ._batch import random_uniforms as _random_uniforms
-from ._batch import sample as _sample
-from ._validate import model_index
+from . import _validate
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material
-from .render import DEFAULT_LIGHT, render_sphere, sphere_frames, to_srgb8
+from . import render as _render
 
 __all__ = ["brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves", "parameter_sweep", "blend_demo",
-           "sky_environment", "slice_directions", "SCALAR_PARAMETERS", "CHANNELS"]
+           "slice_directions", "SCALAR_PARAMETERS", "CHANNELS"]
 
 #: The ten scalar parameters of the model, in the library's order.
 SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items() if info.slots == 1)
@@ -55,11 +53,10 @@ CHANNELS = {
     "b": (0.0, 0.0, 1.0),
 }
 
-LOBE_NAMES = ("diffuse", "sheen", "specular", "clearcoat")
 _LOBE_COLORS = {"diffuse": "tab:orange", "sheen": "tab:purple", "specular": "tab:blue", "clearcoat": "tab:green",
                 "total": "black"}
 
-# Shading of render_sphere (pb.render), used where many spheres are shaded in one kernel call.
+# Shading of pb.render.render_sphere, used where many spheres are shaded in one kernel call.
 _LIGHT_INTENSITY = 3.0
 _AMBIENT = 0.03
 _BACKGROUND = "0.75"  # masked (undefined) pixels
@@ -148,7 +145,7 @@ def _project(rgb: np.ndarray, weights: np.ndarray) -> np.ndarray:
 
 def _rgba(linear: np.ndarray, inside: np.ndarray, exposure: float) -> np.ndarray:
     """8-bit sRGB with alpha 0 off the sphere, ``(..., R, R, 4)``."""
-    rgb = to_srgb8(linear, exposure)
+    rgb = _render.to_srgb8(linear, exposure)
     alpha = np.broadcast_to(np.where(inside, 255, 0).astype(np.uint8), rgb.shape[:-1])
     return np.concatenate([rgb, alpha[..., None]], axis=-1)
 
@@ -212,7 +209,7 @@ def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel:
     n = _resolution(resolution)
     rgb_mode = channel == "rgb"
     weights = None if rgb_mode else _channel(channel)
-    model_index(model)
+    _validate.model_index(model)
     for name, value in (("vmin", vmin), ("vmax", vmax)):
         if value is not None and _real(name, value, 0.0) <= 0.0 and log:
             raise ValueError(f"{name}: a logarithmic scale needs a positive value, got {value!r}")
@@ -244,7 +241,7 @@ def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel:
             scale = np.divide(level, luminance, out=np.zeros_like(luminance), where=luminance > 0.0)
             color = f * scale[..., None]
         else:
-            color = to_srgb8(f / top).astype(np.float64) / 255.0
+            color = _render.to_srgb8(f / top).astype(np.float64) / 255.0
         color = color / np.maximum(1.0, color.max(axis=-1, keepdims=True))  # keep the hue where it clips
         image = np.empty(color.shape[:-1] + (4,))
         image[..., :3] = np.where(valid[..., None], color, colors.to_rgb(_BACKGROUND))
@@ -288,7 +285,7 @@ def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = 
     theta = _real("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
     n = _resolution(resolution)
     weights = _channel(channel)
-    model_index(model)
+    _validate.model_index(model)
     ax = _axes(ax, polar=True)
 
     t = np.radians(np.linspace(-90.0, 90.0, n))
@@ -296,7 +293,7 @@ def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = 
     wi[[0, -1], 2] = 0.0  # exactly on the horizon (cos(±π/2) is 6e-17)
     wo = np.array([np.sin(np.radians(theta)), 0.0, np.cos(np.radians(theta))])
     values = _eval_lobes(material, wi, wo, cosine=cosine, model=model)
-    curves = {name: _project(v, weights) for name, v in zip(LOBE_NAMES, values)}
+    curves = {name: _project(v, weights) for name, v in zip(_validate.LOBE_NAMES, values)}
     total = sum(curves.values())
 
     if lobes:
@@ -323,45 +320,7 @@ def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = 
 # 3. lit sphere, optionally with an environment
 
 
-def sky_environment(direction, zenith=(0.25, 0.45, 1.0), horizon=(1.0, 1.0, 1.0), ground=(0.25, 0.22, 0.2)):
-    """A simple sky/ground gradient ``L(w)`` (RGB radiance) for camera-space directions ``(..., 3)``.
-
-    y is up (as in :mod:`principled_brdf.render`): above the horizon the sky
-    goes from ``horizon`` to ``zenith`` as ``sqrt(y)``; below it is ``ground``,
-    blended over a narrow band around the horizon.
-    """
-    w = np.asarray(direction, dtype=np.float64)
-    up = w[..., 1:2]
-    zenith, horizon, ground = (np.asarray(c, dtype=np.float64) for c in (zenith, horizon, ground))
-    sky = horizon + (zenith - horizon) * np.sqrt(np.clip(up, 0.0, 1.0))
-    blend = np.clip(0.5 + up / 0.04, 0.0, 1.0)
-    return ground + (sky - ground) * blend
-
-
-def _environment_term(material: Material, resolution: int, environment, samples: int, seed: int, model: str):
-    """Per-pixel ``∫ f L(wi) cos θl dwi`` by importance sampling (``pb.sample``), ``(R, R, 3)``."""
-    inside, to_local = sphere_frames(resolution)
-    wo = to_local((0.0, 0.0, 1.0))
-    # to_local(e_k)[..., j] = frame_j[k]: the rows of the local-to-camera matrix.
-    to_camera = np.stack([to_local(e) for e in np.eye(3)], axis=-2)  # [..., k, j]
-    pixels = resolution * resolution
-    chunk = max(1, (1 << 20) // pixels)
-    total = np.zeros((resolution, resolution, 3))
-    for start in range(0, samples, chunk):
-        count = min(chunk, samples - start)
-        u = _random_uniforms(seed, count * pixels, first=start * pixels).reshape(count, resolution, resolution, 3)
-        drawn = _sample(material, wo, u=u, model=model)
-        direction = np.einsum("...kj,s...j->s...k", to_camera, drawn.wi)
-        radiance = np.asarray(environment(direction), dtype=np.float64)
-        if radiance.shape != direction.shape:
-            raise ValueError(f"environment: expected RGB radiance of shape {direction.shape}, got {radiance.shape}")
-        total += np.einsum("s...c,s...c->...c", drawn.weight.astype(np.float64), radiance)
-    total /= samples
-    total[~inside] = 0.0
-    return total
-
-
-def lit_sphere(material, *, resolution: int = 256, light=DEFAULT_LIGHT, light_intensity: float = 3.0,
+def lit_sphere(material, *, resolution: int = 256, light=_render.DEFAULT_LIGHT, light_intensity: float = 3.0,
                environment=False, environment_samples: int = 64, seed: int = 0, exposure: float = 1.0,
                model: str = "disney2014", ax=None):
     """The material on a sphere (``pb.render.render_sphere``), shown as sRGB; returns the Axes.
@@ -370,7 +329,7 @@ def lit_sphere(material, *, resolution: int = 256, light=DEFAULT_LIGHT, light_in
     resolution)``). ``light``: direction towards the light in camera space
     (x right, y up, z to the viewer), ``light_intensity`` its irradiance
     scale (0 turns it off). ``environment``: ``True`` adds the
-    :func:`sky_environment` lighting, a callable ``L(w)`` (camera-space
+    :func:`pb.render.sky_environment` lighting, a callable ``L(w)`` (camera-space
     directions ``(..., 3)`` to RGB radiance) adds that one; the integral
     ``∫ f L cos θl dωi`` is estimated per pixel from ``environment_samples``
     importance samples (``pb.sample``, reproducible from ``seed``), and
@@ -382,7 +341,7 @@ def lit_sphere(material, *, resolution: int = 256, light=DEFAULT_LIGHT, light_in
     exposure = _real("exposure", exposure, 0.0)
     intensity = _real("light_intensity", light_intensity, 0.0)
     if environment is True:
-        environment = sky_environment
+        environment = _render.sky_environment
     elif environment is False or environment is None:
         environment = None
     elif not callable(environment):
@@ -391,14 +350,14 @@ def lit_sphere(material, *, resolution: int = 256, light=DEFAULT_LIGHT, light_in
         raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
                          f"got {material.shape}")
     count = _resolution(environment_samples, "environment_samples", minimum=1)
-    model_index(model)
+    _validate.model_index(model)
     ax = _axes(ax)
 
-    image = render_sphere(material, n, light=light, light_intensity=intensity,
+    image = _render.render_sphere(material, n, light=light, light_intensity=intensity,
                           ambient=_AMBIENT if environment is None else 0.0, model=model)
     if environment is not None:
-        image = image + _environment_term(material, n, environment, count, seed, model)
-    inside, _ = sphere_frames(n)
+        image = image + _render.render_environment(material, n, environment, count, seed, model)
+    inside, _ = _render.sphere_frames(n)
     ax.imshow(_rgba(image, inside, exposure), interpolation="nearest")
     _sphere_axes(ax, "lit sphere" + (" + environment" if environment is not None else ""))
     return ax
@@ -426,13 +385,13 @@ def albedo_curves(material, *, angles=np.linspace(0, 89, 46), samples: int = 1 <
     if np.any(theta < 0.0) or np.any(theta >= 90.0):
         raise ValueError(f"angles: expected degrees in [0, 90), got values from {theta.min():g} to {theta.max():g}")
     _resolution(samples, "samples")
-    model_index(model)
+    _validate.model_index(model)
     ax = _axes(ax)
 
     result = _albedo(material, np.cos(np.radians(theta)), samples=samples, seed=seed, model=model)
     curves = [("total", result.total, result.total_error)]
     if lobes:
-        curves += [(name, value, error) for name, value, error in zip(LOBE_NAMES, result.lobes, result.lobe_errors)]
+        curves += [(name, value, error) for name, value, error in zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)]
     for name, value, error in curves:
         mean, band = _project(value, weights), _project(error, weights) * 2.0
         if name != "total" and not np.any(mean > 0.0):
@@ -458,7 +417,7 @@ def _default_sweep_base() -> Material:
 
 
 def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11, resolution: int = 64, ranges=None,
-                    light=DEFAULT_LIGHT, exposure: float = 1.0, model: str = "disney2014", figsize=None):
+                    light=_render.DEFAULT_LIGHT, exposure: float = 1.0, model: str = "disney2014", figsize=None):
     """The grid of Burley 2012 figure 16: one row per parameter, that parameter
     going from 0 to 1 (or ``ranges[name] = (lo, hi)``) in ``steps`` spheres
     along the row, every other parameter as in ``base``; returns the Figure.
@@ -508,8 +467,8 @@ def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11,
     except ValueError as error:
         raise ValueError(f"ranges: {error}") from None
 
-    linear = render_sphere(material, n, light=light, light_intensity=_LIGHT_INTENSITY, ambient=_AMBIENT, model=model)
-    inside = sphere_frames(n)[0]
+    linear = _render.render_sphere(material, n, light=light, light_intensity=_LIGHT_INTENSITY, ambient=_AMBIENT, model=model)
+    inside = _render.sphere_frames(n)[0]
     spheres = _rgba(linear, inside, exposure)  # (rows, steps, R, R, 4)
     pad = max(1, n // 16)
     spheres = np.pad(spheres, ((0, 0), (0, 0), (pad, pad), (pad, pad), (0, 0)))
@@ -544,7 +503,7 @@ def _checker(resolution: int, cells: int = 8) -> np.ndarray:
     return ((index[:, None] + index[None, :]) % 2).astype(np.float64)
 
 
-def blend_demo(a, b, *, mask=None, resolution: int = 256, light=DEFAULT_LIGHT, exposure: float = 1.0,
+def blend_demo(a, b, *, mask=None, resolution: int = 256, light=_render.DEFAULT_LIGHT, exposure: float = 1.0,
                model: str = "disney2014", ax=None):
     """A sphere of ``Material.mix(a, b, mask)`` with a per-pixel mask; returns the Axes.
 
@@ -570,10 +529,10 @@ def blend_demo(a, b, *, mask=None, resolution: int = 256, light=DEFAULT_LIGHT, e
             index = np.unravel_index(int(np.flatnonzero(bad)[0]), mask.shape)
             raise ValueError(f"mask{list(index) if index else ''}: {float(mask[index])!r} is outside [0, 1]")
     material = Material.mix(a, b, np.broadcast_to(mask, (n, n)))
-    model_index(model)
+    _validate.model_index(model)
     ax = _axes(ax)
-    image = render_sphere(material, n, light=light, model=model)
-    inside, _ = sphere_frames(n)
+    image = _render.render_sphere(material, n, light=light, model=model)
+    inside, _ = _render.sphere_frames(n)
     ax.imshow(_rgba(image, inside, exposure), interpolation="nearest")
     _sphere_axes(ax, "Material.mix(a, b, mask)")
     return ax

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from .material import Material
 
+__all__ = ["get", "names", "parameters"]
+
 _PRESETS = {
     # Metals: base_color is the specular colour at normal incidence.
     "gold": dict(base_color=(1.0, 0.766, 0.336), metallic=1.0, roughness=0.3),

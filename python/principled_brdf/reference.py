@@ -2,39 +2,23 @@
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
 
 from . import _core
-from ._validate import as_real_array, broadcast_leading, directions, flag, model_index, require_in_domain
+from . import _validate
+from ._batch import Lobes, Sample
 from .material import Material
 
-__all__ = ["eval", "eval_lobes", "Lobes", "sample", "pdf", "lobe_probabilities", "Sample", "SPECULAR_SAMPLERS"]
-
-# README "Sampling and pdf": how the primary specular lobe draws its half vector.
-SPECULAR_SAMPLERS = {"visible": 0, "distribution": 1}
-
-
-class Lobes(NamedTuple):
-    """The four lobes of README "The model", each ``(..., 3)``, already weighted as they enter the sum."""
-
-    diffuse: np.ndarray  # diffuse + subsurface, times (1 - metallic)
-    sheen: np.ndarray  # times (1 - metallic)
-    specular: np.ndarray  # primary GTR2 lobe
-    clearcoat: np.ndarray  # grey
-
-    def total(self) -> np.ndarray:
-        return self.diffuse + self.sheen + self.specular + self.clearcoat
+__all__ = ["eval", "eval_lobes", "Lobes", "sample", "pdf", "lobe_probabilities", "Sample"]
 
 
 def _prepare(material, wi, wo, model):
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
-    model_id = model_index(model)
-    wi = directions("wi", wi)
-    wo = directions("wo", wo)
-    shape = broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
+    model_id = _validate.model_index(model)
+    wi = _validate.directions("wi", wi)
+    wo = _validate.directions("wo", wo)
+    shape = _validate.broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
     rows = lambda w: np.ascontiguousarray(np.broadcast_to(w, shape + (3,)).reshape(-1, 3))  # noqa: E731
     return shape, rows(wi), rows(wo), material.packed(shape), model_id
 
@@ -42,7 +26,7 @@ def _prepare(material, wi, wo, model):
 def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False) -> np.ndarray:
     """f(wi, wo) in 1/sr as float64 ``(..., 3)``; times cos θl if ``cosine``."""
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, wi, wo, model)
-    cosine = flag("cosine", cosine)
+    cosine = _validate.flag("cosine", cosine)
     f = _core.reference_eval(wi_rows, wo_rows, params, model_id, False)
     if cosine:
         f *= np.maximum(wi_rows[:, 2:3], 0.0)
@@ -52,38 +36,23 @@ def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool 
 def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False) -> Lobes:
     """The four lobes as a :class:`Lobes` of float64 ``(..., 3)`` arrays."""
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, wi, wo, model)
-    cosine = flag("cosine", cosine)
+    cosine = _validate.flag("cosine", cosine)
     lobes = _core.reference_eval(wi_rows, wo_rows, params, model_id, True)
     if cosine:
         lobes *= np.maximum(wi_rows[:, None, 2:3], 0.0)
-    return Lobes(*(lobes[:, k, :].reshape(shape + (3,)) for k in range(4)))
+    return Lobes(*(lobes[:, k, :].reshape(shape + (3,)) for k in range(len(Lobes._fields))))
 
 
 # --------------------------------------------------------------------------
 # sampling (README "Sampling and pdf")
 
 
-class Sample(NamedTuple):
-    """What ``sample`` returns (the SIMD ``pb.sample`` returns the same type)."""
-
-    wi: np.ndarray  # (..., 3) drawn direction towards the light
-    pdf: np.ndarray  # (...) mixture density in solid angle; 0 at or below the horizon
-    weight: np.ndarray  # (..., 3) f(wi, wo) cos θl / pdf; 0 where pdf is 0
-    lobe: np.ndarray  # (...) int32: 0 cosine, 1 primary specular, 2 clearcoat
-
-
-def specular_sampler_index(specular_sampler) -> int:
-    if not isinstance(specular_sampler, str) or specular_sampler not in SPECULAR_SAMPLERS:
-        raise ValueError(f"specular_sampler: expected one of {sorted(SPECULAR_SAMPLERS)}, got {specular_sampler!r}")
-    return SPECULAR_SAMPLERS[specular_sampler]
-
-
-def uniforms(name: str, value) -> np.ndarray:
+def _uniforms(name: str, value) -> np.ndarray:
     """A float64 ``(..., 3)`` array of numbers in [0, 1], checked (README "Bad input")."""
-    array = as_real_array(name, value)
+    array = _validate.as_real_array(name, value)
     if array.ndim == 0 or array.shape[-1] != 3:
         raise ValueError(f"{name}: expected shape (..., 3) with (u0, u1, u2) on the last axis, got {array.shape}")
-    require_in_domain(name, array, 0.0, 1.0)
+    _validate.require_in_domain(name, array, 0.0, 1.0)
     return array
 
 
@@ -123,11 +92,11 @@ def sample(material: Material, wo, u, *, model: str = "disney2014", specular_sam
     both are 0 when ``wi`` or ``wo`` is at or below the horizon.
     """
     _check_material(material)
-    model_id = model_index(model)
-    sampler_id = specular_sampler_index(specular_sampler)
-    wo = directions("wo", wo)
-    u = uniforms("u", u)
-    shape = broadcast_leading(wo=wo.shape[:-1], u=u.shape[:-1], material=material.shape)
+    model_id = _validate.model_index(model)
+    sampler_id = _validate.sampler_index(specular_sampler)
+    wo = _validate.directions("wo", wo)
+    u = _uniforms("u", u)
+    shape = _validate.broadcast_leading(wo=wo.shape[:-1], u=u.shape[:-1], material=material.shape)
     if int(np.prod(shape, dtype=np.int64)) == 0:
         return Sample(np.zeros(shape + (3,)), np.zeros(shape), np.zeros(shape + (3,)), np.zeros(shape, np.int32))
     wi, density, weight, lobe = _core.reference_sample(
@@ -144,11 +113,11 @@ def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampl
     ``model`` (accepted for symmetry with :func:`sample`; only the weights do).
     """
     _check_material(material)
-    model_id = model_index(model)
-    sampler_id = specular_sampler_index(specular_sampler)
-    wi = directions("wi", wi)
-    wo = directions("wo", wo)
-    shape = broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
+    model_id = _validate.model_index(model)
+    sampler_id = _validate.sampler_index(specular_sampler)
+    wi = _validate.directions("wi", wi)
+    wo = _validate.directions("wo", wo)
+    shape = _validate.broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
     if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape)
     density = _core.reference_pdf(_shared_or_rows(wi, shape, 3), _shared_or_rows(wo, shape, 3),
@@ -160,8 +129,8 @@ def lobe_probabilities(material: Material, wo) -> np.ndarray:
     """``(P0, P1, P2)`` on the last axis, ``(..., 3)``: the chances of the cosine, primary
     specular and clearcoat lobes at ``wo`` (README "Lobe probabilities")."""
     _check_material(material)
-    wo = directions("wo", wo)
-    shape = broadcast_leading(wo=wo.shape[:-1], material=material.shape)
+    wo = _validate.directions("wo", wo)
+    shape = _validate.broadcast_leading(wo=wo.shape[:-1], material=material.shape)
     if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape + (3,))
     p = _core.reference_lobe_probabilities(_shared_or_rows(wo, shape, 3), _material_rows(material, shape))

@@ -14,9 +14,14 @@ import zlib
 
 import numpy as np
 
-from ._validate import as_real_array, require_finite, require_in_domain
+from . import _validate
 from ._batch import eval as _eval
+from ._batch import random_uniforms as _random_uniforms
+from ._batch import sample as _sample
 from .material import Material
+
+__all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_frames", "to_srgb8", "write_png",
+           "DEFAULT_LIGHT", "MAX_RESOLUTION"]
 
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
 
@@ -33,10 +38,10 @@ def _resolution(value) -> int:
 
 
 def _light_direction(value) -> np.ndarray:
-    light = as_real_array("light", value)
+    light = _validate.as_real_array("light", value)
     if light.shape != (3,):
         raise ValueError(f"light: expected a 3-vector towards the light, got shape {light.shape}")
-    require_finite("light", light)
+    _validate.require_finite("light", light)
     length = float(np.linalg.norm(light))
     if not 0.0 < length < np.inf:
         raise ValueError(f"light: expected a non-zero direction, got {light.tolist()}")
@@ -44,10 +49,10 @@ def _light_direction(value) -> np.ndarray:
 
 
 def _non_negative(name: str, value) -> float:
-    array = as_real_array(name, value)
+    array = _validate.as_real_array(name, value)
     if array.shape != ():
         raise ValueError(f"{name}: expected one number, got shape {array.shape}")
-    require_in_domain(name, array, 0.0, np.inf)
+    _validate.require_in_domain(name, array, 0.0, np.inf)
     return float(array)
 
 
@@ -99,6 +104,49 @@ def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT
     radiance += np.float32(ambient) * np.asarray(material.base_color, dtype=np.float32)
     radiance[..., ~inside, :] = 0.0
     return radiance
+
+
+def sky_environment(direction, zenith=(0.25, 0.45, 1.0), horizon=(1.0, 1.0, 1.0), ground=(0.25, 0.22, 0.2)):
+    """A simple sky/ground gradient ``L(w)`` (RGB radiance) for camera-space directions ``(..., 3)``.
+
+    y is up (as in :mod:`principled_brdf.render`): above the horizon the sky
+    goes from ``horizon`` to ``zenith`` as ``sqrt(y)``; below it is ``ground``,
+    blended over a narrow band around the horizon.
+    """
+    w = np.asarray(direction, dtype=np.float64)
+    up = w[..., 1:2]
+    zenith, horizon, ground = (np.asarray(c, dtype=np.float64) for c in (zenith, horizon, ground))
+    sky = horizon + (zenith - horizon) * np.sqrt(np.clip(up, 0.0, 1.0))
+    blend = np.clip(0.5 + up / 0.04, 0.0, 1.0)
+    return ground + (sky - ground) * blend
+
+
+def render_environment(material: Material, resolution: int = 256, environment=None, samples: int = 64, seed: int = 0,
+                       model: str = "disney2014") -> np.ndarray:
+    """Linear RGB ``(resolution, resolution, 3)``: the sphere of :func:`render_sphere` lit by
+    ``environment`` (camera-space directions ``(..., 3)`` to RGB radiance; default
+    :func:`sky_environment`), per pixel ``∫ f L(wi) cos θl dωi`` estimated from
+    ``samples`` importance samples (``pb.sample``, reproducible from ``seed``)."""
+    environment = sky_environment if environment is None else environment
+    inside, to_local = sphere_frames(resolution)
+    wo = to_local((0.0, 0.0, 1.0))
+    # to_local(e_k)[..., j] = frame_j[k]: the rows of the local-to-camera matrix.
+    to_camera = np.stack([to_local(e) for e in np.eye(3)], axis=-2)  # [..., k, j]
+    pixels = resolution * resolution
+    chunk = max(1, (1 << 20) // pixels)
+    total = np.zeros((resolution, resolution, 3))
+    for start in range(0, samples, chunk):
+        count = min(chunk, samples - start)
+        u = _random_uniforms(seed, count * pixels, first=start * pixels).reshape(count, resolution, resolution, 3)
+        drawn = _sample(material, wo, u=u, model=model)
+        direction = np.einsum("...kj,s...j->s...k", to_camera, drawn.wi)
+        radiance = np.asarray(environment(direction), dtype=np.float64)
+        if radiance.shape != direction.shape:
+            raise ValueError(f"environment: expected RGB radiance of shape {direction.shape}, got {radiance.shape}")
+        total += np.einsum("s...c,s...c->...c", drawn.weight.astype(np.float64), radiance)
+    total /= samples
+    total[~inside] = 0.0
+    return total
 
 
 def to_srgb8(linear: np.ndarray, exposure: float = 1.0) -> np.ndarray:

@@ -46,13 +46,6 @@ enum class Output : int {
     kLobes = 1,  // diffuse, sheen, specular, clearcoat
     kPdf = 2,    // the sampling pdf of (wi, wo)
 };
-inline constexpr int kLobeCount = 4;
-
-// How the primary specular lobe is sampled (README "Sampling and pdf").
-enum class SpecularSampler : int {
-    kVisibleNormals = 0,  // Dupuy & Benyoub 2023 spherical caps; pdf G1(wo) Ds / (4 cos θv)
-    kDistribution = 1,    // the paper's eq. 14-15; pdf Ds cos θh / (4 cos θd)
-};
 
 inline bool uniform_material(const ParamSlot* params) {
     for (int s = 0; s < kParamSlots; ++s)
@@ -115,6 +108,9 @@ struct SampleJob {
     MutableVec3Array wi, weight;  // outputs, (N, 3) or (3, N)
     float* pdf = nullptr;         // output, N
     std::int32_t* lobe = nullptr; // output, N: 0 cosine, 1 specular, 2 clearcoat
+    // optional outputs, (N, 3) or (3, N) each: every lobe's share of the weight
+    // (the lobe's value cos θl / pdf, in kLobeNames' order); unused when the first is null
+    MutableVec3Array lobe_weight[kLobeCount];
     DirectionCheck check;  // of wo, as in EvalJob
 };
 

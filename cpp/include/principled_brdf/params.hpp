@@ -54,10 +54,33 @@ inline constexpr std::array<ParamInfo, 11> kParams{{
     {"clearcoat_gloss", kClearcoatGloss, 1, {1.0}, 0.0, 1.0},
 }};
 
-// Which specular masking term the model uses (README "The model").
+// The default of the parameter that owns a slot (base_color's for its three).
+constexpr double default_of(Param slot) {
+    for (const ParamInfo& info : kParams)
+        if (slot >= info.first_slot && slot < info.first_slot + info.slots) return info.default_value[slot - info.first_slot];
+    return 0.0;
+}
+
+// Which specular masking term the model uses (README "The model"); the names
+// are the Python ones, in the enum's order.
 enum class Model : int {
     kDisney2014 = 0,  // anisotropic Smith GGX with the material's alpha_x, alpha_y
     kDisney2012 = 1,  // isotropic Smith GGX with alpha_g = (0.5 + roughness / 2)^2
 };
+inline constexpr std::array<const char*, 2> kModelNames{"disney2014", "disney2012"};
+
+// The lobes of f, in the order eval_lobes returns them.
+inline constexpr std::array<const char*, 4> kLobeNames{"diffuse", "sheen", "specular", "clearcoat"};
+inline constexpr int kLobeCount = static_cast<int>(kLobeNames.size());
+
+// The lobes sampling draws from, by the index a sample reports.
+inline constexpr std::array<const char*, 3> kSampledLobeNames{"cosine", "specular", "clearcoat"};
+
+// How the primary specular lobe draws its half vector (README "Sampling and pdf").
+enum class SpecularSampler : int {
+    kVisibleNormals = 0,  // Dupuy & Benyoub 2023 spherical caps; pdf G1(wo) Ds / (4 cos θv)
+    kDistribution = 1,    // Burley 2012 eq. 14-15; pdf Ds cos θh / (4 cos θd)
+};
+inline constexpr std::array<const char*, 2> kSpecularSamplerNames{"visible", "distribution"};
 
 }  // namespace principled_brdf

@@ -1,0 +1,118 @@
+"""pb.eval and pb.sample beside Mitsuba 3's `principled` BSDF on the same pairs and material.
+
+    pip install mitsuba==3.5.2 drjit==0.4.6      # and Debian's libllvm16
+    DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-16.so.1 python3 bench/compare_mitsuba.py
+
+Mitsuba runs its LLVM backend (variant llvm_ad_rgb, no gradients asked for),
+whose JIT folds the uniform material's constants into the kernel. Its `wi`
+is this library's `wo` (towards the viewer) and its `eval` includes the
+cosine, so it is timed against `pb.eval(..., cosine=True)`; its `sample`
+against `pb.sample` with given uniforms. Each figure is the best of
+`--repeats` timed runs after a warm-up (which compiles Mitsuba's kernel);
+Dr.Jit runs asynchronously, so its timer stops after `dr.sync_thread()`.
+"One core" pins the process to CPU 0 (sched_setaffinity) and runs both on
+one thread; "all" uses every core. Prints a Markdown table (M pairs/s and
+ratios); not a test dependency.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+import principled_brdf as pb
+
+MATERIAL = dict(base_color=(0.82, 0.67, 0.16), metallic=0.2, roughness=0.4, sheen=0.2, clearcoat=0.5,
+                clearcoat_gloss=0.7, specular=0.5)
+
+
+def best_seconds(run, repeats: int) -> float:
+    run()  # warm-up: page faults, Mitsuba's JIT
+    best = np.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        run()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def random_pairs(n: int, seed: int = 1):
+    rng = np.random.default_rng(seed)
+
+    def upper(size):
+        v = rng.normal(size=(size, 3))
+        v[:, 2] = np.abs(v[:, 2]) + 1e-3
+        return (v / np.linalg.norm(v, axis=1, keepdims=True)).astype(np.float32)
+
+    return upper(n), upper(n), rng.random((n, 3), dtype=np.float32)
+
+
+def mitsuba_timers(n: int, wi, wo, u, repeats: int):
+    import drjit as dr
+    import mitsuba as mi
+
+    mi.set_variant("llvm_ad_rgb")
+    bsdf = mi.load_dict({"type": "principled", "base_color": {"type": "rgb", "value": list(MATERIAL["base_color"])},
+                         **{k: v for k, v in MATERIAL.items() if k != "base_color"}})
+    ctx = mi.BSDFContext()
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f(wo[:, 0], wo[:, 1], wo[:, 2])  # Mitsuba's wi: towards the viewer
+    light = mi.Vector3f(wi[:, 0], wi[:, 1], wi[:, 2])
+    sample1, sample2 = mi.Float(u[:, 0]), mi.Point2f(u[:, 1], u[:, 2])
+
+    def evaluate():
+        value = bsdf.eval(ctx, si, light)
+        dr.eval(value)
+        dr.sync_thread()
+
+    def sample():
+        drawn, weight = bsdf.sample(ctx, si, sample1, sample2)
+        dr.eval(drawn.wo, drawn.pdf, weight)
+        dr.sync_thread()
+
+    return {"eval": best_seconds(evaluate, repeats), "sample": best_seconds(sample, repeats)}
+
+
+def library_timers(n: int, wi, wo, u, threads, repeats: int):
+    m = pb.Material(**MATERIAL)
+    out = np.empty_like(wi)
+    return {
+        "eval, out=, check=False": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, out=out, check=False,
+                                                                threads=threads), repeats),
+        "eval, out= (checked)": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, out=out, threads=threads),
+                                             repeats),
+        "eval, fresh output (checked)": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, threads=threads),
+                                                     repeats),
+        "sample, u given": best_seconds(lambda: pb.sample(m, wo, u=u, threads=threads), repeats),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[1 << 16, 1 << 20, 1 << 24])
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args()
+    import drjit as dr
+
+    cores = sorted(os.sched_getaffinity(0))
+    print(f"principled-brdf {pb.__version__}, {pb.cpu_info()['isa']}; Mitsuba 3 llvm_ad_rgb\n")
+    print("| pairs | cores | call | pb M pairs/s | Mitsuba M pairs/s | pb / Mitsuba |\n|---:|---|---|---:|---:|---:|")
+    for label, affinity, threads in (("one (pinned)", {cores[0]}, 1), ("all", set(cores), None)):
+        os.sched_setaffinity(0, affinity)
+        dr.set_thread_count(len(affinity))
+        for n in args.sizes:
+            wi, wo, u = random_pairs(n)
+            theirs = mitsuba_timers(n, wi, wo, u, args.repeats)
+            ours = library_timers(n, wi, wo, u, threads, args.repeats)
+            for call, seconds in ours.items():
+                peer = theirs["sample" if call.startswith("sample") else "eval"]
+                print(f"| {n:,} | {label} | {call} | {n / seconds / 1e6:.0f} | {n / peer / 1e6:.0f} | "
+                      f"{peer / seconds:.2f}x |", flush=True)
+    os.sched_setaffinity(0, set(cores))
+
+
+if __name__ == "__main__":
+    main()

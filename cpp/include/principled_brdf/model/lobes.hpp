@@ -1,0 +1,136 @@
+// Part of the model (docs/model.md): the lobes of the principled BRDF over a
+// number type F, each with the constants it prepares once per material (per
+// call for a uniform material, per batch otherwise) and what it contributes:
+// its value, its share of the lobe choice (a cheap estimate of its albedo at
+// wo) and its density.
+#pragma once  // (per namespace that includes the model)
+
+// What the lobes read of a pair (wi, wo): the half vector H = wi + wo kept
+// unnormalised (README "The model", numerics).
+template <class F>
+struct Geometry : HalfVector<F> {
+    Vec3<F> wi, wo;
+    F cos_theta_d;            // |H| / 2 (= wi·h = wo·h for unit vectors)
+    F one_minus_cos_theta_d;  // |wi - wo|² / (4 (1 + cos θd)): no cancellation as wi -> wo
+    MaskOf<F> finite;         // false where a direction held NaN, infinity or a huge value (checks off)
+};
+
+template <class F>
+PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
+    Geometry<F> g;
+    g.wi = wi;
+    g.wo = wo;
+    const F hx = wi.x + wo.x, hy = wi.y + wo.y;
+    g.hz = wi.z + wo.z;
+    g.hx2 = hx * hx;
+    g.hy2 = hy * hy;
+    g.hz2 = g.hz * g.hz;
+    g.h_len2 = g.hx2 + g.hy2 + g.hz2;
+    g.finite = g.h_len2 <= largest_finite(g.h_len2);
+    g.cos_theta_d = F(0.5) * g.h_len2 * reciprocal_sqrt(g.h_len2);
+    const F dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
+    const F d_len2 = mul_add(dx, dx, mul_add(dy, dy, dz * dz));
+    g.one_minus_cos_theta_d = d_len2 * reciprocal(mul_add(F(4.0), g.cos_theta_d, F(4.0)));
+    return g;
+}
+
+// The Schlick weights of the pair: FL, FV, FH.
+template <class F>
+struct Fresnel {
+    F fl, fv, fh;
+};
+
+// Diffuse with its subsurface blend (Burley 2012 §5.3):
+//   (1/π) mix(Fd, ss, subsurface) base_color (1 - metallic),
+//   Fd = mix(1, Fd90, FL) mix(1, Fd90, FV),  Fd90 = 0.5 + 2 roughness cos²θd,
+//   ss = 1.25 (Fss (1 / (cos θl + cos θv) - 0.5) + 0.5),  Fss90 = roughness cos²θd.
+// Sampled by the cosine lobe (cos θl / π), which also serves the sheen.
+template <class F>
+struct DiffuseLobe {
+    Rgb<F> color;  // base_color (1 - metallic) / π
+    F subsurface, roughness;
+    F cosine_lobe_weight;  // w0 = (1 - metallic) (Cdlum + 0.1 sheen lum(Csheen))
+
+    // the scalar factor of color
+    PB_MODEL_INLINE F value(const Geometry<F>& g, const Fresnel<F>& fresnel) const {
+        const F one(1.0);
+        const F cos2_theta_d = F(0.25) * g.h_len2;
+        const F fd90_minus_1 = mul_add(F(2.0) * roughness, cos2_theta_d, F(-0.5));
+        const F fd = mul_add(fd90_minus_1, fresnel.fl, one) * mul_add(fd90_minus_1, fresnel.fv, one);
+        // Skipped when 0 in every lane: for a uniform material the test has the
+        // same outcome for every batch, and mix(fd, ss, 0) = fd bit for bit.
+        if (!any(subsurface != F(0.0))) return fd;
+        const F fss90_minus_1 = mul_sub(roughness, cos2_theta_d, one);
+        const F fss = mul_add(fss90_minus_1, fresnel.fl, one) * mul_add(fss90_minus_1, fresnel.fv, one);
+        const F inv_cos_sum = reciprocal(g.wi.z + g.wo.z);
+        const F ss = F(1.25) * mul_add(fss, inv_cos_sum - F(0.5), F(0.5));
+        return mix(fd, ss, subsurface);
+    }
+};
+
+// Sheen: FH sheen Csheen (1 - metallic), Csheen = mix(1, Ctint, sheen_tint).
+template <class F>
+struct SheenLobe {
+    Rgb<F> color;  // sheen Csheen (1 - metallic); the lobe is FH times it
+};
+
+// The primary specular Gs Fs Ds: anisotropic GGX, Fs = mix(Cspec0, 1, FH), and
+// Gs = S(wi) S(wo) with S(w) = G1(w) / (2 n·w): anisotropic Smith in the 2014
+// model, isotropic Smith with alpha_g = (0.5 + roughness / 2)² in the 2012 one.
+template <class F>
+struct SpecularLobe {
+    Rgb<F> f0;        // Cspec0
+    F f0_luminance;   // lum(Cspec0)
+    Ggx<F> ggx;
+    F alpha_g2;       // alpha_g² of the 2012 model's Smith term
+
+    // Gs Ds, the scalar factor of Fs, given the Smith denominator of wo
+    template <Model model>
+    PB_MODEL_INLINE F value(const Geometry<F>& g, F smith_wo) const {
+        F denominator;
+        if constexpr (model == Model::kDisney2012) {
+            denominator = smith_denominator_iso(g.wi, alpha_g2) * smith_wo;
+        } else {
+            denominator = ggx.smith_denominator(g.wi) * smith_wo;
+        }
+        return ggx.d(g) * reciprocal(denominator);
+    }
+
+    // w1 = max(lum(mix(Cspec0, 1, FV)), 0.02)
+    PB_MODEL_INLINE F weight(F fv) const { return max(mix(f0_luminance, F(1.0), fv), F(0.02)); }
+
+    // the density in wi of the half vector drawn by `sampler`
+    PB_MODEL_INLINE F pdf(const Geometry<F>& g, F smith_visible_wo, SpecularSampler sampler) const {
+        const F d_h = ggx.d(g);
+        return sampler == SpecularSampler::kDistribution ? ggx.distribution_pdf(d_h, g) : ggx.visible_pdf(d_h, smith_visible_wo);
+    }
+};
+
+// Clearcoat 0.25 clearcoat Gr Fr Dr: GTR1 with ac = mix(0.1, 0.001, clearcoat_gloss),
+// Fr = mix(0.04, 1, FH), Gr = Siso(wi, 0.25) Siso(wo, 0.25).
+template <class F>
+struct ClearcoatLobe {
+    Gtr1<F> gtr1;
+    F scale;        // 0.25 clearcoat (ac² - 1) / (π ln ac²)
+    F lobe_weight;  // 0.25 clearcoat
+
+    static constexpr double kSmithAlpha2 = 0.0625;  // Gr's alpha 0.25, squared
+
+    PB_MODEL_INLINE bool absent() const { return !any(scale != F(0.0)); }
+
+    // the Smith denominator of wo at alpha 0.25 (1 when no lane has a clearcoat)
+    PB_MODEL_INLINE F smith_wo(const Vec3<F>& wo) const {
+        return absent() ? F(1.0) : smith_denominator_iso_small(wo.z, F(kSmithAlpha2));
+    }
+
+    // the grey value (0 in every lane without a clearcoat)
+    PB_MODEL_INLINE F value(const Geometry<F>& g, F fh, F smith_wo) const {
+        if (absent()) return F(0.0);
+        const F fr = mul_add(F(0.96), fh, F(0.04));
+        const F denominator = smith_denominator_iso_small(g.wi.z, F(kSmithAlpha2)) * smith_wo;
+        return scale * fr * g.h_len2 * reciprocal(gtr1.denominator(g) * denominator);
+    }
+
+    // w2 = 0.25 clearcoat mix(0.04, 1, FV)
+    PB_MODEL_INLINE F weight(F fv) const { return lobe_weight * mul_add(F(0.96), fv, F(0.04)); }
+};

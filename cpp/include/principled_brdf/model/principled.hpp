@@ -1,0 +1,282 @@
+// Part of the model (docs/model.md): the principled BRDF as the composition of
+// its lobes, over a number type F: the material's constants, f and its lobes,
+// the sampling mixture's weights and density, the lobe choice, the draw of wi
+// and the weight of a drawn sample (README "The model", "Sampling and pdf").
+#pragma once  // (per namespace that includes the model)
+
+// Everything the lobes need of a material, independent of the directions.
+template <class F>
+struct Shading {
+    DiffuseLobe<F> diffuse;
+    SheenLobe<F> sheen;
+    SpecularLobe<F> specular;
+    ClearcoatLobe<F> clearcoat;
+};
+
+// From the kParamSlots values of params.hpp's order.
+template <class F>
+PB_MODEL_INLINE Shading<F> shading_of(const F* p) {
+    const F one(1.0);
+    const Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
+    const F metallic = p[kMetallic];
+    const F dielectric = one - metallic;
+
+    // Ctint: hue and saturation at unit luminance (1 where the luminance is 0)
+    const F luminance = luminance_of(base);
+    const MaskOf<F> has_luminance = luminance > F(0.0);
+    const F inv_luminance = reciprocal(select(has_luminance, luminance, one));
+    const Rgb<F> tint{select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
+                      select(has_luminance, base.b * inv_luminance, one)};
+    const Rgb<F> white{one, one, one};
+
+    Shading<F> s;
+    s.diffuse.color = (dielectric * F(kInvPi)) * base;
+    s.diffuse.subsurface = p[kSubsurface];
+    s.diffuse.roughness = p[kRoughness];
+    const Rgb<F> sheen_tint = mix(white, tint, p[kSheenTint]);
+    s.sheen.color = (p[kSheen] * dielectric) * sheen_tint;
+    s.diffuse.cosine_lobe_weight = dielectric * mul_add(F(0.1) * p[kSheen], luminance_of(sheen_tint), luminance);
+
+    s.specular.f0 = mix((p[kSpecular] * F(0.08)) * mix(white, tint, p[kSpecularTint]), base, metallic);
+    s.specular.f0_luminance = luminance_of(s.specular.f0);
+    // 2014 addenda: aspect = sqrt(1 - 0.9 anisotropic), alpha = roughness²
+    const F aspect2 = neg_mul_add(F(0.9), p[kAnisotropic], one);  // in [0.1, 1]
+    const F inv_aspect = reciprocal_sqrt(aspect2);
+    const F aspect = aspect2 * inv_aspect;
+    const F alpha = p[kRoughness] * p[kRoughness];
+    s.specular.ggx = Ggx<F>::from_alphas(max(F(0.001), alpha * inv_aspect), max(F(0.001), alpha * aspect));
+    const F alpha_g = mul_add(F(0.5), p[kRoughness], F(0.5));
+    s.specular.alpha_g2 = (alpha_g * alpha_g) * (alpha_g * alpha_g);
+
+    // ac = mix(0.1, 0.001, clearcoat_gloss) stays in [0.001, 0.1]
+    s.clearcoat.gtr1 = Gtr1<F>::from_alpha(mix(F(0.1), F(0.001), p[kClearcoatGloss]));
+    s.clearcoat.scale = F(0.25) * p[kClearcoat] * s.clearcoat.gtr1.norm;
+    s.clearcoat.lobe_weight = F(0.25) * p[kClearcoat];
+    return s;
+}
+
+// What f and the pdf need of wo alone.
+template <class F>
+struct View {
+    F fv;               // Schlick(cos θv)
+    F smith_visible;    // the GGX Smith denominator of wo: the 2014 model's, and the visible-normal pdf's
+    F smith_specular;   // the model's Smith denominator of wo
+    F smith_clearcoat;  // at alpha 0.25 (1 when no lane has a clearcoat)
+};
+
+// given FV and the visible-normal Smith denominator (sampling has them from the choice and the draw)
+template <Model model, class F>
+PB_MODEL_INLINE View<F> view_of(const Vec3<F>& wo, const Shading<F>& s, F smith_visible, F fv) {
+    View<F> v;
+    v.fv = fv;
+    v.smith_visible = smith_visible;
+    if constexpr (model == Model::kDisney2012) {
+        v.smith_specular = smith_denominator_iso(wo, s.specular.alpha_g2);
+    } else {
+        v.smith_specular = v.smith_visible;
+    }
+    v.smith_clearcoat = s.clearcoat.smith_wo(wo);
+    return v;
+}
+
+template <Model model, class F>
+PB_MODEL_INLINE View<F> view_of(const Vec3<F>& wo, const Shading<F>& s) {
+    return view_of<model>(wo, s, s.specular.ggx.smith_denominator(wo), schlick_weight(wo.z));
+}
+
+// The lobes as scalar factors of the material's colours:
+//   diffuse   = D  base_color (1 - metallic) / π     (s.diffuse.color)
+//   sheen     = FH sheen Csheen (1 - metallic)       (s.sheen.color)
+//   specular  = S  mix(Cspec0, 1, FH),  S = Gs Ds
+//   clearcoat = C  (grey)
+template <class F>
+struct LobeValues {
+    F diffuse, fh, specular, clearcoat;
+
+    Rgb<F> diffuse_rgb(const Shading<F>& s) const { return diffuse * s.diffuse.color; }
+    Rgb<F> sheen_rgb(const Shading<F>& s) const { return fh * s.sheen.color; }
+    Rgb<F> specular_rgb(const Shading<F>& s) const { return specular * mix(s.specular.f0, Rgb<F>{F(1.0), F(1.0), F(1.0)}, fh); }
+    Rgb<F> clearcoat_rgb() const { return {clearcoat, clearcoat, clearcoat}; }
+
+    // f per channel: D dc + FH sc + S (1 - FH) Cspec0 + (S FH + C), three FMAs a channel
+    Rgb<F> total(const Shading<F>& s) const {
+        const F specular_tinted = specular * (F(1.0) - fh);
+        const F grey = mul_add(specular, fh, clearcoat);
+        auto channel = [&](F dc, F sc, F f0) { return mul_add(diffuse, dc, mul_add(fh, sc, mul_add(specular_tinted, f0, grey))); };
+        return {channel(s.diffuse.color.r, s.sheen.color.r, s.specular.f0.r),
+                channel(s.diffuse.color.g, s.sheen.color.g, s.specular.f0.g),
+                channel(s.diffuse.color.b, s.sheen.color.b, s.specular.f0.b)};
+    }
+};
+
+// f = 0 unless both directions lie strictly above the surface (and, checks
+// off, H is finite): the values are selected away there, whatever they are.
+template <class F>
+PB_MODEL_INLINE MaskOf<F> above_surface(const Geometry<F>& g) {
+    return (g.wi.z > F(0.0)) & (g.wo.z > F(0.0)) & g.finite;
+}
+
+template <Model model, class F>
+PB_MODEL_INLINE LobeValues<F> eval_lobes(const Geometry<F>& g, const Shading<F>& s, const View<F>& view) {
+    const F fh = schlick_weight_of_complement(g.one_minus_cos_theta_d);
+    LobeValues<F> out;
+    out.diffuse = s.diffuse.value(g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
+    out.fh = fh;
+    out.specular = s.specular.template value<model>(g, view.smith_specular);
+    out.clearcoat = s.clearcoat.value(g, fh, view.smith_clearcoat);
+    return out;
+}
+
+// ---------------------------------------------------------------- the sampling mixture
+// Lobes 0 (cosine: diffuse, subsurface, sheen), 1 (specular), 2 (clearcoat),
+// chosen with probabilities P_k = w_k / Σ w from the lobes' albedo estimates:
+// w0 = (1 - metallic)(Cdlum + 0.1 sheen lum(Csheen)), w1 and w2 from FV.
+
+// w1, w2 at wo (w0 is the material's) and 1 / Σ w: the choice compares
+// u0 Σ w against them, so it does not wait for the reciprocal.
+template <class F>
+struct LobeWeights {
+    F specular, clearcoat, inv_total;
+};
+
+template <class F>
+PB_MODEL_INLINE LobeWeights<F> lobe_weights(F fv, const Shading<F>& s) {
+    const F w1 = s.specular.weight(fv), w2 = s.clearcoat.weight(fv);
+    return {w1, w2, reciprocal(s.diffuse.cosine_lobe_weight + w1 + w2)};
+}
+
+// Σ P_k pdf_k(wi), before the horizon test:
+//   pdf0 = cos θl / π,  pdf1 the specular sampler's,  pdf2 the GTR1 draw's.
+template <class F>
+PB_MODEL_INLINE F mixture_pdf(const Geometry<F>& g, const Shading<F>& s, const View<F>& view, const LobeWeights<F>& w,
+                              SpecularSampler sampler) {
+    const F pdf1 = s.specular.pdf(g, view.smith_visible, sampler);
+    const F pdf2 = s.clearcoat.gtr1.pdf(g);
+    return w.inv_total * mul_add(s.diffuse.cosine_lobe_weight * F(kInvPi), g.wi.z, mul_add(w.specular, pdf1, w.clearcoat * pdf2));
+}
+
+template <class F>
+struct LobeChoice {
+    MaskOf<F> cosine, specular;  // clearcoat otherwise
+};
+
+// Lobe 0 if u0 < P0, else 1 if u0 < P0 + P1, else 2, compared as u0 Σ w
+// against w0 and w0 + w1; never 2 when w2 = 0 (u0 may be 1 if passed).
+template <class F>
+PB_MODEL_INLINE LobeChoice<F> choose_lobe(F u0, const Shading<F>& s, const LobeWeights<F>& w) {
+    const F w0 = s.diffuse.cosine_lobe_weight;
+    const F scaled = u0 * (w0 + w.specular + w.clearcoat);
+    const MaskOf<F> cosine = scaled < w0;
+    const MaskOf<F> specular = ((scaled < w0 + w.specular) | (w.clearcoat <= F(0.0))) & !cosine;
+    return {cosine, specular};
+}
+
+template <class F>
+struct Uniforms {
+    F u0, u1, u2;
+};
+
+// What the draw returns: wi, and the visible-normal Smith denominator of wo
+// (View::smith_visible), which the draw computes on the way.
+template <class F>
+struct Direction {
+    Vec3<F> wi;
+    F smith_visible;  // cos θv + |V|, V = (ax wo.x, ay wo.y, wo.z)
+};
+
+// wi for the chosen lobes. Each lobe draws a point at azimuth φ = 2π u1 about
+// a centre and stretches it (README "Sampling and pdf"):
+//   m = (sinθ cos φ + c.x, sinθ sin φ + c.y, cosθ + c.z),  d = (sx m.x, sy m.y, m.z)
+// cosine lobe:  sin²θ = u2, c = 0, s = 1, wi = d
+// clearcoat:    sin²θ of the GTR1 draw, c = 0, s = 1, h ∝ d
+// specular, visible normals by spherical caps (Dupuy & Benyoub 2023):
+//               c = normalize(ax wo.x, ay wo.y, wo.z), cosθ = (1 - u2)(1 + c.z) - c.z,
+//               s = (ax, ay), h ∝ d
+// specular, distribution (Burley 2012 eq. 14-15): sin²θ = u2, c = 0, s = (ax, ay), h ∝ d
+// and wi = 2 (wo·h) h - wo for the reflected lobes. So every lane does one
+// draw, whatever the mixture of lobes in its batch; the parts of a lobe no
+// lane chose are skipped, which changes no result. A d of length 0 (u2 = 1 at
+// special angles) gives h = 0 and wi = -wo: below the horizon like every
+// other u2 = 1 sample of the reflected lobes.
+template <class F>
+PB_MODEL_INLINE Direction<F> sample_direction(const Vec3<F>& wo, const Uniforms<F>& u, const LobeChoice<F>& lobe,
+                                              const Shading<F>& s, SpecularSampler sampler) {
+    using Mask = MaskOf<F>;
+    const F zero(0.0), one(1.0);
+    const Ggx<F>& ggx = s.specular.ggx;
+    // the visible-normal cap construction scaled by L = |V|, V = (ax wo.x, ay wo.y, wo.z),
+    // so V need not be normalised: L cosθ = (1 - u2)(L + V.z) - V.z, L² sin²θ = L² - (L cosθ)²;
+    // cos θv + L is the View's smith_visible, which the weight needs anyway
+    const Vec3<F> stretched{ggx.alpha_x * wo.x, ggx.alpha_y * wo.y, wo.z};
+    const F length2 = squared_length(stretched);
+    const F length = square_root(length2);
+    const F smith_visible = wo.z + length;
+    const auto [sin_phi, cos_phi] = sincos_turns(u.u1);
+    if (all(lobe.cosine)) {
+        const F radius = square_root(u.u2);
+        return {{radius * cos_phi, radius * sin_phi, square_root(one - u.u2)}, smith_visible};
+    }
+    const Mask clearcoat = !lobe.cosine & !lobe.specular;
+    const bool visible_normals = sampler == SpecularSampler::kVisibleNormals;
+    const Mask visible_specular = visible_normals ? lobe.specular : Mask(false);
+
+    F sin2_theta = u.u2;  // cosine lobe, distribution sampler
+    F scaled_cos = zero;  // L cosθ of the visible-normal specular
+    F centre_x = zero, centre_y = zero;
+    if (visible_normals && any(lobe.specular)) {
+        scaled_cos = mul_sub(one - u.u2, length + stretched.z, stretched.z);
+        sin2_theta = select(lobe.specular, neg_mul_add(scaled_cos, scaled_cos, length2), sin2_theta);
+        centre_x = select(lobe.specular, stretched.x, zero);
+        centre_y = select(lobe.specular, stretched.y, zero);
+    }
+    if (any(clearcoat)) sin2_theta = select(clearcoat, s.clearcoat.gtr1.draw_sin2(u.u2), sin2_theta);
+    const F sin_theta = square_root(sin2_theta);
+    // m.z: L cosθ + V.z for the visible-normal specular, else cosθ from sin²θ
+    const F height = select(visible_specular, scaled_cos + stretched.z, square_root(one - sin2_theta));
+    const F stretch_x = select(lobe.specular, ggx.alpha_x, one);
+    const F stretch_y = select(lobe.specular, ggx.alpha_y, one);
+    const Vec3<F> d{stretch_x * mul_add(sin_theta, cos_phi, centre_x), stretch_y * mul_add(sin_theta, sin_phi, centre_y), height};
+
+    // wi = 2 (wo·h) h - wo with h = d / |d|
+    const F d_len2 = squared_length(d);
+    const F scale = select(d_len2 > zero, F(2.0) * dot(wo, d) * reciprocal(d_len2), zero);
+    const Vec3<F> reflected{mul_sub(scale, d.x, wo.x), mul_sub(scale, d.y, wo.y), mul_sub(scale, d.z, wo.z)};
+    return {select(lobe.cosine, d, reflected), smith_visible};
+}
+
+// A drawn sample weighed: its mixture pdf and weight = f cos θl / pdf, both 0
+// unless wi and wo lie above the surface with pdf > 0; wi = 0 where H was not
+// finite (a NaN, infinite or huge wo, checks off).
+template <class F>
+struct Weighed {
+    Vec3<F> wi;
+    F pdf;
+    Rgb<F> weight;
+    // each lobe's share of the weight is select(valid, scale * lobe, 0)
+    LobeValues<F> lobes;
+    F scale;  // cos θl / pdf
+    MaskOf<F> valid;
+
+    Rgb<F> share(const Rgb<F>& lobe) const {
+        const Rgb<F> zero{F(0.0), F(0.0), F(0.0)};
+        return select(valid, scale * lobe, zero);
+    }
+};
+
+template <Model model, class F>
+PB_MODEL_INLINE Weighed<F> weigh(const Vec3<F>& wo, F fv, const LobeWeights<F>& weights, const Direction<F>& drawn,
+                                 const Shading<F>& s, SpecularSampler sampler) {
+    const Vec3<F>& wi = drawn.wi;
+    const View<F> view = view_of<model>(wo, s, drawn.smith_visible, fv);
+    const Geometry<F> g = geometry_of(wi, wo);
+    const F pdf = mixture_pdf(g, s, view, weights, sampler);
+    const MaskOf<F> valid = (min(wi.z, wo.z) > F(0.0)) & g.finite & (pdf > F(0.0));
+    const LobeValues<F> lobes = eval_lobes<model>(g, s, view);
+    const Rgb<F> f = lobes.total(s);
+    const F scale = wi.z * reciprocal(pdf);  // cos θl / pdf
+    // select after multiplying: below the horizon f may be infinite or NaN
+    auto weight = [&](F value) { return select(valid, scale * value, F(0.0)); };
+    auto finite = [&](F value) { return select(g.finite, value, F(0.0)); };
+    return {{finite(wi.x), finite(wi.y), finite(wi.z)}, select(valid, pdf, F(0.0)), {weight(f.r), weight(f.g), weight(f.b)},
+            lobes, scale, valid};
+}

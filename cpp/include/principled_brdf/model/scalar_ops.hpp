@@ -1,0 +1,27 @@
+// The model's operations on double (docs/model.md), for the float64
+// instantiation: exact where the kernels' float32 versions approximate
+// (reciprocals, square roots, sin and cos of 2πu, e^x - 1, log).
+// Included inside the namespace that includes the model for double, before it.
+#pragma once  // (per namespace that includes the model)
+
+inline double mul_add(double a, double b, double c) { return std::fma(a, b, c); }
+inline double mul_sub(double a, double b, double c) { return std::fma(a, b, -c); }
+inline double neg_mul_add(double a, double b, double c) { return std::fma(-a, b, c); }
+inline double reciprocal(double x) { return 1.0 / x; }
+inline double reciprocal_sqrt(double x) { return 1.0 / std::sqrt(x); }
+inline double square_root(double x) { return std::sqrt(std::max(x, 0.0)); }
+inline double select(bool mask, double a, double b) { return mask ? a : b; }
+// as x86's minps and maxps: the second operand where either is NaN
+inline double min(double a, double b) { return a < b ? a : b; }
+inline double max(double a, double b) { return a > b ? a : b; }
+inline bool any(bool mask) { return mask; }
+inline bool all(bool mask) { return mask; }
+inline double log(double x) { return std::log(x); }
+inline double exp_minus_one(double x) { return std::expm1(x); }
+inline double largest_finite(double) { return std::numeric_limits<double>::max(); }
+
+// (sin 2πu, cos 2πu)
+inline std::pair<double, double> sincos_turns(double u) {
+    const double phi = 6.283185307179586476925 * u;
+    return {std::sin(phi), std::cos(phi)};
+}
