@@ -304,3 +304,36 @@ def test_uniforms_are_checked_as_given_by_both_paths(u):
         pb.sample(pb.Material(), UP, u=values)
     with pytest.raises(ValueError, match=r"u\[0, 1\]"):
         pb.reference.sample(pb.Material(), UP, values)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_batches_the_fast_test_cannot_decide_give_the_same_bits(isa):
+    # Directions the rule accepts but the kernels' narrowed fast test does not
+    # (length² within 1e-6 of the bound) make a loop stop, be decided element
+    # by element and resume: wherever they sit (the sampling pipeline's
+    # prologue, loop and epilogue, tails, thread chunks), every element is
+    # written and the bits are those of the unchecked call.
+    rng = np.random.default_rng(21)
+    n = 40_000  # two thread chunks of 20032
+    wo = directions_at_length(rng, n, 1.0)
+    wi = directions_at_length(rng, n, 1.0)
+    edge = np.float32(np.sqrt(DIRECTION_LENGTH2_BOUNDS[1]) * (1 - 1e-7))
+    for k in (0, 1, 15, 16, 17, 40, 63, 64, 100, 500, 1023, 20031, 20032, 20040, n - 17, n - 1):
+        wo[k] *= edge
+        wi[(k * 7) % n] *= edge
+    assert unit_length(wo).all() and unit_length(wi).all()
+    roughness, clearcoat = rng.random(n), rng.random(n)
+    materials = {"uniform": lambda start: pb.Material(clearcoat=0.7, sheen=0.3, roughness=0.4),
+                 "per element": lambda start: pb.Material(roughness=roughness[start:], clearcoat=clearcoat[start:])}
+    for make in materials.values():
+        for threads in (1, 2):
+            material = make(0)
+            checked, unchecked = (pb.eval(material, wi, wo, isa=isa, threads=threads, check=c) for c in (True, False))
+            np.testing.assert_array_equal(checked, unchecked)
+            checked, unchecked = (pb.pdf(material, wi, wo, isa=isa, threads=threads, check=c) for c in (True, False))
+            np.testing.assert_array_equal(checked, unchecked)
+            for start in (0, 3, 8):
+                a, b = (pb.sample(make(start), wo[start:], seed=5, isa=isa, threads=threads, check=c)
+                        for c in (True, False))
+                for x, y in zip(a, b):
+                    np.testing.assert_array_equal(x, y)

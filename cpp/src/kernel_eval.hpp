@@ -27,27 +27,24 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
     }
 }
 
-// One batch at i: -1, or with the direction check on the first lane whose wi
-// or wo fails it (and nothing stored).
+// One batch at i; false, with nothing stored, when the fast direction test
+// does not accept it.
 template <Model model, Output output, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE int eval_one_batch(const EvalJob& job, std::int64_t i, const Shading<Floats>& uniform) {
+PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const Shading<Floats>& uniform) {
     const Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
     const Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
-    if (job.check.enabled) {
-        const int bad = first_bad_lane(wi, wo, job.check);
-        if (bad >= 0) return bad;
-    }
+    if (job.check.enabled && !all(surely_unit_length(wi, job.check) & surely_unit_length(wo, job.check))) return false;
     if constexpr (per_element) {
         eval_batch<model, output, layouts>(job, i, wi, wo, shading_of(load_material(job.params, i)));
     } else {
         eval_batch<model, output, layouts>(job, i, wi, wo, uniform);
     }
-    return -1;
+    return true;
 }
 
-// The last pad.count < kLanes elements: -1, or the first bad lane as above.
+// The last pad.count < kLanes elements, as one batch.
 template <Model model, Output output, bool per_element>
-int eval_tail(const EvalJob& job, const Padding& pad, const Shading<Floats>& uniform) {
+bool eval_tail(const EvalJob& job, const Padding& pad, const Shading<Floats>& uniform) {
     alignas(64) PadBuffer wi, wo, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
     EvalJob padded = job;
@@ -58,30 +55,23 @@ int eval_tail(const EvalJob& job, const Padding& pad, const Shading<Floats>& uni
     for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
     padded.pdf = pdf;
 
-    // the padding repeats the last element, so a bad lane is one of the first pad.count
-    const int bad = eval_one_batch<model, output, per_element, Layouts::kMixed>(padded, 0, uniform);
-    if (bad >= 0) return bad;
+    if (!eval_one_batch<model, output, per_element, Layouts::kMixed>(padded, 0, uniform)) return false;
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf) unpad_scalars(job.pdf, pad, pdf);
-    return -1;
+    return true;
 }
 
-// -1 with every element of [begin, end) written, or the first element whose
-// direction fails the check (the elements from its batch on are not written).
+// -1 with every element of [begin, end) written, or the start of the first
+// batch the fast direction test did not accept (see run_checked).
 template <Model model, Output output, bool per_element, Layouts layouts>
 std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     Shading<Floats> uniform{};
     if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
     std::int64_t i = begin;
-    for (; i + kLanes <= end; i += kLanes) {
-        const int bad = eval_one_batch<model, output, per_element, layouts>(job, i, uniform);
-        if (bad >= 0) return i + bad;
-    }
-    if (i < end) {
-        const int bad = eval_tail<model, output, per_element>(job, Padding{i, end - i}, uniform);
-        if (bad >= 0) return i + bad;
-    }
+    for (; i + kLanes <= end; i += kLanes)
+        if (!eval_one_batch<model, output, per_element, layouts>(job, i, uniform)) return i;
+    if (i < end && !eval_tail<model, output, per_element>(job, Padding{i, end - i}, uniform)) return i;
     return -1;
 }
 
@@ -95,15 +85,22 @@ inline Layouts layouts_of(const EvalJob& job) {
     return Layouts::kMixed;
 }
 
+template <Model model, Output output, bool per_element, Layouts layouts>
+std::int64_t eval_checked(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    auto rejected = [&](std::int64_t i) { return !unit_length_at(job.wi, i, job.check) || !unit_length_at(job.wo, i, job.check); };
+    return run_checked(job, begin, end, eval_loop<model, output, per_element, layouts>, rejected);
+}
+
+// -1 with every element written, or the first element whose wi or wo fails the direction check.
 template <Model model, Output output, bool per_element>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     switch (layouts_of(job)) {
         case Layouts::kInterleaved:
-            return eval_loop<model, output, per_element, Layouts::kInterleaved>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kInterleaved>(job, begin, end);
         case Layouts::kRows:
-            return eval_loop<model, output, per_element, Layouts::kRows>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kRows>(job, begin, end);
         default:
-            return eval_loop<model, output, per_element, Layouts::kMixed>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kMixed>(job, begin, end);
     }
 }
 

@@ -48,28 +48,35 @@ PB_KERNEL_INLINE Mask surely_unit_length(const Vec3<Floats>& w, const DirectionC
     return (length2 >= Floats(check.fast_lowest)) & (length2 <= Floats(check.fast_highest));  // false for NaN
 }
 
-// The first lane of w that the rule rejects, or -1. Out of line: it runs only
-// for batches the fast test did not accept.
-[[gnu::noinline]] inline int first_rejected_lane(const Vec3<Floats>& w, const DirectionCheck& check) {
-    alignas(64) float x[kLanes], y[kLanes], z[kLanes];
-    w.x.store_aligned(x);
-    w.y.store_aligned(y);
-    w.z.store_aligned(z);
-    for (int lane = 0; lane < kLanes; ++lane)
-        if (!unit_length(x[lane], y[lane], z[lane], check)) return lane;
+// The rule itself for element i of a (scalar, from memory).
+inline bool unit_length_at(const Vec3Array& a, std::int64_t i, const DirectionCheck& check) {
+    const float* p = a.layout == Vec3Layout::kSingle ? a.data : a.layout == Vec3Layout::kRows ? a.data + i : a.data + 3 * i;
+    const std::int64_t stride = a.layout == Vec3Layout::kRows ? a.row_stride : 1;
+    return unit_length(p[0], p[stride], p[2 * stride], check);
+}
+
+// The loops run with the fast test and stop at the first batch it does not
+// accept, returning that batch's start (or -1 when they wrote every element):
+// nothing out of line is called inside them, which would make the compiler
+// keep their state in memory around the call. This decides such a batch by
+// the rule, element by element: the first element the rule rejects is the
+// call's answer; if there is none, the batch runs with the check off (the same
+// bits, the check changes no value) and the loop resumes after it.
+template <class Job, class Loop, class FirstRejected>
+std::int64_t run_checked(const Job& job, std::int64_t begin, std::int64_t end, const Loop& loop,
+                         const FirstRejected& first_rejected) {
+    while (begin < end) {
+        const std::int64_t stopped = loop(job, begin, end);
+        if (stopped < 0) return -1;
+        const std::int64_t batch_end = std::min(stopped + kLanes, end);
+        for (std::int64_t i = stopped; i < batch_end; ++i)
+            if (first_rejected(i)) return i;
+        Job unchecked = job;
+        unchecked.check.enabled = false;
+        loop(unchecked, stopped, batch_end);
+        begin = batch_end;
+    }
     return -1;
-}
-
-// -1 when every lane of w passes the check, else the first lane that fails.
-PB_KERNEL_INLINE int first_bad_lane(const Vec3<Floats>& w, const DirectionCheck& check) {
-    return xsimd::all(surely_unit_length(w, check)) ? -1 : first_rejected_lane(w, check);
-}
-
-// The same for a pair: the first lane where either fails.
-PB_KERNEL_INLINE int first_bad_lane(const Vec3<Floats>& a, const Vec3<Floats>& b, const DirectionCheck& check) {
-    if (xsimd::all(surely_unit_length(a, check) & surely_unit_length(b, check))) return -1;
-    const int in_a = first_rejected_lane(a, check), in_b = first_rejected_lane(b, check);
-    return in_a < 0 ? in_b : in_b < 0 ? in_a : std::min(in_a, in_b);
 }
 
 

@@ -18,14 +18,11 @@ struct Chosen {
     Floats fv;
 };
 
-// -1, or with the direction check on the first lane whose wo fails it
+// false, with nothing computed, when the fast direction test does not accept wo
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE int choose(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed, Chosen& c) {
+PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed, Chosen& c) {
     c.wo = load_vec3<layouts>(job.wo, i);
-    if (job.check.enabled) {
-        const int bad = first_bad_lane(c.wo, job.check);
-        if (bad >= 0) return bad;
-    }
+    if (job.check.enabled && !all(surely_unit_length(c.wo, job.check))) return false;
     if (job.u.data != nullptr) {
         const Vec3<Floats> given = load_vec3<layouts>(job.u, i);
         c.u = {given.x, given.y, given.z};
@@ -35,25 +32,28 @@ PB_KERNEL_INLINE int choose(const SampleJob& job, std::int64_t i, const Shading<
     c.fv = schlick_weight(c.wo.z);
     c.weights = lobe_weights(c.fv, s);
     c.lobe = choose_lobe(c.u.u0, s, c.weights);
-    return -1;
+    return true;
 }
 
 PB_KERNEL_INLINE Direction<Floats> draw(const SampleJob& job, const Chosen& c, const Shading<Floats>& s) {
     return sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
 }
 
-template <Model model, Layouts layouts>
+// Stores a batch's sample; with_lobes also each lobe's share of the weight.
+template <Model model, Layouts layouts, bool with_lobes>
 PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction<Floats>& d,
                             const Shading<Floats>& s) {
-    const Weighed<Floats> w = weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler);
+    const WeighedWithLobes<Floats> full = weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler);
+    // only what is stored is kept: without the lobes, the small part
+    const Weighed<Floats> w = full;
     store_rgb<layouts>(job.wi, i, Rgb<Floats>{w.wi.x, w.wi.y, w.wi.z});
     w.pdf.store_unaligned(job.pdf + i);
     store_rgb<layouts>(job.weight, i, w.weight);
-    if (job.lobe_weight[0].data != nullptr) {  // each lobe's share (the albedo's split)
-        store_rgb<layouts>(job.lobe_weight[0], i, w.share(w.lobes.diffuse_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[1], i, w.share(w.lobes.sheen_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
+    if constexpr (with_lobes) {
+        store_rgb<layouts>(job.lobe_weight[0], i, full.share(full.lobes.diffuse_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[1], i, full.share(full.lobes.sheen_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[2], i, full.share(full.lobes.specular_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[3], i, full.share(full.lobes.clearcoat_rgb()));
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
@@ -61,20 +61,19 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& 
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
-template <Model model, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE int sample_one_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform, const CounterSeed& seed) {
+template <Model model, bool per_element, Layouts layouts, bool with_lobes>
+PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform, const CounterSeed& seed) {
     Shading<Floats> per_batch;
     if constexpr (per_element) per_batch = shading_of(load_material(job.params, i));
     const Shading<Floats>& s = per_element ? per_batch : uniform;
     Chosen chosen;
-    const int bad = choose<model, layouts>(job, i, s, seed, chosen);
-    if (bad >= 0) return bad;
-    weigh<model, layouts>(job, i, chosen, draw(job, chosen, s), s);
-    return -1;
+    if (!choose<model, layouts>(job, i, s, seed, chosen)) return false;
+    weigh<model, layouts, with_lobes>(job, i, chosen, draw(job, chosen, s), s);
+    return true;
 }
 
-template <Model model, bool per_element>
-int sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>& uniform, const CounterSeed& seed) {
+template <Model model, bool per_element, bool with_lobes>
+bool sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>& uniform, const CounterSeed& seed) {
     alignas(64) PadBuffer wo, u, params[kParamSlots], wi, weight, lobe_weight[kLobeCount];
     alignas(64) float pdf[kLanes];
     alignas(64) std::int32_t lobe[kLanes];
@@ -84,23 +83,21 @@ int sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>&
     pad_params(job.params, padded.params, pad, params);
     padded.wi = MutableVec3Array{wi, Vec3Layout::kInterleaved, 0};
     padded.weight = MutableVec3Array{weight, Vec3Layout::kInterleaved, 0};
-    const bool lobe_weights = job.lobe_weight[0].data != nullptr;
-    if (lobe_weights)
+    if (with_lobes)
         for (int k = 0; k < kLobeCount; ++k) padded.lobe_weight[k] = MutableVec3Array{lobe_weight[k], Vec3Layout::kInterleaved, 0};
     padded.pdf = pdf;
     padded.lobe = lobe;
     padded.first_index = job.first_index + pad.begin;  // the generator sees the true element indices
 
-    const int bad = sample_one_batch<model, per_element, Layouts::kMixed>(padded, 0, uniform, seed);
-    if (bad >= 0) return bad;  // one of the first pad.count lanes, as in eval_tail
+    if (!sample_one_batch<model, per_element, Layouts::kMixed, with_lobes>(padded, 0, uniform, seed)) return false;
 
     unpad_vec3(job.wi, pad, wi);
     unpad_vec3(job.weight, pad, weight);
-    if (lobe_weights)
+    if (with_lobes)
         for (int k = 0; k < kLobeCount; ++k) unpad_vec3(job.lobe_weight[k], pad, lobe_weight[k]);
     unpad_scalars(job.pdf, pad, pdf);
     unpad_scalars(job.lobe, pad, lobe);
-    return -1;
+    return true;
 }
 
 // One batch between its stages: chosen, then drawn.
@@ -110,12 +107,12 @@ struct InFlight {
 };
 
 // One step of the pipeline: weigh the batch at i, draw the next one, choose
-// the one after it at i + 2 kLanes (-1, or the lane of that batch whose wo
-// fails the check).
+// the one after it at i + 2 kLanes (false when the fast direction test does
+// not accept that one's wo).
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE int pipeline_step(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed,
+PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed,
                                     InFlight& weighed, InFlight& drawn, InFlight& chosen) {
-    weigh<model, layouts>(job, i, weighed.chosen, weighed.drawn, s);
+    weigh<model, layouts, false>(job, i, weighed.chosen, weighed.drawn, s);
     drawn.drawn = draw(job, drawn.chosen, s);
     return choose<model, layouts>(job, i + 2 * kLanes, s, seed, chosen.chosen);
 }
@@ -133,8 +130,11 @@ PB_KERNEL_INLINE int pipeline_step(const SampleJob& job, std::int64_t i, const S
 // other copies of the code, to the same bits (no contraction, see
 // simd_ops.hpp). Uniform materials only: with per-element materials each
 // batch's Shading in flight would not fit in the registers, so their batches
-// run one after another (bench/RESULTS.md has the figures).
-template <Model model, bool per_element, Layouts layouts>
+// run one after another (bench/RESULTS.md has the figures). Returns -1 with
+// every element of [begin, end) written, or the start of the first batch the
+// fast direction test did not accept, every element before it written (see
+// run_checked).
+template <Model model, bool per_element, Layouts layouts, bool with_lobes>
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     Shading<Floats> uniform{};
     if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
@@ -142,46 +142,58 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
     const std::int64_t batches = (end - begin) / kLanes;
     auto at = [&](std::int64_t b) { return begin + b * kLanes; };
     std::int64_t b = 0;
-    int bad = -1;
-    if constexpr (!per_element) {
+    if constexpr (!per_element && !with_lobes) {
         if (batches >= 5) {
             InFlight slot0, slot1, slot2;
-            if ((bad = choose<model, layouts>(job, at(0), uniform, seed, slot0.chosen)) >= 0) return at(0) + bad;
-            if ((bad = choose<model, layouts>(job, at(1), uniform, seed, slot1.chosen)) >= 0) return at(1) + bad;
+            // a stop at a batch first weighs the one drawn before it, so that
+            // every element before the returned batch is written
+            if (!choose<model, layouts>(job, at(0), uniform, seed, slot0.chosen)) return at(0);
+            if (!choose<model, layouts>(job, at(1), uniform, seed, slot1.chosen)) {
+                weigh<model, layouts, false>(job, at(0), slot0.chosen, draw(job, slot0.chosen, uniform), uniform);
+                return at(1);
+            }
             slot0.drawn = draw(job, slot0.chosen, uniform);
             // here and after each step: slot0 holds batch b, drawn, and slot1 batch b + 1, chosen
             for (; b + 4 < batches; b += 3) {
-                if ((bad = pipeline_step<model, layouts>(job, at(b), uniform, seed, slot0, slot1, slot2)) >= 0)
-                    return at(b + 2) + bad;
-                if ((bad = pipeline_step<model, layouts>(job, at(b + 1), uniform, seed, slot1, slot2, slot0)) >= 0)
-                    return at(b + 3) + bad;
-                if ((bad = pipeline_step<model, layouts>(job, at(b + 2), uniform, seed, slot2, slot0, slot1)) >= 0)
-                    return at(b + 4) + bad;
+                if (!pipeline_step<model, layouts>(job, at(b), uniform, seed, slot0, slot1, slot2))
+                    { weigh<model, layouts, false>(job, at(b + 1), slot1.chosen, slot1.drawn, uniform); return at(b + 2); }
+                if (!pipeline_step<model, layouts>(job, at(b + 1), uniform, seed, slot1, slot2, slot0))
+                    { weigh<model, layouts, false>(job, at(b + 2), slot2.chosen, slot2.drawn, uniform); return at(b + 3); }
+                if (!pipeline_step<model, layouts>(job, at(b + 2), uniform, seed, slot2, slot0, slot1))
+                    { weigh<model, layouts, false>(job, at(b + 3), slot0.chosen, slot0.drawn, uniform); return at(b + 4); }
             }
-            weigh<model, layouts>(job, at(b), slot0.chosen, slot0.drawn, uniform);
-            weigh<model, layouts>(job, at(b + 1), slot1.chosen, draw(job, slot1.chosen, uniform), uniform);
+            weigh<model, layouts, false>(job, at(b), slot0.chosen, slot0.drawn, uniform);
+            weigh<model, layouts, false>(job, at(b + 1), slot1.chosen, draw(job, slot1.chosen, uniform), uniform);
             b += 2;
         }
     }
     for (; b < batches; ++b)
-        if ((bad = sample_one_batch<model, per_element, layouts>(job, at(b), uniform, seed)) >= 0) return at(b) + bad;
+        if (!sample_one_batch<model, per_element, layouts, with_lobes>(job, at(b), uniform, seed)) return at(b);
     const std::int64_t i = begin + batches * kLanes;
-    if (i < end && (bad = sample_tail<model, per_element>(job, Padding{i, end - i}, uniform, seed)) >= 0) return i + bad;
+    if (i < end && !sample_tail<model, per_element, with_lobes>(job, Padding{i, end - i}, uniform, seed)) return i;
     return -1;
 }
 
+template <Model model, bool per_element, Layouts layouts, bool with_lobes = false>
+std::int64_t sample_checked(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+    auto rejected = [&](std::int64_t i) { return !unit_length_at(job.wo, i, job.check); };
+    return run_checked(job, begin, end, sample_loop<model, per_element, layouts, with_lobes>, rejected);
+}
+
+// -1 with every element written, or the first element whose wo fails the direction check.
 template <Model model, bool per_element>
 std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+    // each lobe's share as well (the albedo's split): batch after batch, any layout
+    if (job.lobe_weight[0].data != nullptr) return sample_checked<model, per_element, Layouts::kMixed, true>(job, begin, end);
     const Vec3Layout layout = job.wo.layout;
     const bool uniform_layout = (layout == Vec3Layout::kInterleaved || layout == Vec3Layout::kRows) &&
                                 job.wi.layout == layout && job.weight.layout == layout &&
-                                (job.u.data == nullptr || job.u.layout == layout) &&
-                                (job.lobe_weight[0].data == nullptr || job.lobe_weight[0].layout == layout);
+                                (job.u.data == nullptr || job.u.layout == layout);
     if (uniform_layout && layout == Vec3Layout::kInterleaved)
-        return sample_loop<model, per_element, Layouts::kInterleaved>(job, begin, end);
+        return sample_checked<model, per_element, Layouts::kInterleaved>(job, begin, end);
     if (uniform_layout && layout == Vec3Layout::kRows)
-        return sample_loop<model, per_element, Layouts::kRows>(job, begin, end);
-    return sample_loop<model, per_element, Layouts::kMixed>(job, begin, end);
+        return sample_checked<model, per_element, Layouts::kRows>(job, begin, end);
+    return sample_checked<model, per_element, Layouts::kMixed>(job, begin, end);
 }
 
 inline std::int64_t sample_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {

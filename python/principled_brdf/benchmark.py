@@ -78,7 +78,8 @@ def best_seconds(fn, repeats: int) -> float:
 
 
 def compare_with_numpy(pairs: int = 1 << 22, repeats: int = 5, report=print) -> dict:
-    """Times pb.eval (default call, and out= with check=False) and numpy_eval on ``pairs`` pairs."""
+    """Times pb.eval (the default call with a fresh output; out= checked and unchecked) and
+    numpy_eval on ``pairs`` pairs."""
     material = Material(**MATERIAL)
     report(f"generating {pairs:,} random pairs ...")
     wi, wo = random_pairs(pairs)
@@ -89,6 +90,7 @@ def compare_with_numpy(pairs: int = 1 << 22, repeats: int = 5, report=print) -> 
     numpy_seconds = best_seconds(lambda: numpy_eval(MATERIAL, wi, wo), repeats)
     report(f"timing pb.eval ({repeats} runs each) ...")
     eval_seconds = best_seconds(lambda: _eval(material, wi, wo), repeats)
+    checked_out_seconds = best_seconds(lambda: _eval(material, wi, wo, out=out), repeats)
     unchecked_seconds = best_seconds(lambda: _eval(material, wi, wo, out=out, check=False), repeats)
     info = cpu_info()
     result = {
@@ -97,6 +99,7 @@ def compare_with_numpy(pairs: int = 1 << 22, repeats: int = 5, report=print) -> 
         "threads": info["threads"],
         "numpy_pairs_per_s": pairs / numpy_seconds,
         "eval_pairs_per_s": pairs / eval_seconds,
+        "eval_out_pairs_per_s": pairs / checked_out_seconds,
         "eval_unchecked_pairs_per_s": pairs / unchecked_seconds,
         "speedup": numpy_seconds / eval_seconds,
         "speedup_unchecked": numpy_seconds / unchecked_seconds,
@@ -106,6 +109,9 @@ def compare_with_numpy(pairs: int = 1 << 22, repeats: int = 5, report=print) -> 
     report(f"  numpy float32:                   {result['numpy_pairs_per_s'] / 1e6:9.1f} M pairs/s")
     report(f"  pb.eval(m, wi, wo):              {result['eval_pairs_per_s'] / 1e6:9.1f} M pairs/s "
            f"({result['speedup']:.0f}x numpy)")
+    report(f"  pb.eval(..., out=):              {result['eval_out_pairs_per_s'] / 1e6:9.1f} M pairs/s "
+           f"(the direction check: {result['eval_out_pairs_per_s'] / result['eval_unchecked_pairs_per_s']:.2f}x "
+           "of unchecked)")
     report(f"  pb.eval(..., out=, check=False): {result['eval_unchecked_pairs_per_s'] / 1e6:9.1f} M pairs/s "
            f"({result['speedup_unchecked']:.0f}x numpy)")
     report(f"  max relative difference vs numpy (floor 1e-3): {worst:.2e}")

@@ -1,12 +1,15 @@
 // The model's operations on double (docs/model.md), for the float64
 // instantiation: exact where the kernels' float32 versions approximate
-// (reciprocals, square roots, sin and cos of 2πu, e^x - 1, log).
+// (reciprocals, square roots, sin and cos of 2πu, e^x - 1, log), each
+// rounded as IEEE double.
 // Included inside the namespace that includes the model for double, before it.
 #pragma once  // (per namespace that includes the model)
 
-inline double mul_add(double a, double b, double c) { return std::fma(a, b, c); }
-inline double mul_sub(double a, double b, double c) { return std::fma(a, b, -c); }
-inline double neg_mul_add(double a, double b, double c) { return std::fma(-a, b, c); }
+// a b + c rounded twice: std::fma is a slow library call without FMA
+// instructions, and the float64 path needs no single rounding
+inline double mul_add(double a, double b, double c) { return a * b + c; }
+inline double mul_sub(double a, double b, double c) { return a * b - c; }
+inline double neg_mul_add(double a, double b, double c) { return c - a * b; }
 inline double reciprocal(double x) { return 1.0 / x; }
 inline double reciprocal_sqrt(double x) { return 1.0 / std::sqrt(x); }
 inline double square_root(double x) { return std::sqrt(std::max(x, 0.0)); }
