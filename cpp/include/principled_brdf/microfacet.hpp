@@ -23,6 +23,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/f64.hpp"
+
 namespace principled_brdf::microfacet {
 
 inline constexpr double kPi = 3.14159265358979323846;
@@ -220,15 +222,12 @@ inline Vec3 gtr_sample_h(double u1, double u2, double alpha, double gamma, bool 
 // ---------------------------------------------------------------------------
 // Anisotropic GGX (GTR2 aniso) and its Smith masking.
 
-// Eq. (13): D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²).
+// Eq. (13): D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²), the model's
+// distribution (model/distributions.hpp) with the toolkit's clamps.
 inline double ggx_d(const Vec3& h, double alpha_x, double alpha_y) {
     if (h.z <= 0.0) return 0.0;
-    alpha_x = clamp_alpha(alpha_x);
-    alpha_y = clamp_alpha(alpha_y);
-    const double sx = h.x / alpha_x;
-    const double sy = h.y / alpha_y;
-    const double denom = sx * sx + sy * sy + h.z * h.z;
-    return 1.0 / (kPi * alpha_x * alpha_y * denom * denom);
+    const f64::HalfVector<double> half{h.x * h.x, h.y * h.y, h.z, h.z * h.z, dot(h, h)};
+    return f64::Ggx<double>::from_alphas(clamp_alpha(alpha_x), clamp_alpha(alpha_y)).d(half);
 }
 
 inline double ggx_pdf_h(const Vec3& h, double alpha_x, double alpha_y) {

@@ -12,15 +12,12 @@
 #include <limits>
 #include <utility>
 
+#include "model/f64.hpp"
 #include "params.hpp"
 
 namespace principled_brdf::reference {
 
-#include "model/scalar_ops.hpp"
-#define PB_MODEL_INLINE inline
-#include "model/model.hpp"
-#undef PB_MODEL_INLINE
-
+using namespace principled_brdf::f64;  // the model's parts for double
 using Eigen::Vector3d;
 
 // The parameters of README "The model", with their defaults.
@@ -79,7 +76,7 @@ template <Model model>
 Lobes lobes_of(const Shading<double>& s, const Vec3<double>& wi, const Vec3<double>& wo) {
     const Geometry<double> g = geometry_of(wi, wo);
     if (!above_surface(g)) return {};
-    const LobeValues<double> v = eval_lobes<model>(g, s, view_of<model>(wo, s));
+    const LobeValues<double> v = f64::eval_lobes<model>(g, s, view_of<model>(wo, s));
     return {vector3d(v.diffuse_rgb(s)), vector3d(v.sheen_rgb(s)), vector3d(v.specular_rgb(s)), vector3d(v.clearcoat_rgb())};
 }
 
@@ -94,7 +91,7 @@ template <Model model>
 Vector3d eval_of(const Shading<double>& s, const Vec3<double>& wi, const Vec3<double>& wo) {
     const Geometry<double> g = geometry_of(wi, wo);
     if (!above_surface(g)) return Vector3d::Zero();
-    return vector3d(eval_lobes<model>(g, s, view_of<model>(wo, s)).total(s));
+    return vector3d(f64::eval_lobes<model>(g, s, view_of<model>(wo, s)).total(s));
 }
 
 // f(wi, wo) in 1/sr, without the cosine factor.

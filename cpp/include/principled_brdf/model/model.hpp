@@ -2,8 +2,8 @@
 // written once. Included inside a namespace that defines, for each number type
 // F it instantiates the model with, the operations of model/scalar_ops.hpp
 // (mul_add, reciprocal, select, min, max, any, all, log, sincos_turns, ...) and
-// the macro PB_MODEL_INLINE; the kernels include it per instruction set, the
-// reference for double (reference.hpp).
+// the macro PB_MODEL_INLINE; the kernels include it per instruction set,
+// f64.hpp for double.
 #include "vector.hpp"
 #include "distributions.hpp"
 #include "lobes.hpp"

@@ -1,0 +1,20 @@
+// The model instantiated for double (docs/model.md), in principled_brdf::f64:
+// the float64 reference (reference.hpp) and the toolkit's distributions where
+// they are the model's (microfacet.hpp). Exact operations (model/scalar_ops.hpp).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "principled_brdf/params.hpp"
+
+namespace principled_brdf::f64 {
+
+#include "scalar_ops.hpp"
+#define PB_MODEL_INLINE inline
+#include "model.hpp"
+#undef PB_MODEL_INLINE
+
+}  // namespace principled_brdf::f64
