@@ -3,6 +3,7 @@
 
 #include <pybind11/pybind11.h>
 
+#include <array>
 #include <stdexcept>
 #include <string>
 
@@ -14,8 +15,8 @@ namespace principled_brdf::bindings {
 // Python side validated the name; this keeps a bad index from reaching C++.
 template <class Enum, std::size_t N>
 Enum enum_from(int index, const std::array<const char*, N>& names, const char* what) {
-    if (index < 0 || index >= static_cast<int>(N))
-        throw std::invalid_argument(std::string(what) + ": expected an index below " + std::to_string(N));
+    if (index < 0 || index >= static_cast<int>(names.size()))
+        throw std::invalid_argument(std::string(what) + ": expected an index below " + std::to_string(names.size()));
     return static_cast<Enum>(index);
 }
 
