@@ -260,6 +260,7 @@ PB_KERNEL_INLINE Floats max(Floats a, Floats b) { return xsimd::max(a, b); }
 PB_KERNEL_INLINE bool any(const Mask& m) { return xsimd::any(m); }
 PB_KERNEL_INLINE bool all(const Mask& m) { return xsimd::all(m); }
 PB_KERNEL_INLINE Floats log(Floats x) { return xsimd::log(x); }
+PB_KERNEL_INLINE Floats exp(Floats x) { return xsimd::exp(x); }
 PB_KERNEL_INLINE Floats largest_finite(Floats) { return Floats(std::numeric_limits<float>::max()); }
 
 // (sin 2πu, cos 2πu) for u in [0, 1] by the double angle, without quadrant

@@ -330,17 +330,12 @@ inline double ggx_pdf_visible_h(const Vec3& h, const Vec3& wo, double alpha_x, d
 // ---------------------------------------------------------------------------
 // Anisotropic Beckmann (Walter et al. 2007, Heitz 2014 §5.2): slope density P22 = exp(-(x²/αx² + y²/αy²)) / (π αx αy).
 
-// Eq. (3-29) made anisotropic by eq. (3-24):
-//   D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴),
-// evaluated as one exp so that 0 · inf never arises at the horizon.
+// D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴): the model's
+// distribution (model/distributions.hpp) with the toolkit's clamps.
 inline double beckmann_d(const Vec3& h, double alpha_x, double alpha_y) {
     if (h.z <= 0.0) return 0.0;
-    alpha_x = clamp_alpha(alpha_x);
-    alpha_y = clamp_alpha(alpha_y);
-    const double sx = h.x / alpha_x;
-    const double sy = h.y / alpha_y;
-    const double tan2_stretched = (sx * sx + sy * sy) / (h.z * h.z);
-    return std::exp(-tan2_stretched - 4.0 * std::log(h.z)) / (kPi * alpha_x * alpha_y);
+    const f64::HalfVector<double> half{h.x * h.x, h.y * h.y, h.z, h.z * h.z, dot(h, h)};
+    return f64::Beckmann<double>::from_alphas(clamp_alpha(alpha_x), clamp_alpha(alpha_y)).d(half);
 }
 
 inline double beckmann_pdf_h(const Vec3& h, double alpha_x, double alpha_y) {

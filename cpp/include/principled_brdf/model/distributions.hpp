@@ -62,6 +62,32 @@ struct Ggx {
     static PB_MODEL_INLINE F smith_denominator_of(F cos_theta, F q) { return mul_add(q, reciprocal_sqrt(q), cos_theta); }
 };
 
+// Anisotropic Beckmann (Walter et al. 2007), slope density
+// P22 = exp(-(x²/ax² + y²/ay²)) / (π ax ay):
+//   D(h) = exp(-((h·x/ax)² + (h·y/ay)²) / (h·n)²) / (π ax ay (h·n)⁴),
+// with (h·n)⁴ taken into the exponent (one exp: no 0 · inf at the horizon).
+template <class F>
+struct Beckmann {
+    F inv_alpha_x2, inv_alpha_y2;  // 1/ax², 1/ay²
+    F norm;                        // 1/(π ax ay)
+
+    static PB_MODEL_INLINE Beckmann from_alphas(F ax, F ay) {
+        Beckmann d;
+        d.inv_alpha_x2 = reciprocal(ax * ax);
+        d.inv_alpha_y2 = reciprocal(ay * ay);
+        d.norm = F(kInvPi) * reciprocal(ax * ay);
+        return d;
+    }
+
+    // D(h) for h = H/|H|, h·n > 0; ln cos θh from Hz itself, which stays
+    // finite where Hz² underflows (the stretched tan² is then +inf, D 0)
+    PB_MODEL_INLINE F d(const HalfVector<F>& h) const {
+        const F tan2_stretched = mul_add(h.hx2, inv_alpha_x2, h.hy2 * inv_alpha_y2) * reciprocal(h.hz2);
+        const F log_cos = log(h.hz * reciprocal_sqrt(h.h_len2));
+        return norm * exp(neg_mul_add(F(4.0), log_cos, -tan2_stretched));
+    }
+};
+
 // Isotropic Smith GGX denominator n·w + sqrt(a2 (1 - (n·w)²) + (n·w)²) for
 // alpha² = a2 < 1, as a2 + cos²(1 - a2) (both terms >= 0): the clearcoat's.
 template <class F>

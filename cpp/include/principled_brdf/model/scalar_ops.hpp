@@ -20,6 +20,7 @@ inline double max(double a, double b) { return a > b ? a : b; }
 inline bool any(bool mask) { return mask; }
 inline bool all(bool mask) { return mask; }
 inline double log(double x) { return std::log(x); }
+inline double exp(double x) { return std::exp(x); }
 inline double exp_minus_one(double x) { return std::expm1(x); }
 inline double largest_finite(double) { return std::numeric_limits<double>::max(); }
 
