@@ -161,7 +161,7 @@ def readme_sample(p, wo, u, sampler):
 
 
 def toolkit_pdf(p, wi, wo, sampler):
-    """The mixture pdf from README, per lobe through pb.microfacet (independent of reference_sampling.hpp)."""
+    """The mixture pdf from README, per lobe through pb.microfacet (independent of the model's C++)."""
     n = len(wi)
     probability = readme_lobe_probabilities(p, wo)
     upper = (wi[:, 2] > 0) & (wo[:, 2] > 0)

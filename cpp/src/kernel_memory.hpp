@@ -62,15 +62,14 @@ inline bool unit_length_at(const Vec3Array& a, std::int64_t i, const DirectionCh
 // the rule, element by element: the first element the rule rejects is the
 // call's answer; if there is none, the batch runs with the check off (the same
 // bits, the check changes no value) and the loop resumes after it.
-template <class Job, class Loop, class FirstRejected>
-std::int64_t run_checked(const Job& job, std::int64_t begin, std::int64_t end, const Loop& loop,
-                         const FirstRejected& first_rejected) {
+template <class Job, class Loop, class Rejects>
+std::int64_t run_checked(const Job& job, std::int64_t begin, std::int64_t end, const Loop& loop, const Rejects& rejects) {
     while (begin < end) {
         const std::int64_t stopped = loop(job, begin, end);
         if (stopped < 0) return -1;
         const std::int64_t batch_end = std::min(stopped + kLanes, end);
         for (std::int64_t i = stopped; i < batch_end; ++i)
-            if (first_rejected(i)) return i;
+            if (rejects(i)) return i;
         Job unchecked = job;
         unchecked.check.enabled = false;
         loop(unchecked, stopped, batch_end);
