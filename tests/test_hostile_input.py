@@ -337,3 +337,17 @@ def test_batches_the_fast_test_cannot_decide_give_the_same_bits(isa):
                         for c in (True, False))
                 for x, y in zip(a, b):
                     np.testing.assert_array_equal(x, y)
+
+
+def test_the_kernels_never_see_misaligned_data():
+    # The Python side copies misaligned inputs; the bindings refuse any that
+    # would still reach them, rather than hand the kernels a float* off alignment.
+    n = 8
+    wi = misaligned(np.tile(np.float32([0, 0, 1]), (n, 1)))
+    params = pb._batch._params(pb.Material(), (n,))
+    with pytest.raises(ValueError, match="wi: array data is not aligned"):
+        pb._core.batch_eval(wi, 0, np.float32([0, 0, 1]), 2, params, [np.empty((n, 3), np.float32)], 0, n, 0,
+                            False, False, 0.0, 1, "")
+    with pytest.raises(ValueError, match="out: array data is not aligned"):
+        pb._core.batch_eval(wi.copy(), 0, np.float32([0, 0, 1]), 2, params,
+                            [misaligned(np.empty((n, 3), np.float32))], 0, n, 0, False, False, 0.0, 1, "")
