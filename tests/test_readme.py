@@ -3,7 +3,6 @@ reader pastes them into a notebook), and the outputs it prints are what they pri
 
 import os
 import re
-import sys
 
 import numpy as np
 import pytest
