@@ -47,6 +47,19 @@ MutableVec3Array output_view(Float32Array& a, int layout, std::int64_t n, const 
     return {a.mutable_data(), view.layout, view.row_stride};
 }
 
+// `count` output arrays, each C-contiguous float32 in the same layout, as views;
+// `keep` holds the arrays while the views are used.
+void output_views(const py::sequence& arrays, int count, int layout, std::int64_t n, const char* name,
+                  MutableVec3Array* views, std::vector<Float32Array>& keep) {
+    if (py::len(arrays) != static_cast<std::size_t>(count))
+        throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(count) + " arrays");
+    for (int k = 0; k < count; ++k) {
+        keep.push_back(py::cast<Float32Array>(arrays[k]));
+        if (!keep.back().is(arrays[k])) throw std::invalid_argument(std::string(name) + ": expected C-contiguous float32 arrays");
+        views[k] = output_view(keep.back(), layout, n, name);
+    }
+}
+
 // params: 11 entries in the order of kParams, each a number (base_color: a
 // 3-sequence) or a float32 array of n values ((n, 3) for base_color).
 void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, py::list& keep_alive) {
@@ -75,9 +88,9 @@ void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, p
 }
 
 // Returns -1, or with check_tolerance > 0 the index of an element whose wi or
-// wo is not a unit vector (the outputs are then partly written: pass fresh ones).
+// wo is not a unit vector (the outputs then hold the results of some elements only).
 std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
-                        const py::sequence& params, py::list outputs, int out_layout, std::int64_t n, int model,
+                        const py::sequence& params, const py::sequence& outputs, int out_layout, std::int64_t n, int model,
                         bool lobes, bool cosine, double check_tolerance, int threads, const std::string& isa) {
     EvalJob job;
     job.wi = vec3_view(wi, wi_layout, n, "wi");
@@ -88,15 +101,8 @@ std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Arra
     job.output = lobes ? Output::kLobes : Output::kTotal;
     job.cosine = cosine;
     if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
-    const int expected = lobes ? kLobeCount : 1;
-    if (py::len(outputs) != static_cast<std::size_t>(expected))
-        throw std::invalid_argument("out: expected " + std::to_string(expected) + " arrays");
-    std::vector<Float32Array> out_arrays;
-    for (int k = 0; k < expected; ++k) {
-        out_arrays.push_back(py::cast<Float32Array>(outputs[k]));
-        if (!out_arrays.back().is(outputs[k])) throw std::invalid_argument("out: expected C-contiguous float32 arrays");
-        job.out[k] = output_view(out_arrays.back(), out_layout, n, "out");
-    }
+    std::vector<Float32Array> keep_outputs;
+    output_views(outputs, lobes ? kLobeCount : 1, out_layout, n, "out", job.out, keep_outputs);
     if (n == 0) return -1;
     py::gil_scoped_release release;
     return eval(job, n, threads, isa);
@@ -148,17 +154,10 @@ std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::objec
     job.weight = output_view(weight, out_layout, n, "weight");
     job.pdf = scalar_output(pdf, n, "pdf");
     job.lobe = scalar_output(lobe, n, "lobe");
-    std::vector<Float32Array> lobe_arrays;
-    if (!lobe_weights.is_none()) {
-        const py::sequence arrays = lobe_weights.cast<py::sequence>();
-        if (py::len(arrays) != static_cast<std::size_t>(kLobeCount))
-            throw std::invalid_argument("lobe_weights: expected " + std::to_string(kLobeCount) + " arrays");
-        for (int k = 0; k < kLobeCount; ++k) {
-            lobe_arrays.push_back(py::cast<Float32Array>(arrays[k]));
-            if (!lobe_arrays.back().is(arrays[k])) throw std::invalid_argument("lobe_weights: expected C-contiguous float32 arrays");
-            job.lobe_weight[k] = output_view(lobe_arrays.back(), out_layout, n, "lobe_weights");
-        }
-    }
+    std::vector<Float32Array> keep_outputs;
+    if (!lobe_weights.is_none())
+        output_views(lobe_weights.cast<py::sequence>(), kLobeCount, out_layout, n, "lobe_weights", job.lobe_weight,
+                     keep_outputs);
     if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
     if (n == 0) return -1;
     py::gil_scoped_release release;

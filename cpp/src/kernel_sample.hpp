@@ -43,17 +43,15 @@ PB_KERNEL_INLINE Direction<Floats> draw(const SampleJob& job, const Chosen& c, c
 template <Model model, Layouts layouts, bool with_lobes>
 PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction<Floats>& d,
                             const Shading<Floats>& s) {
-    const WeighedWithLobes<Floats> full = weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler);
-    // only what is stored is kept: without the lobes, the small part
-    const Weighed<Floats> w = full;
+    const Weighed<Floats> w = weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler);
     store_rgb<layouts>(job.wi, i, Rgb<Floats>{w.wi.x, w.wi.y, w.wi.z});
     w.pdf.store_unaligned(job.pdf + i);
     store_rgb<layouts>(job.weight, i, w.weight);
     if constexpr (with_lobes) {
-        store_rgb<layouts>(job.lobe_weight[0], i, full.share(full.lobes.diffuse_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[1], i, full.share(full.lobes.sheen_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[2], i, full.share(full.lobes.specular_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[3], i, full.share(full.lobes.clearcoat_rgb()));
+        store_rgb<layouts>(job.lobe_weight[0], i, w.share(w.lobes.diffuse_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[1], i, w.share(w.lobes.sheen_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };

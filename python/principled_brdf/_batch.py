@@ -13,7 +13,6 @@ Input handling, once per call:
 
 from __future__ import annotations
 
-
 from typing import NamedTuple
 
 import numpy as np
@@ -23,15 +22,15 @@ from ._validate import (
     DIRECTION_LENGTH_TOLERANCE,
     as_real_array,
     broadcast_leading,
+    LOBE_NAMES,
     direction_error,
     element_name,
     flag,
-    LOBE_NAMES,
     integer,
     model_index,
     require_float32,
-    sampler_index,
     require_in_domain,
+    sampler_index,
     seed_value,
     unit_length,
 )
@@ -61,8 +60,9 @@ class Sample(NamedTuple):
     pdf: np.ndarray  # (...) mixture density in solid angle; 0 at or below the horizon
     weight: np.ndarray  # (..., 3) f(wi, wo) cos θl / pdf; 0 where pdf is 0
     lobe: np.ndarray  # (...) int32, an index into SAMPLED_LOBE_NAMES: 0 cosine, 1 primary specular, 2 clearcoat
-_LAYOUTS = ("aos", "soa")
 
+
+_LAYOUTS = ("aos", "soa")
 
 
 def cpu_info() -> dict:

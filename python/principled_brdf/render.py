@@ -8,7 +8,6 @@ directional light plus a constant ambient term. Returns linear RGB; use
 
 from __future__ import annotations
 
-import numbers
 import struct
 import zlib
 
@@ -30,11 +29,10 @@ MAX_RESOLUTION = 16384
 
 
 def _resolution(value) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Integral, np.integer)):
-        raise TypeError(f"resolution: expected an integer, got {type(value).__name__}")
+    value = _validate.integer("resolution", value)
     if not 2 <= value <= MAX_RESOLUTION:
         raise ValueError(f"resolution: expected 2 to {MAX_RESOLUTION} pixels, got {value}")
-    return int(value)
+    return value
 
 
 def _light_direction(value) -> np.ndarray:

@@ -61,8 +61,8 @@ inline bool uniform_material(const ParamSlot* params) {
 // decision for every vector: a direction passes everywhere or fails everywhere.
 // The kernels first test the float32 squared length against bounds narrowed
 // by far more than its rounding error (fast_lowest, fast_highest), which only
-// accepts what the rule accepts, and decide any other batch lane by lane by
-// the rule itself.
+// accepts what the rule accepts, and decide any batch it does not accept
+// element by element by the rule itself (run_checked in kernel_memory.hpp).
 struct DirectionCheck {
     bool enabled = false;
     double length2_lowest = 0.0, length2_highest = 0.0;
@@ -131,11 +131,9 @@ std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::st
 // As eval, for sampling; returns -1 or an element whose wo is bad.
 std::int64_t sample(const SampleJob& job, std::int64_t n, int threads, const std::string& isa = "");
 
-
 // The counter-based uniforms sample() uses for elements first .. first + n - 1,
 // written as (n, 3) interleaved into out (scalar code, bit-identical to the kernels').
 void counter_uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n, float* out);
-
 
 int hardware_threads();
 

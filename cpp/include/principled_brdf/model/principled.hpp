@@ -252,12 +252,7 @@ struct Weighed {
     Vec3<F> wi;
     F pdf;
     Rgb<F> weight;
-};
-
-// The same with each lobe's share of the weight, select(valid, scale * lobe, 0)
-// (a separate type: the kernels' sampling loops keep the small one in registers).
-template <class F>
-struct WeighedWithLobes : Weighed<F> {
+    // what each lobe's share of the weight, select(valid, scale * lobe, 0), needs
     LobeValues<F> lobes;
     F scale;  // cos θl / pdf
     MaskOf<F> valid;
@@ -269,8 +264,8 @@ struct WeighedWithLobes : Weighed<F> {
 };
 
 template <Model model, class F>
-PB_MODEL_INLINE WeighedWithLobes<F> weigh(const Vec3<F>& wo, F fv, const LobeWeights<F>& weights, const Direction<F>& drawn,
-                                          const Shading<F>& s, SpecularSampler sampler) {
+PB_MODEL_INLINE Weighed<F> weigh(const Vec3<F>& wo, F fv, const LobeWeights<F>& weights, const Direction<F>& drawn,
+                                 const Shading<F>& s, SpecularSampler sampler) {
     const Vec3<F>& wi = drawn.wi;
     const View<F> view = view_of<model>(wo, s, drawn.smith_visible, fv);
     const Geometry<F> g = geometry_of(wi, wo);
@@ -282,7 +277,7 @@ PB_MODEL_INLINE WeighedWithLobes<F> weigh(const Vec3<F>& wo, F fv, const LobeWei
     // select after multiplying: below the horizon f may be infinite or NaN
     auto weight = [&](F value) { return select(valid, scale * value, F(0.0)); };
     auto finite = [&](F value) { return select(g.finite, value, F(0.0)); };
-    WeighedWithLobes<F> w;
+    Weighed<F> w;
     w.wi = {finite(wi.x), finite(wi.y), finite(wi.z)};
     w.pdf = select(valid, pdf, F(0.0));
     w.weight = {weight(f.r), weight(f.g), weight(f.b)};
