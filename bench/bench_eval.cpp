@@ -27,7 +27,7 @@ constexpr std::int64_t kSizes[] = {4096, 65536, 16 << 20};
 // both layouts, made once per size.
 struct Data {
     std::int64_t n;
-    std::vector<float> wi_aos, wo_aos, wi_soa, wo_soa, out;
+    std::vector<float> wi_aos, wo_aos, wi_soa, wo_soa, out, jacobian;
     std::vector<float> params[pb::kParamSlots];  // per-element, base_color interleaved in slot 0
 };
 
@@ -56,6 +56,7 @@ Data& data_for(std::int64_t n) {
     directions(d.wi_aos, d.wi_soa);
     directions(d.wo_aos, d.wo_soa);
     d.out.resize(12 * n);
+    d.jacobian.resize(static_cast<std::size_t>(pb::kJacobianWidth) * n);
     d.params[pb::kBaseColorR].resize(3 * n);
     for (auto& v : d.params[pb::kBaseColorR]) v = uniform(rng);
     for (int s = pb::kMetallic; s < pb::kParamSlots; ++s) {
@@ -97,6 +98,21 @@ void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_elem
     state.SetItemsProcessed(state.iterations() * d.n);
 }
 
+// f and its Jacobian in the 13 parameter slots (pb.eval_grad).
+void simd_eval_grad(benchmark::State& state, std::string isa, bool soa, bool per_element) {
+    Data& d = data_for(state.range(0));
+    pb::EvalJob job = make_job(d, soa, per_element);
+    job.output = pb::Output::kGradient;
+    job.jacobian = d.jacobian.data();
+    job.jacobian_row_stride = soa ? d.n : 0;
+    const int threads = threads_of(state);
+    for (auto _ : state) {
+        pb::eval(job, d.n, threads, isa);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * d.n);
+}
+
 // Importance sampling with the counter-based generator: wi, pdf, weight, lobe per element.
 void simd_sample(benchmark::State& state, std::string isa, bool soa, bool per_element) {
     Data& d = data_for(state.range(0));
@@ -125,11 +141,14 @@ void reference_eval(benchmark::State& state) {
     m.roughness = 0.4;
     m.clearcoat = 0.5;
     m.sheen = 0.2;
+    const auto row = m.slots();
     for (auto _ : state) {
+        // as pb.reference.eval runs a uniform material: its shading prepared once per call
+        pb::reference::ShadingCache shading;
         for (std::int64_t i = 0; i < d.n; ++i) {
             const Eigen::Vector3d wi(d.wi_aos[3 * i], d.wi_aos[3 * i + 1], d.wi_aos[3 * i + 2]);
             const Eigen::Vector3d wo(d.wo_aos[3 * i], d.wo_aos[3 * i + 1], d.wo_aos[3 * i + 2]);
-            const Eigen::Vector3d f = pb::reference::eval(m, wi, wo);
+            const Eigen::Vector3d f = pb::reference::eval(shading.of(row.data()), wi, wo);
             d.out[3 * i] = static_cast<float>(f.x());
             d.out[3 * i + 1] = static_cast<float>(f.y());
             d.out[3 * i + 2] = static_cast<float>(f.z());
@@ -184,6 +203,14 @@ void register_all() {
                         if (!soa && !per_element) {  // the default call: the direction check on
                             const std::string checked_name = "eval_checked/" + isa + "/aos/uniform";
                             benchmark::RegisterBenchmark(checked_name.c_str(), simd_eval, isa, false, false, true)
+                                ->Args({n, threads})
+                                ->UseRealTime()
+                                ->Unit(benchmark::kMicrosecond);
+                        }
+                        if (n == kSizes[0] && threads == 1) {
+                            const std::string grad_name = "eval_grad/" + isa + (soa ? "/soa" : "/aos") +
+                                                          (per_element ? "/per_element" : "/uniform");
+                            benchmark::RegisterBenchmark(grad_name.c_str(), simd_eval_grad, isa, soa, per_element)
                                 ->Args({n, threads})
                                 ->UseRealTime()
                                 ->Unit(benchmark::kMicrosecond);

@@ -108,6 +108,36 @@ std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Arra
     return eval(job, n, threads, isa);
 }
 
+// f (out) and its Jacobian: (N, 3) and (N, 3, 13) arrays, or (3, N) and (3, 13, N) with out_layout rows.
+std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                             const py::sequence& params, Float32Array out, Float32Array jacobian, int out_layout,
+                             std::int64_t n, int model, bool cosine, double check_tolerance, int threads,
+                             const std::string& isa) {
+    EvalJob job;
+    job.wi = vec3_view(wi, wi_layout, n, "wi");
+    job.wo = vec3_view(wo, wo_layout, n, "wo");
+    py::list keep_alive;
+    fill_params(params, n, job.params, keep_alive);
+    job.model = model_from(model);
+    job.output = Output::kGradient;
+    job.cosine = cosine;
+    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
+    job.out[0] = output_view(out, out_layout, n, "out");
+    const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
+    const bool shape_ok = rows ? (jacobian.ndim() == 3 && jacobian.shape(0) == 3 && jacobian.shape(1) == kParamSlots &&
+                                  jacobian.shape(2) == n)
+                               : (jacobian.ndim() == 3 && jacobian.shape(0) == n && jacobian.shape(1) == 3 &&
+                                  jacobian.shape(2) == kParamSlots);
+    if (!shape_ok || !jacobian.writeable())
+        throw std::invalid_argument("jacobian: expected a writeable (N, 3, 13) array, or (3, 13, N) for the rows layout");
+    require_aligned(jacobian.data(), "jacobian");
+    job.jacobian = jacobian.mutable_data();
+    job.jacobian_row_stride = rows ? n : 0;
+    if (n == 0) return -1;
+    py::gil_scoped_release release;
+    return eval(job, n, threads, isa);
+}
+
 template <class T>
 T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const char* name) {
     if (a.ndim() != 1 || a.shape(0) != n || !a.writeable())
@@ -207,6 +237,10 @@ void bind_batch(py::module_& m) {
           py::arg("params"), py::arg("outputs"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
           py::arg("lobes"), py::arg("cosine"), py::arg("check_tolerance"), py::arg("threads"), py::arg("isa"),
           "SIMD evaluation into preallocated float32 outputs (validated by the caller).");
+    m.def("batch_eval_grad", &batch_eval_grad, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
+          py::arg("params"), py::arg("out"), py::arg("jacobian"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
+          py::arg("cosine"), py::arg("check_tolerance"), py::arg("threads"), py::arg("isa"),
+          "SIMD f and its Jacobian over the parameter slots into preallocated float32 outputs.");
     m.def("batch_pdf", &batch_pdf, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
           py::arg("params"), py::arg("pdf"), py::arg("n"), py::arg("sampler"), py::arg("check_tolerance"),
           py::arg("threads"), py::arg("isa"), "SIMD sampling pdf into a preallocated float32 array.");

@@ -49,43 +49,6 @@ void require_rows(const Float64Array& a, py::ssize_t n, py::ssize_t columns, con
                                     ") float64 array");
 }
 
-// f or the four lobes for N packed rows: wi (N,3), wo (N,3), params (N,13).
-py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
-                                   int model, bool lobes) {
-    const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
-    require_rows(wi, n, 3, "wi");
-    require_rows(wo, n, 3, "wo");
-    require_rows(params, n, kParamSlots, "params");
-    const Model which_model = model_from(model);
-
-    std::vector<py::ssize_t> shape{n};
-    if (lobes) shape.push_back(kLobeCount);
-    shape.push_back(3);
-    py::array_t<double> out(shape);
-    const double* wi_data = wi.data();
-    const double* wo_data = wo.data();
-    const double* param_data = params.data();
-    double* out_data = out.mutable_data();
-    {
-        py::gil_scoped_release release;
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const auto material = reference::Material::from_slots(param_data + i * kParamSlots);
-            const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
-            if (lobes) {
-                const auto result = reference::eval_lobes(material, in, view, which_model);
-                double* row = out_data + 3 * kLobeCount * i;
-                Eigen::Map<Eigen::Vector3d>(row + 0) = result.diffuse;
-                Eigen::Map<Eigen::Vector3d>(row + 3) = result.sheen;
-                Eigen::Map<Eigen::Vector3d>(row + 6) = result.specular;
-                Eigen::Map<Eigen::Vector3d>(row + 9) = result.clearcoat;
-            } else {
-                Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, which_model);
-            }
-        }
-    }
-    return out;
-}
-
 // The sampling functions take each input as N rows or as a single row shared by
 // all N (a uniform material, one view direction): a packed (N, 13) copy of a
 // uniform material would cost more than the samples.
@@ -110,6 +73,68 @@ Rows shared_or_rows(const Float64Array& a, py::ssize_t n, py::ssize_t columns, c
     return {a.data(), a.shape(0) == 1 ? 0 : columns};
 }
 
+// f or the four lobes for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
+py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
+                                   int model, bool lobes) {
+    const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
+    require_rows(wi, n, 3, "wi");
+    require_rows(wo, n, 3, "wo");
+    const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
+    const Model which_model = model_from(model);
+
+    std::vector<py::ssize_t> shape{n};
+    if (lobes) shape.push_back(kLobeCount);
+    shape.push_back(3);
+    py::array_t<double> out(shape);
+    const double* wi_data = wi.data();
+    const double* wo_data = wo.data();
+    double* out_data = out.mutable_data();
+    {
+        py::gil_scoped_release release;
+        reference::ShadingCache shading;
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const auto& material = shading.of(material_rows.row(i));
+            const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+            if (lobes) {
+                const auto result = reference::eval_lobes(material, in, view, which_model);
+                double* row = out_data + 3 * kLobeCount * i;
+                Eigen::Map<Eigen::Vector3d>(row + 0) = result.diffuse;
+                Eigen::Map<Eigen::Vector3d>(row + 3) = result.sheen;
+                Eigen::Map<Eigen::Vector3d>(row + 6) = result.specular;
+                Eigen::Map<Eigen::Vector3d>(row + 9) = result.clearcoat;
+            } else {
+                Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, which_model);
+            }
+        }
+    }
+    return out;
+}
+
+// f (N,3) and its Jacobian (N,3,13) for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
+py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, const Float64Array& params, int model) {
+    const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
+    require_rows(wi, n, 3, "wi");
+    require_rows(wo, n, 3, "wo");
+    const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
+    const Model which_model = model_from(model);
+    py::array_t<double> value({n, py::ssize_t(3)}), jacobian({n, py::ssize_t(3), py::ssize_t(kParamSlots)});
+    const double* wi_data = wi.data();
+    const double* wo_data = wo.data();
+    double* value_data = value.mutable_data();
+    double* jacobian_data = jacobian.mutable_data();
+    {
+        py::gil_scoped_release release;
+        reference::GradientShadingCache prepared;
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+            const reference::Gradient g = reference::eval_grad(prepared.of(material_rows.row(i)), in, view, which_model);
+            Eigen::Map<Eigen::Vector3d>(value_data + 3 * i) = g.value;
+            std::copy(g.jacobian.data(), g.jacobian.data() + 3 * kParamSlots, jacobian_data + 3 * kParamSlots * i);
+        }
+    }
+    return py::make_tuple(value, jacobian);
+}
+
 // README "Sampling and pdf": wo (N,3), u (N,3) = (u0, u1, u2), params (N,13); each may be one shared row.
 py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const Float64Array& params, int model,
                            int sampler) {
@@ -128,8 +153,9 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
     std::int32_t* lobe_data = lobe_out.mutable_data();
     {
         py::gil_scoped_release release;
+        reference::ShadingCache shading;
         for (py::ssize_t i = 0; i < n; ++i) {
-            const auto material = reference::Material::from_slots(material_rows.row(i));
+            const auto& material = shading.of(material_rows.row(i));
             const double* ui = uniforms.row(i);
             const auto s =
                 reference::sample(material, Eigen::Vector3d(view.row(i)), ui[0], ui[1], ui[2], which_model, which_sampler);
@@ -156,8 +182,9 @@ py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo
     double* out_data = out.mutable_data();
     {
         py::gil_scoped_release release;
+        reference::ShadingCache shading;
         for (py::ssize_t i = 0; i < n; ++i) {
-            const auto material = reference::Material::from_slots(material_rows.row(i));
+            const auto& material = shading.of(material_rows.row(i));
             out_data[i] = reference::pdf(material, Eigen::Vector3d(in.row(i)), Eigen::Vector3d(view.row(i)),
                                          which_sampler);
         }
@@ -174,8 +201,9 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
     double* out_data = out.mutable_data();
     {
         py::gil_scoped_release release;
+        reference::ShadingCache shading;
         for (py::ssize_t i = 0; i < n; ++i) {
-            const auto material = reference::Material::from_slots(material_rows.row(i));
+            const auto& material = shading.of(material_rows.row(i));
             const auto p = reference::lobe_probabilities(material, Eigen::Vector3d(view.row(i)));
             std::copy(p.begin(), p.end(), out_data + 3 * i);
         }
@@ -189,6 +217,8 @@ void bind_reference(py::module_& m) {
     m.def("reference_eval", &reference_eval, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
           py::arg("lobes"),
           "Float64 reference f (N,3) or lobes (N,4,3) for packed, already validated rows.");
+    m.def("reference_eval_grad", &reference_eval_grad, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
+          "Float64 reference f (N,3) and its Jacobian (N,3,13) over the parameter slots, for packed validated rows.");
     m.def("reference_sample", &reference_sample, py::arg("wo"), py::arg("u"), py::arg("params"), py::arg("model"),
           py::arg("sampler"),
           "Float64 reference samples (wi (N,3), pdf (N,), weight (N,3), lobe (N,) int32) for validated rows;\n"

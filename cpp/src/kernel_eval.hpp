@@ -2,14 +2,55 @@
 // loop (f, the lobes, or the sampling pdf) over a range of elements.
 #pragma once  // (per translation unit)
 
+// What a batch needs of its material: the lobes' constants and, for the
+// Jacobian, their partials (nothing otherwise).
+struct NoPartials {};
+
+template <Output output>
+struct Prepared {
+    Shading<Floats> shading;
+    std::conditional_t<output == Output::kGradient, MaterialPartials<Floats>, NoPartials> partials;
+};
+
+template <Output output>
+PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
+    Prepared<output> p;
+    p.shading = shading_of(m);
+    if constexpr (output == Output::kGradient) p.partials = material_partials_of(m.slot);
+    return p;
+}
+
+// A batch's Jacobian, row r = kParamSlots c + p holding ∂f_c/∂p of every lane:
+// stored by rows, or transposed through the stack to element-major order.
+PB_KERNEL_INLINE void store_jacobian(const EvalJob& job, std::int64_t i, const Floats (&rows)[kJacobianWidth]) {
+    if (job.jacobian_row_stride > 0) {
+        for (int r = 0; r < kJacobianWidth; ++r) rows[r].store_unaligned(job.jacobian + r * job.jacobian_row_stride + i);
+        return;
+    }
+    alignas(64) float lanes[kJacobianWidth][kLanes];
+    for (int r = 0; r < kJacobianWidth; ++r) rows[r].store_aligned(lanes[r]);
+    float* out = job.jacobian + kJacobianWidth * i;
+    for (std::int64_t lane = 0; lane < kLanes; ++lane)
+        for (int r = 0; r < kJacobianWidth; ++r) out[kJacobianWidth * lane + r] = lanes[r][lane];
+}
+
 template <Model model, Output output, Layouts layouts>
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
-                                 const Shading<Floats>& s) {
+                                 const Prepared<output>& material) {
+    const Shading<Floats>& s = material.shading;
     const Geometry<Floats> g = geometry_of(wi, wo);
     // select discards whatever the formulas gave below the surface (H may be 0)
     const Mask above = above_surface(g);
     const View<Floats> view = view_of<model>(wo, s);
-    if constexpr (output == Output::kPdf) {
+    if constexpr (output == Output::kGradient) {
+        const ValueGradient<Floats> v = eval_gradient<model>(g, s, view, material.partials);
+        auto masked = [&](Floats x) { return select(above, job.cosine ? wi.z * x : x, Floats(0.0f)); };
+        store_rgb<layouts>(job.out[0], i, {masked(v.value.r), masked(v.value.g), masked(v.value.b)});
+        Floats rows[kJacobianWidth];
+        for (int c = 0; c < 3; ++c)
+            for (int p = 0; p < kParamSlots; ++p) rows[kParamSlots * c + p] = masked(v.jacobian[c][p]);
+        store_jacobian(job, i, rows);
+    } else if constexpr (output == Output::kPdf) {
         const Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     } else {
@@ -30,12 +71,12 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
 // One batch at i; false, with nothing stored, when the fast direction test
 // does not accept it.
 template <Model model, Output output, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const Shading<Floats>& uniform) {
+PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const Prepared<output>& uniform) {
     const Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
     const Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled && !all(surely_unit_length(wi, job.check) & surely_unit_length(wo, job.check))) return false;
     if constexpr (per_element) {
-        eval_batch<model, output, layouts>(job, i, wi, wo, shading_of(load_material(job.params, i)));
+        eval_batch<model, output, layouts>(job, i, wi, wo, prepare<output>(load_material(job.params, i)));
     } else {
         eval_batch<model, output, layouts>(job, i, wi, wo, uniform);
     }
@@ -44,21 +85,32 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const S
 
 // The last pad.count < kLanes elements, as one batch.
 template <Model model, Output output, bool per_element>
-bool eval_tail(const EvalJob& job, const Padding& pad, const Shading<Floats>& uniform) {
+bool eval_tail(const EvalJob& job, const Padding& pad, const Prepared<output>& uniform) {
     alignas(64) PadBuffer wi, wo, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
+    alignas(64) float jacobian[output == Output::kGradient ? kJacobianWidth * kLanes : 1];
     EvalJob padded = job;
     padded.wi = pad_vec3(job.wi, pad, wi);
     padded.wo = pad_vec3(job.wo, pad, wo);
     pad_params(job.params, padded.params, pad, params);
-    const int outputs = output == Output::kLobes ? kLobeCount : output == Output::kTotal ? 1 : 0;
+    const int outputs = output == Output::kLobes ? kLobeCount : output == Output::kPdf ? 0 : 1;
     for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
     padded.pdf = pdf;
+    padded.jacobian = jacobian;
+    padded.jacobian_row_stride = 0;
 
     if (!eval_one_batch<model, output, per_element, Layouts::kMixed>(padded, 0, uniform)) return false;
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf) unpad_scalars(job.pdf, pad, pdf);
+    if constexpr (output == Output::kGradient) {
+        for (std::int64_t j = 0; j < pad.count; ++j)
+            for (int r = 0; r < kJacobianWidth; ++r) {
+                const std::int64_t e = pad.begin + j;
+                const std::int64_t index = job.jacobian_row_stride > 0 ? r * job.jacobian_row_stride + e : kJacobianWidth * e + r;
+                job.jacobian[index] = jacobian[kJacobianWidth * j + r];
+            }
+    }
     return true;
 }
 
@@ -66,8 +118,8 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const Shading<Floats>& un
 // batch the fast direction test did not accept (see run_checked).
 template <Model model, Output output, bool per_element, Layouts layouts>
 std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    Shading<Floats> uniform{};
-    if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
+    Prepared<output> uniform{};
+    if constexpr (!per_element) uniform = prepare<output>(load_material(job.params, 0));
     std::int64_t i = begin;
     for (; i + kLanes <= end; i += kLanes)
         if (!eval_one_batch<model, output, per_element, layouts>(job, i, uniform)) return i;
@@ -76,7 +128,7 @@ std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end)
 }
 
 inline Layouts layouts_of(const EvalJob& job) {
-    const int outputs = job.output == Output::kLobes ? kLobeCount : job.output == Output::kTotal ? 1 : 0;
+    const int outputs = job.output == Output::kLobes ? kLobeCount : job.output == Output::kPdf ? 0 : 1;
     for (Vec3Layout layout : {Vec3Layout::kInterleaved, Vec3Layout::kRows}) {
         bool all = job.wi.layout == layout && job.wo.layout == layout;
         for (int k = 0; k < outputs; ++k) all = all && job.out[k].layout == layout;
@@ -114,6 +166,9 @@ inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int6
     switch (job.output) {
         case Output::kPdf:  // the pdf does not depend on the model
             return eval_range_for<Model::kDisney2014, Output::kPdf>(job, begin, end);
+        case Output::kGradient:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kGradient>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kGradient>(job, begin, end);
         case Output::kLobes:
             return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kLobes>(job, begin, end)
                                                    : eval_range_for<Model::kDisney2014, Output::kLobes>(job, begin, end);

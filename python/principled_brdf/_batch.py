@@ -34,9 +34,11 @@ from ._validate import (
     seed_value,
     unit_length,
 )
+from . import _gradient
+from ._gradient import GRADIENT_NAMES, Gradient
 from .material import PARAMETERS, Material
 
-__all__ = ["eval", "eval_lobes", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
+__all__ = ["eval", "eval_lobes", "eval_grad", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
 
 _INTERLEAVED, _ROWS, _SINGLE = 0, 1, 2
 
@@ -243,8 +245,9 @@ def _flat_vec3(array: np.ndarray, layout: str) -> tuple:
     return (array.reshape(n, 3), _INTERLEAVED) if layout == "aos" else (array.reshape(3, n), _ROWS)
 
 
-def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs_for_shape, pdf_sampler=None):
-    """eval / eval_lobes / pdf: validated arguments in, outputs written."""
+def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs_for_shape, pdf_sampler=None,
+              gradient=False):
+    """eval / eval_lobes / pdf / eval_grad: validated arguments in, outputs written."""
     _require_material(material)
     layout = _layout(layout)
     thread_count = _threads(threads)
@@ -263,13 +266,19 @@ def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, o
     # The check rides along with the evaluation (README "Bad input"): on a bad
     # direction the call raises, and an out= buffer may hold partial results.
     tolerance = DIRECTION_LENGTH_TOLERANCE if check else 0.0
-    if pdf_sampler is not None:
+    out_layout = _INTERLEAVED if layout == "aos" else _ROWS
+    if gradient:
+        value, jacobian = outputs
+        bad = _core.batch_eval_grad(wi_flat, wi_code, wo_flat, wo_code, params, _flat_vec3(value, layout)[0],
+                                    jacobian.reshape((n, 3, -1) if layout == "aos" else (3, -1, n)), out_layout, n,
+                                    model_id, cosine, tolerance, thread_count, isa_name)
+    elif pdf_sampler is not None:
         bad = _core.batch_pdf(wi_flat, wi_code, wo_flat, wo_code, params, outputs[0].reshape(n), n, pdf_sampler,
                               tolerance, thread_count, isa_name)
     else:
         flat_outputs = [_flat_vec3(o, layout)[0] for o in outputs]
         bad = _core.batch_eval(wi_flat, wi_code, wo_flat, wo_code, params, flat_outputs,
-                               _INTERLEAVED if layout == "aos" else _ROWS, n, model_id, len(outputs) == len(LOBE_NAMES),
+                               out_layout, n, model_id, len(outputs) == len(LOBE_NAMES),
                                cosine, tolerance, thread_count, isa_name)
     if bad >= 0:
         raise _direction_error(bad, leading, wi_dirs, wo_dirs)
@@ -301,6 +310,49 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
     outputs = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
                         lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in LOBE_NAMES])
     return Lobes(*outputs)
+
+
+def _jacobian_shape(leading: tuple, layout: str, width: int) -> tuple:
+    return leading + (3, width) if layout == "aos" else (3, width) + leading
+
+
+def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014", cosine: bool = False,
+              layout: str = "aos", threads=None, out=None, check: bool = True, isa=None) -> Gradient:
+    """f and its Jacobian in the material's parameters, by the SIMD kernel in
+    float32 (README "Gradients").
+
+    Returns a :class:`Gradient`: ``value`` as :func:`eval` returns it,
+    ``jacobian`` ``(..., 3, P)`` (``(3, P, ...)`` for ``layout="soa"``) with
+    ``jacobian[..., c, k] = ∂f_c/∂names[k]``, and ``names``: the P parameters
+    ``wrt`` selects (default all 13 slots of the parameter table,
+    ``base_color`` as ``base_color_r/g/b``), in the table's order. A uniform
+    parameter still gets a per-element derivative. ``out=(value, jacobian)``
+    writes into preallocated float32 arrays of exactly those shapes. The other
+    arguments are :func:`eval`'s.
+    """
+    wanted = _gradient.columns(wrt)
+    full = len(wanted) == len(GRADIENT_NAMES)
+    if out is not None and not (isinstance(out, tuple) and len(out) == 2):
+        raise TypeError("out: expected a tuple (value, jacobian) of float32 arrays")
+
+    def outputs(leading, layout):
+        value = _output(None if out is None else out[0], _vec3_shape(leading, layout), "out[0]")
+        jacobian_shape = _jacobian_shape(leading, layout, len(wanted))
+        jacobian = _output(None if out is None else out[1], jacobian_shape, "out[1]")
+        if out is not None and np.may_share_memory(value, jacobian):
+            raise ValueError("out: the value and jacobian arrays overlap")
+        return [value, jacobian if full else np.empty(_jacobian_shape(leading, layout, len(GRADIENT_NAMES)), np.float32)]
+
+    value, jacobian_all = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
+                                    gradient=True)
+    if full:
+        return Gradient(value, jacobian_all, GRADIENT_NAMES)
+    axis = -1 if _layout(layout) == "aos" else 1
+    selected = np.take(jacobian_all, wanted, axis=axis)
+    if out is not None:
+        out[1][...] = selected
+        selected = out[1]
+    return Gradient(value, selected, tuple(GRADIENT_NAMES[k] for k in wanted))
 
 
 def pdf(material: Material, wi, wo, *, specular_sampler: str = "visible", layout: str = "aos", threads=None,

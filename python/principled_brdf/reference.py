@@ -5,11 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
+from . import _gradient
 from . import _validate
+from ._gradient import Gradient
 from ._batch import Lobes, Sample
 from .material import Material
 
-__all__ = ["eval", "eval_lobes", "Lobes", "sample", "pdf", "lobe_probabilities", "Sample"]
+__all__ = ["eval", "eval_lobes", "eval_grad", "Lobes", "Gradient", "sample", "pdf", "lobe_probabilities", "Sample"]
 
 
 def _prepare(material, wi, wo, model):
@@ -20,7 +22,7 @@ def _prepare(material, wi, wo, model):
     wo = _validate.directions("wo", wo)
     shape = _validate.broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
     rows = lambda w: np.ascontiguousarray(np.broadcast_to(w, shape + (3,)).reshape(-1, 3))  # noqa: E731
-    return shape, rows(wi), rows(wo), material.packed(shape), model_id
+    return shape, rows(wi), rows(wo), _material_rows(material, shape), model_id
 
 
 def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False) -> np.ndarray:
@@ -31,6 +33,23 @@ def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool 
     if cosine:
         f *= np.maximum(wi_rows[:, 2:3], 0.0)
     return f.reshape(shape + (3,))
+
+
+def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014", cosine: bool = False) -> Gradient:
+    """f in float64 and its Jacobian in the material's parameters (README "Gradients"):
+    ``value`` ``(..., 3)`` as :func:`eval`, ``jacobian`` ``(..., 3, P)`` with
+    ``jacobian[..., c, k] = ∂f_c/∂names[k]``, ``names`` the P parameters ``wrt``
+    selects (default all 13, ``base_color`` as three channels). A uniform
+    parameter still gets a per-element derivative."""
+    shape, wi_rows, wo_rows, params, model_id = _prepare(material, wi, wo, model)
+    cosine = _validate.flag("cosine", cosine)
+    wanted = _gradient.columns(wrt)
+    value, jacobian = _core.reference_eval_grad(wi_rows, wo_rows, params, model_id)
+    if cosine:
+        cos_theta_l = np.maximum(wi_rows[:, 2], 0.0)
+        value *= cos_theta_l[:, None]
+        jacobian *= cos_theta_l[:, None, None]
+    return _gradient.result(value.reshape(shape + (3,)), jacobian.reshape(shape + jacobian.shape[1:]), wanted)
 
 
 def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False) -> Lobes:

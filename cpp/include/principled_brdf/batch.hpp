@@ -45,7 +45,11 @@ enum class Output : int {
     kTotal = 0,  // f
     kLobes = 1,  // diffuse, sheen, specular, clearcoat
     kPdf = 2,    // the sampling pdf of (wi, wo)
+    kGradient = 3,  // f and its Jacobian in the parameter slots
 };
+
+// The Jacobian's values per element: ∂f_c/∂p for the 3 channels c and the kParamSlots slots p.
+inline constexpr int kJacobianWidth = 3 * kParamSlots;
 
 inline bool uniform_material(const ParamSlot* params) {
     for (int s = 0; s < kParamSlots; ++s)
@@ -86,6 +90,12 @@ struct EvalJob {
     bool cosine = false;  // multiply by cos θl
     // out[0] is f; with Output::kLobes, out[0..3] are the four lobes.
     MutableVec3Array out[kLobeCount];
+    // Output::kGradient: out[0] is f, and element i's ∂f_c/∂p is at
+    // jacobian[kJacobianWidth i + kParamSlots c + p] (an (N, 3, 13) array) or,
+    // with jacobian_row_stride > 0, at jacobian[(kParamSlots c + p) jacobian_row_stride + i]
+    // (a (3, 13, N) array).
+    float* jacobian = nullptr;
+    std::int64_t jacobian_row_stride = 0;
     // Output::kPdf: one float per element, for this specular sampler.
     float* pdf = nullptr;
     SpecularSampler sampler = SpecularSampler::kVisibleNormals;

@@ -1,7 +1,9 @@
 // Microfacet toolkit in float64 (README "Microfacet toolkit"): the GTR family of
 // Burley 2012 (appendix B), anisotropic GGX with Smith masking, and anisotropic
-// Beckmann (Walter et al. 2007; its Smith Λ as in Heitz 2014). One small function per formula; each
-// names the equation it implements.
+// Beckmann (Walter et al. 2007; its Smith Λ as in Heitz 2014). The
+// distributions are the model's types (model/distributions.hpp: Ggx, Gtr1,
+// Gtr, Beckmann) instantiated for double; this file adds the toolkit's
+// clamps, its two-sided conventions and the GTR closed forms at γ = 3/2 and 2.
 //
 // Conventions: local shading frame, n = (0,0,1), tangent x, bitangent y; every
 // direction argument is a unit vector. A distribution D is zero for half
@@ -28,7 +30,6 @@
 namespace principled_brdf::microfacet {
 
 inline constexpr double kPi = 3.14159265358979323846;
-inline constexpr double kSqrtPi = 1.77245385090551602730;
 inline constexpr double kMinAlpha = 1e-10;
 inline constexpr double kMaxAlpha = 1e10;
 inline constexpr double kMaxGamma = 1e6;
@@ -68,18 +69,22 @@ inline double clamp_alpha(double alpha) { return std::clamp(alpha, kMinAlpha, kM
 inline double clamp_gtr_alpha(double alpha) { return std::clamp(alpha, kMinAlpha, 1.0); }
 inline double clamp_gamma(double gamma) { return std::min(gamma, kMaxGamma); }
 
-// (e^x - 1) / x, with its limit 1 at x = 0.
-inline double expm1_over_x(double x) { return x == 0.0 ? 1.0 : std::expm1(x) / x; }
+using f64::Beckmann;
+using f64::Ggx;
+using f64::Gtr;
+using f64::Gtr1;
+using ModelVec3 = f64::Vec3<double>;
 
-// log((1 - w) + w e^z) = log(1 + w expm1(z)) for a weight w in [0, 1] given with its
-// complement 1 - w: log1p where w expm1(z) is small, else the log of a sum of two
-// positive terms (pulling e^z out when z > 0), so that it neither cancels nor overflows.
-inline double log_mix_exp(double weight, double weight_complement, double z) {
-    const double y = weight * std::expm1(z);
-    if (z < 700.0 && std::abs(y) <= 0.5) return std::log1p(y);
-    if (z > 0.0) return z + std::log(weight + weight_complement * std::exp(-z));
-    return std::log(weight_complement + weight * std::exp(z));
-}
+inline ModelVec3 model_vec(const Vec3& w) { return {w.x, w.y, w.z}; }
+inline Vec3 toolkit_vec(const ModelVec3& w) { return {w.x, w.y, w.z}; }
+// w with its z made |z|: the toolkit's masking functions are two-sided
+inline ModelVec3 upper(const Vec3& w) { return {w.x, w.y, std::abs(w.z)}; }
+// the half vector's squares of a unit h, |h|² taken as 1
+inline f64::HalfVector<double> half_of(const Vec3& h) { return {h.x * h.x, h.y * h.y, h.z, h.z * h.z, dot(h, h)}; }
+inline f64::HalfVector<double> half_of(const Cos2Sin2& h) { return {h.sin2, 0.0, std::sqrt(h.cos2), h.cos2, 1.0}; }
+
+// h = d / |d| for a model draw's unnormalised d
+inline Vec3 normalized_draw(const ModelVec3& d) { return normalize(toolkit_vec(d)); }
 
 // ---------------------------------------------------------------------------
 // GTR, isotropic (appendix B.2). With a2 = α² and c = cosθh, every D below has
@@ -87,34 +92,16 @@ inline double log_mix_exp(double weight, double weight_complement, double z) {
 
 inline double gtr_t(const Cos2Sin2& h, double a2) { return a2 * h.cos2 + h.sin2; }
 
-// Eq. (1), any γ > 0: D = (γ-1)(a2-1) / (π (1 - a2^(1-γ))) / t^γ.
-// With L = ln a2 and x = (1-γ) L the normaliser is
-//   (expm1(L)/L) / (π expm1(x)/x),
-// which tends smoothly to eq. (4) as γ -> 1 and to 1/π as α -> 1. For γ > 1
-// the factor e^(-x) = a2^(γ-1) is moved onto t^-γ, giving (a2/t)^γ / a2 with
-// a2/t in (0, 1], so nothing overflows for small α and large γ.
+// Eq. (1), any γ > 0: the model's Gtr (its normaliser stays accurate at γ = 1 and α = 1).
 inline double gtr_d_general(const Cos2Sin2& h, double alpha, double gamma) {
     if (h.cos2 <= 0.0) return 0.0;
-    alpha = clamp_gtr_alpha(alpha);
-    gamma = clamp_gamma(gamma);
-    const double a2 = alpha * alpha;
-    const double log_a2 = 2.0 * std::log(alpha);
-    const double x = (1.0 - gamma) * log_a2;
-    const double t = gtr_t(h, a2);
-    if (x > 0.0) {
-        const double norm_times_a2 = expm1_over_x(log_a2) / (kPi * expm1_over_x(-x));
-        return norm_times_a2 / a2 * std::pow(a2 / t, gamma);
-    }
-    const double norm = expm1_over_x(log_a2) / (kPi * expm1_over_x(x));
-    return norm * std::pow(t, -gamma);
+    return Gtr<double>::from(clamp_gtr_alpha(alpha), clamp_gamma(gamma)).d(h.cos2, h.sin2);
 }
 
-// Eq. (4), γ = 1 (Berry; the clearcoat lobe): D = (a2-1) / (π ln a2) / t.
+// Eq. (4), γ = 1 (Berry; the clearcoat lobe): D = (a2-1) / (π ln a2) / t, the model's Gtr1.
 inline double gtr1_d(const Cos2Sin2& h, double alpha) {
     if (h.cos2 <= 0.0) return 0.0;
-    alpha = clamp_gtr_alpha(alpha);
-    const double a2 = alpha * alpha;
-    return expm1_over_x(2.0 * std::log(alpha)) / (kPi * gtr_t(h, a2));
+    return Gtr1<double>::from_alpha(clamp_gtr_alpha(alpha)).d(half_of(h));
 }
 
 // Eq. (6), γ = 3/2: D = (a2 + α) / (2π) / t^(3/2).
@@ -126,13 +113,11 @@ inline double gtr3_2_d(const Cos2Sin2& h, double alpha) {
     return (a2 + alpha) / (2.0 * kPi * t * std::sqrt(t));
 }
 
-// Eq. (8), γ = 2 (isotropic GGX / Trowbridge-Reitz): D = a2 / (π t²).
+// Eq. (8), γ = 2 (isotropic GGX / Trowbridge-Reitz): D = a2 / (π t²), the model's Ggx.
 inline double gtr2_d(const Cos2Sin2& h, double alpha) {
     if (h.cos2 <= 0.0) return 0.0;
     alpha = clamp_gtr_alpha(alpha);
-    const double a2 = alpha * alpha;
-    const double t = gtr_t(h, a2);
-    return a2 / (kPi * t * t);
+    return Ggx<double>::from_alphas(alpha, alpha).d(half_of(h));
 }
 
 // D_GTR for any γ > 0, using the closed forms at γ = 1, 3/2 and 2 when asked.
@@ -157,34 +142,18 @@ inline double gtr_pdf_h(const Vec3& h, double alpha, double gamma, bool closed_f
     return gtr_d(h.z, cos2_sin2_of(h), alpha, gamma, closed_forms) * h.z;
 }
 
-// Eq. (3), any γ > 0, as the pair (cos²θh, sin²θh). With L = ln a2 and k = 1-γ,
-//   M = ln((1-u) a2^k + u) / k                  so that cos²θh = expm1(M) / expm1(L),
-//   q = M - L = ln(u a2^-k + (1-u)) / k         and sin²θh = e^M expm1(-q) / expm1(L)
-// needs no 1 - cos²θh. Both logarithms are log_mix_exp, and both tend to eq. (5)
-// as k -> 0 (M -> (1-u) L, q -> -u L).
+// Eq. (3), any γ > 0, as the pair (cos²θh, sin²θh): the model's Gtr draw.
 inline Cos2Sin2 gtr_sample_cos2_general(double u2, double alpha, double gamma) {
-    if (u2 >= 1.0) return {0.0, 1.0};
-    alpha = clamp_gtr_alpha(alpha);
-    gamma = clamp_gamma(gamma);
-    const double log_a2 = 2.0 * std::log(alpha);
-    if (log_a2 == 0.0) return {1.0 - u2, u2};  // α = 1: cos²θh uniform
-    const double k = 1.0 - gamma;
-    const double m = k == 0.0 ? (1.0 - u2) * log_a2 : log_mix_exp(1.0 - u2, u2, k * log_a2) / k;
-    const double q = k == 0.0 ? -u2 * log_a2 : log_mix_exp(u2, 1.0 - u2, -k * log_a2) / k;
-    const double expm1_l = std::expm1(log_a2);
-    const double cos2 = std::expm1(m) / expm1_l;
-    const double sin2 = std::exp(m) * std::expm1(-q) / expm1_l;
-    return {std::clamp(cos2, 0.0, 1.0), std::clamp(sin2, 0.0, 1.0)};
+    const auto [cos2, sin2] = Gtr<double>::from(clamp_gtr_alpha(alpha), clamp_gamma(gamma)).draw_cos2_sin2(u2);
+    return {cos2, sin2};
 }
 
-// Eq. (5), γ = 1: cos²θh = (1 - a2^(1-u)) / (1 - a2), sin²θh = (a2^(1-u) - a2) / (1 - a2).
+// Eq. (5), γ = 1: the model's Gtr1 draw; cos²θh uniform at α = 1, its limit.
 inline Cos2Sin2 gtr1_sample_cos2(double u2, double alpha) {
     alpha = clamp_gtr_alpha(alpha);
-    const double log_a2 = 2.0 * std::log(alpha);
-    if (log_a2 == 0.0) return {1.0 - u2, u2};
-    const double expm1_l = std::expm1(log_a2);
-    const double m = (1.0 - u2) * log_a2;
-    return {std::expm1(m) / expm1_l, std::exp(m) * std::expm1(u2 * log_a2) / expm1_l};
+    if (alpha == 1.0) return {1.0 - u2, u2};
+    const Gtr1<double> gtr1 = Gtr1<double>::from_alpha(alpha);
+    return {gtr1.draw_cos2(u2), gtr1.draw_sin2(u2)};
 }
 
 // Eq. (7), γ = 3/2, with b = 1 + (α-1) u = (1-u) + α u (no cancellation as u -> 1):
@@ -220,152 +189,113 @@ inline Vec3 gtr_sample_h(double u1, double u2, double alpha, double gamma, bool 
 }
 
 // ---------------------------------------------------------------------------
-// Anisotropic GGX (GTR2 aniso) and its Smith masking.
+// Anisotropic GGX (GTR2 aniso) and its Smith masking: the model's Ggx with the
+// toolkit's clamps; Λ, G1 and G2 two-sided (they read |w·n|).
 
-// Eq. (13): D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²), the model's
-// distribution (model/distributions.hpp) with the toolkit's clamps.
+inline Ggx<double> ggx_of(double alpha_x, double alpha_y) {
+    return Ggx<double>::from_alphas(clamp_alpha(alpha_x), clamp_alpha(alpha_y));
+}
+
+// Eq. (13): D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²).
 inline double ggx_d(const Vec3& h, double alpha_x, double alpha_y) {
     if (h.z <= 0.0) return 0.0;
-    const f64::HalfVector<double> half{h.x * h.x, h.y * h.y, h.z, h.z * h.z, dot(h, h)};
-    return f64::Ggx<double>::from_alphas(clamp_alpha(alpha_x), clamp_alpha(alpha_y)).d(half);
+    return ggx_of(alpha_x, alpha_y).d(half_of(h));
 }
 
 inline double ggx_pdf_h(const Vec3& h, double alpha_x, double alpha_y) {
     return h.z <= 0.0 ? 0.0 : ggx_d(h, alpha_x, alpha_y) * h.z;
 }
 
-// Eq. (14)-(15): h' = sqrt(u2/(1-u2)) (αx cos 2πu1 x + αy sin 2πu1 y) + n,
-// h = h'/|h'|; scaled by sqrt(1-u2) first so that u2 = 1 is the horizon.
+// Eq. (14)-(15): h ∝ (αx sqrt(u2) cos 2πu1, αy sqrt(u2) sin 2πu1, sqrt(1-u2)); u2 = 1 is the horizon.
 inline Vec3 ggx_sample_h(double u1, double u2, double alpha_x, double alpha_y) {
-    alpha_x = clamp_alpha(alpha_x);
-    alpha_y = clamp_alpha(alpha_y);
-    const double phi = 2.0 * kPi * u1;
-    const double radius = std::sqrt(u2);
-    return normalize({radius * alpha_x * std::cos(phi), radius * alpha_y * std::sin(phi), std::sqrt(1.0 - u2)});
+    const auto [sin_phi, cos_phi] = f64::sincos_turns(u1);
+    return normalized_draw(ggx_of(alpha_x, alpha_y).sample_distribution(sin_phi, cos_phi, u2));
 }
 
 // αx² wx² + αy² wy² = (α(φ) sinθ)², the projected roughness times sinθ, squared.
 inline double projected_roughness2_sin2(const Vec3& w, double alpha_x, double alpha_y) {
-    alpha_x = clamp_alpha(alpha_x);
-    alpha_y = clamp_alpha(alpha_y);
-    const double px = alpha_x * w.x;
-    const double py = alpha_y * w.y;
-    return px * px + py * py;
+    return ggx_of(alpha_x, alpha_y).projected_length2(model_vec(w));
 }
 
-// Λ(w) = (-1 + sqrt(1 + (αx² wx² + αy² wy²) / wz²)) / 2, written
-//   p² / (2 |wz| (sqrt(wz² + p²) + |wz|)),  p² = αx² wx² + αy² wy²,
-// which neither cancels nor overflows as wz -> 0 (it is +inf at wz = 0).
+// Λ(w) = (-1 + sqrt(1 + (αx² wx² + αy² wy²) / wz²)) / 2, in a form that neither
+// cancels nor overflows as wz -> 0 (it is +inf at wz = 0).
 inline double ggx_lambda(const Vec3& w, double alpha_x, double alpha_y) {
-    const double p2 = projected_roughness2_sin2(w, alpha_x, alpha_y);
-    const double cos_abs = std::abs(w.z);
-    return p2 / (2.0 * cos_abs * (std::sqrt(cos_abs * cos_abs + p2) + cos_abs));
+    return ggx_of(alpha_x, alpha_y).lambda(upper(w));
 }
 
 // G1 = 1 / (1 + Λ) = 2 |wz| / (|wz| + sqrt(wz² + p²)); 0 at grazing.
-inline double ggx_g1(const Vec3& w, double alpha_x, double alpha_y) {
-    const double p2 = projected_roughness2_sin2(w, alpha_x, alpha_y);
-    const double cos_abs = std::abs(w.z);
-    return 2.0 * cos_abs / (cos_abs + std::sqrt(cos_abs * cos_abs + p2));
-}
+inline double ggx_g1(const Vec3& w, double alpha_x, double alpha_y) { return ggx_of(alpha_x, alpha_y).g1(upper(w)); }
 
 // G1(w) / |wz| = 2 / (|wz| + sqrt(wz² + p²)): finite at grazing (it is 2 S(w) of README "The model").
 inline double ggx_g1_over_cos(const Vec3& w, double alpha_x, double alpha_y) {
-    const double p2 = projected_roughness2_sin2(w, alpha_x, alpha_y);
-    const double cos_abs = std::abs(w.z);
-    return 2.0 / (cos_abs + std::sqrt(cos_abs * cos_abs + p2));
+    return 2.0 / ggx_of(alpha_x, alpha_y).smith_denominator(upper(w));
 }
 
 // Separable Smith G2 = G1(wi) G1(wo) (what the model uses).
 inline double ggx_g2_separable(const Vec3& wi, const Vec3& wo, double alpha_x, double alpha_y) {
-    return ggx_g1(wi, alpha_x, alpha_y) * ggx_g1(wo, alpha_x, alpha_y);
+    const Ggx<double> ggx = ggx_of(alpha_x, alpha_y);
+    return ggx.g1(upper(wi)) * ggx.g1(upper(wo));
 }
 
-// Height-correlated Smith G2 = 1 / (1 + Λ(wi) + Λ(wo)), with Λ = (r - |z|) / (2|z|),
-// r = sqrt(z² + p²):  G2 = 2 |zi| |zo| / (|zi| ro + |zo| ri)  (cf. Heitz 2014, the height-correlated form).
+// Height-correlated Smith G2 = 1 / (1 + Λ(wi) + Λ(wo)) (Heitz 2014 eq. 99).
 inline double ggx_g2_height_correlated(const Vec3& wi, const Vec3& wo, double alpha_x, double alpha_y) {
-    const double zi = std::abs(wi.z);
-    const double zo = std::abs(wo.z);
-    const double ri = std::sqrt(zi * zi + projected_roughness2_sin2(wi, alpha_x, alpha_y));
-    const double ro = std::sqrt(zo * zo + projected_roughness2_sin2(wo, alpha_x, alpha_y));
-    const double denom = zi * ro + zo * ri;
-    return denom > 0.0 ? 2.0 * zi * zo / denom : 0.0;
+    return ggx_of(alpha_x, alpha_y).g2_height_correlated(upper(wi), upper(wo));
 }
 
-// Visible normals (Heitz 2018, "Sampling the GGX Distribution of Visible
-// Normals"): stretch wo to the isotropic α = 1 configuration, sample the
-// projected hemisphere as a disk warped towards the visible half, lift the
-// point onto the hemisphere and unstretch. φ = 2π u1 and disk radius sqrt(u2).
-// A wo below the horizon is mirrored (wo -> -wo), so the sampler is two-sided.
+// A wo below the horizon is mirrored (wo -> -wo), so the visible-normal sampler is two-sided.
+inline Vec3 mirrored_above(const Vec3& wo) { return wo.z < 0.0 ? scale(wo, -1.0) : wo; }
+
+// Visible normals by spherical caps (Dupuy & Benyoub 2023), the model's
+// sampler: the density D_wo(h) of ggx_pdf_visible_h.
 inline Vec3 ggx_sample_visible_h(const Vec3& wo, double u1, double u2, double alpha_x, double alpha_y) {
-    alpha_x = clamp_alpha(alpha_x);
-    alpha_y = clamp_alpha(alpha_y);
-    const Vec3 view = wo.z < 0.0 ? scale(wo, -1.0) : wo;
-    const Vec3 view_std = normalize({alpha_x * view.x, alpha_y * view.y, view.z});
-    // An orthonormal basis (t1, t2, view_std).
-    const double len2 = view_std.x * view_std.x + view_std.y * view_std.y;
-    const Vec3 t1 = len2 > 0.0 ? scale(Vec3{-view_std.y, view_std.x, 0.0}, 1.0 / std::sqrt(len2)) : Vec3{1.0, 0.0, 0.0};
-    const Vec3 t2 = cross(view_std, t1);
-    // A uniform point on the unit disk, its second coordinate squeezed into the visible part.
-    const double radius = std::sqrt(u2);
-    const double phi = 2.0 * kPi * u1;
-    const double d1 = radius * std::cos(phi);
-    const double d2_disk = radius * std::sin(phi);
-    const double s = 0.5 * (1.0 + view_std.z);
-    const double d2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - d1 * d1)) + s * d2_disk;
-    const double lift = std::sqrt(std::max(0.0, 1.0 - d1 * d1 - d2 * d2));
-    const Vec3 h_std = add(add(scale(t1, d1), scale(t2, d2)), scale(view_std, lift));
-    return normalize({alpha_x * h_std.x, alpha_y * h_std.y, std::max(0.0, h_std.z)});
+    const auto [sin_phi, cos_phi] = f64::sincos_turns(u1);
+    const ModelVec3 d = ggx_of(alpha_x, alpha_y).sample_visible(model_vec(mirrored_above(wo)), sin_phi, cos_phi, u2);
+    const double length2 = d.x * d.x + d.y * d.y + d.z * d.z;
+    // u2 = 1 at a view along the normal: d = 0, any horizon normal is right
+    return length2 > 0.0 ? normalized_draw(d) : Vec3{1.0, 0.0, 0.0};
 }
 
 // Density of visible normals, D_wo(h) = G1(wo) max(0, wo·h) D(h) / |wo_z|
-// (Heitz 2014/2018), with G1/|wo_z| taken in its grazing-safe form; wo mirrored as above.
+// (Heitz 2014 eq. 38), with G1/|wo_z| taken in its grazing-safe form; wo mirrored as above.
 inline double ggx_pdf_visible_h(const Vec3& h, const Vec3& wo, double alpha_x, double alpha_y) {
-    const Vec3 view = wo.z < 0.0 ? scale(wo, -1.0) : wo;
+    const Vec3 view = mirrored_above(wo);
     const double cos_view_h = dot(view, h);
     if (cos_view_h <= 0.0 || h.z <= 0.0) return 0.0;
     return ggx_g1_over_cos(view, alpha_x, alpha_y) * cos_view_h * ggx_d(h, alpha_x, alpha_y);
 }
 
 // ---------------------------------------------------------------------------
-// Anisotropic Beckmann (Walter et al. 2007, Heitz 2014 §5.2): slope density P22 = exp(-(x²/αx² + y²/αy²)) / (π αx αy).
+// Anisotropic Beckmann (Walter et al. 2007, Heitz 2014 §5.2): the model's
+// Beckmann with the toolkit's clamps; Λ and G1 two-sided.
 
-// D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴): the model's
-// distribution (model/distributions.hpp) with the toolkit's clamps.
+inline Beckmann<double> beckmann_of(double alpha_x, double alpha_y) {
+    return Beckmann<double>::from_alphas(clamp_alpha(alpha_x), clamp_alpha(alpha_y));
+}
+
+// D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴).
 inline double beckmann_d(const Vec3& h, double alpha_x, double alpha_y) {
     if (h.z <= 0.0) return 0.0;
-    const f64::HalfVector<double> half{h.x * h.x, h.y * h.y, h.z, h.z * h.z, dot(h, h)};
-    return f64::Beckmann<double>::from_alphas(clamp_alpha(alpha_x), clamp_alpha(alpha_y)).d(half);
+    return beckmann_of(alpha_x, alpha_y).d(half_of(h));
 }
 
 inline double beckmann_pdf_h(const Vec3& h, double alpha_x, double alpha_y) {
     return h.z <= 0.0 ? 0.0 : beckmann_d(h, alpha_x, alpha_y) * h.z;
 }
 
-// Stretched slope radius ρ = sqrt(-ln(1 - u2)), φ = 2π u1, h ∝ (ρ αx cos φ, ρ αy sin φ, 1):
-// the same projected-half-vector construction as eq. (14)-(15), for P22 above.
+// Stretched slope radius ρ = sqrt(-ln(1 - u2)), φ = 2π u1, h ∝ (ρ αx cos φ, ρ αy sin φ, 1).
 inline Vec3 beckmann_sample_h(double u1, double u2, double alpha_x, double alpha_y) {
-    alpha_x = clamp_alpha(alpha_x);
-    alpha_y = clamp_alpha(alpha_y);
-    const double phi = 2.0 * kPi * u1;
-    const Vec3 tangent{alpha_x * std::cos(phi), alpha_y * std::sin(phi), 0.0};
-    if (u2 >= 1.0) return normalize(tangent);
-    const double radius = std::sqrt(-std::log1p(-u2));
-    if (radius <= 1.0) return normalize({radius * tangent.x, radius * tangent.y, 1.0});
-    return normalize({tangent.x, tangent.y, 1.0 / radius});
+    const auto [sin_phi, cos_phi] = f64::sincos_turns(u1);
+    return normalized_draw(beckmann_of(alpha_x, alpha_y).sample_distribution(sin_phi, cos_phi, u2));
 }
 
-// Eq. (3-30): Λ = (erf(a) - 1)/2 + exp(-a²) / (2 a sqrt(π)), a = 1 / (α_o tanθ) by
-// eq. (3-25), i.e. a = |wz| / sqrt(αx² wx² + αy² wy²). Λ = 0 at the normal, +inf at grazing.
+// Λ = (erf(a) - 1)/2 + exp(-a²) / (2 a sqrt(π)), a = |wz| / sqrt(αx² wx² + αy² wy²):
+// 0 at the normal, +inf at grazing.
 inline double beckmann_lambda(const Vec3& w, double alpha_x, double alpha_y) {
-    const double p2 = projected_roughness2_sin2(w, alpha_x, alpha_y);
-    if (p2 <= 0.0) return 0.0;
-    const double a = std::abs(w.z) / std::sqrt(p2);
-    return -0.5 * std::erfc(a) + std::exp(-a * a) / (2.0 * a * kSqrtPi);
+    return beckmann_of(alpha_x, alpha_y).lambda(upper(w));
 }
 
 inline double beckmann_g1(const Vec3& w, double alpha_x, double alpha_y) {
-    return 1.0 / (1.0 + beckmann_lambda(w, alpha_x, alpha_y));
+    return beckmann_of(alpha_x, alpha_y).g1(upper(w));
 }
 
 }  // namespace principled_brdf::microfacet

@@ -59,6 +59,42 @@ struct Material {
     Shading<double> shading() const { return shading_of(slots().data()); }
 };
 
+// What a run of packed material rows (slot order of params.hpp) prepares,
+// prepared again only when a row differs from the one before: a uniform
+// material is prepared once per call, as the kernels hoist it.
+template <class Prepared, Prepared (*prepare)(const double*)>
+class RowCache {
+public:
+    // `row` is read only when it is not the row of the last call (one shared row is prepared once)
+    const Prepared& of(const double* row) {
+        if (prepared_ && row == last_) return value_;
+        last_ = row;
+        if (!prepared_ || !std::equal(row, row + kParamSlots, row_.begin())) {
+            std::copy(row, row + kParamSlots, row_.begin());
+            value_ = prepare(row_.data());
+            prepared_ = true;
+        }
+        return value_;
+    }
+
+private:
+    const double* last_ = nullptr;
+    std::array<double, kParamSlots> row_{};
+    Prepared value_{};
+    bool prepared_ = false;
+};
+
+// A material's shading with the partials of its constants, for eval_grad.
+struct GradientShading {
+    Shading<double> shading;
+    MaterialPartials<double> partials;
+};
+
+inline GradientShading gradient_shading_of(const double* row) { return {shading_of(row), material_partials_of(row)}; }
+
+using ShadingCache = RowCache<Shading<double>, &shading_of<double>>;
+using GradientShadingCache = RowCache<GradientShading, &gradient_shading_of>;
+
 // The four lobes, each already weighted as it enters the sum.
 struct Lobes {
     Vector3d diffuse = Vector3d::Zero();    // diffuse + subsurface, times (1 - metallic)
@@ -81,10 +117,15 @@ Lobes lobes_of(const Shading<double>& s, const Vec3<double>& wi, const Vec3<doub
 }
 
 // Every lobe at (wi, wo); all zero unless both lie strictly above the surface.
-inline Lobes eval_lobes(const Material& m, const Vector3d& wi, const Vector3d& wo, Model model = Model::kDisney2014) {
-    const Shading<double> s = m.shading();
+// Each function below takes the material or its prepared Shading.
+inline Lobes eval_lobes(const Shading<double>& s, const Vector3d& wi, const Vector3d& wo,
+                        Model model = Model::kDisney2014) {
     return model == Model::kDisney2012 ? lobes_of<Model::kDisney2012>(s, vec3(wi), vec3(wo))
                                        : lobes_of<Model::kDisney2014>(s, vec3(wi), vec3(wo));
+}
+
+inline Lobes eval_lobes(const Material& m, const Vector3d& wi, const Vector3d& wo, Model model = Model::kDisney2014) {
+    return eval_lobes(m.shading(), wi, wo, model);
 }
 
 template <Model model>
@@ -95,29 +136,70 @@ Vector3d eval_of(const Shading<double>& s, const Vec3<double>& wi, const Vec3<do
 }
 
 // f(wi, wo) in 1/sr, without the cosine factor.
-inline Vector3d eval(const Material& m, const Vector3d& wi, const Vector3d& wo, Model model = Model::kDisney2014) {
-    const Shading<double> s = m.shading();
+inline Vector3d eval(const Shading<double>& s, const Vector3d& wi, const Vector3d& wo, Model model = Model::kDisney2014) {
     return model == Model::kDisney2012 ? eval_of<Model::kDisney2012>(s, vec3(wi), vec3(wo))
                                        : eval_of<Model::kDisney2014>(s, vec3(wi), vec3(wo));
+}
+
+inline Vector3d eval(const Material& m, const Vector3d& wi, const Vector3d& wo, Model model = Model::kDisney2014) {
+    return eval(m.shading(), wi, wo, model);
+}
+
+// f and its Jacobian ∂f_c/∂p over the 13 parameter slots (README "Gradients"); both zero
+// unless wi and wo lie strictly above the surface.
+struct Gradient {
+    Vector3d value = Vector3d::Zero();
+    Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor> jacobian =
+            Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor>::Zero();
+};
+
+template <Model model>
+Gradient gradient_of(const GradientShading& prepared, const Vec3<double>& wi, const Vec3<double>& wo) {
+    const Shading<double>& s = prepared.shading;
+    const Geometry<double> g = geometry_of(wi, wo);
+    Gradient out;
+    if (!above_surface(g)) return out;
+    const ValueGradient<double> v = f64::eval_gradient<model>(g, s, view_of<model>(wo, s), prepared.partials);
+    out.value = vector3d(v.value);
+    for (int c = 0; c < 3; ++c)
+        for (int p = 0; p < kParamSlots; ++p) out.jacobian(c, p) = v.jacobian[c][p];
+    return out;
+}
+
+inline Gradient eval_grad(const GradientShading& prepared, const Vector3d& wi, const Vector3d& wo,
+                          Model model = Model::kDisney2014) {
+    return model == Model::kDisney2012 ? gradient_of<Model::kDisney2012>(prepared, vec3(wi), vec3(wo))
+                                       : gradient_of<Model::kDisney2014>(prepared, vec3(wi), vec3(wo));
+}
+
+inline Gradient eval_grad(const Material& m, const Vector3d& wi, const Vector3d& wo, Model model = Model::kDisney2014) {
+    return eval_grad(gradient_shading_of(m.slots().data()), wi, wo, model);
 }
 
 // ---------------------------------------------------------------- sampling (README "Sampling and pdf")
 
 // P_k = w_k / (w0 + w1 + w2) at wo: the chances of the cosine, specular and clearcoat lobes.
-inline std::array<double, 3> lobe_probabilities(const Material& m, const Vector3d& wo) {
-    const Shading<double> s = m.shading();
+inline std::array<double, 3> lobe_probabilities(const Shading<double>& s, const Vector3d& wo) {
     const LobeWeights<double> w = lobe_weights(schlick_weight(wo.z()), s);
     return {s.diffuse.cosine_lobe_weight * w.inv_total, w.specular * w.inv_total, w.clearcoat * w.inv_total};
 }
 
+inline std::array<double, 3> lobe_probabilities(const Material& m, const Vector3d& wo) {
+    return lobe_probabilities(m.shading(), wo);
+}
+
 // The mixture density Σ P_k pdf_k(wi) of wi given wo; 0 unless both lie strictly above the surface.
-inline double pdf(const Material& m, const Vector3d& wi, const Vector3d& wo,
+inline double pdf(const Shading<double>& s, const Vector3d& wi, const Vector3d& wo,
                   SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
-    const Shading<double> s = m.shading();
     const Geometry<double> g = geometry_of(vec3(wi), vec3(wo));
     if (!above_surface(g)) return 0.0;
     const View<double> view = view_of<Model::kDisney2014>(vec3(wo), s);  // the pdf does not depend on the model
     return mixture_pdf(g, s, view, lobe_weights(view.fv, s), sampler);
+}
+
+inline double pdf(const Material& m, const Vector3d& wi, const Vector3d& wo,
+                  SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
+    return pdf(m.shading(), wi, wo, sampler);
 }
 
 // One drawn direction with its mixture pdf and weight f cos θl / pdf.
@@ -140,12 +222,16 @@ Sample sample_of(const Shading<double>& s, const Vec3<double>& wo, const Uniform
 // The whole sample for (u0, u1, u2): wi, its mixture pdf (the number pdf()
 // gives for the pair) and weight = f(wi, wo) cos θl / pdf; pdf and weight are
 // 0 when wi or wo is at or below the horizon (wi is still the direction drawn).
-inline Sample sample(const Material& m, const Vector3d& wo, double u0, double u1, double u2,
+inline Sample sample(const Shading<double>& s, const Vector3d& wo, double u0, double u1, double u2,
                      Model model = Model::kDisney2014, SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
-    const Shading<double> s = m.shading();
     const Uniforms<double> u{u0, u1, u2};
     return model == Model::kDisney2012 ? sample_of<Model::kDisney2012>(s, vec3(wo), u, sampler)
                                        : sample_of<Model::kDisney2014>(s, vec3(wo), u, sampler);
+}
+
+inline Sample sample(const Material& m, const Vector3d& wo, double u0, double u1, double u2,
+                     Model model = Model::kDisney2014, SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
+    return sample(m.shading(), wo, u0, u1, u2, model, sampler);
 }
 
 }  // namespace principled_brdf::reference

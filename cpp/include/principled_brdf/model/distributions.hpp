@@ -12,6 +12,24 @@ struct HalfVector {
     F h_len2;  // |H|²
 };
 
+// Log-derivatives in the two roughnesses as their half-sum and half-difference:
+//   sum = ax ∂/∂ax + ay ∂/∂ay (scaling both),  difference = ax ∂/∂ax - ay ∂/∂ay (changing their ratio).
+// Roughness scales both alphas and anisotropic changes their ratio, so each
+// parameter's derivative is one of the two (unless a clamp holds one alpha):
+// taken apart per axis, they cancel to a few digits in float32.
+template <class F>
+struct LogAlphaPartials {
+    F sum, difference;
+};
+
+// ∂ln(cos θ + sqrt(q))/∂q = 1 / (2 sqrt(q) (cos θ + sqrt(q))): the log-derivative of a
+// Smith denominator in its stretched squared length q
+template <class F>
+PB_MODEL_INLINE F log_smith_denominator_partial(F cos_theta, F q) {
+    const F root = q * reciprocal_sqrt(q);
+    return reciprocal(F(2.0) * root * (cos_theta + root));
+}
+
 // Anisotropic GGX (GTR2, Burley 2012 eq. 13) with Smith masking (Heitz 2014):
 //   D(h)  = 1 / (π ax ay ((h·x / ax)² + (h·y / ay)² + (h·n)²)²)
 //   G1(w) = 2 n·w / (n·w + sqrt((w·x ax)² + (w·y ay)² + (n·w)²))
@@ -60,21 +78,98 @@ struct Ggx {
 
     // cos θ + sqrt(q): the Smith denominator given q (the stretched squared length)
     static PB_MODEL_INLINE F smith_denominator_of(F cos_theta, F q) { return mul_add(q, reciprocal_sqrt(q), cos_theta); }
+
+    // log-derivatives of D: with tx = Hx²/ax², ty = Hy²/ay², s = tx + ty + Hz² and
+    // D ∝ (|H|²/s)² / (ax ay):  ax ∂ln D/∂ax = 4 tx / s - 1, ay ∂ln D/∂ay = 4 ty / s - 1
+    PB_MODEL_INLINE LogAlphaPartials<F> log_d_partials(const HalfVector<F>& h) const {
+        const F tx = h.hx2 * inv_alpha_x2, ty = h.hy2 * inv_alpha_y2;
+        const F inv_s = reciprocal(tx + ty + h.hz2);
+        return {F(2.0) * (tx + ty - h.hz2) * inv_s, F(4.0) * (tx - ty) * inv_s};
+    }
+
+    // log-derivatives of smith_denominator(w): ax ∂/∂ax = 2 (w·x ax)² ∂ln/∂q, the same in y
+    PB_MODEL_INLINE LogAlphaPartials<F> log_smith_partials(const Vec3<F>& w) const {
+        const F by_q = F(2.0) * log_smith_denominator_partial(w.z, stretched_length2(w));
+        const F px = alpha_x2 * (w.x * w.x), py = alpha_y2 * (w.y * w.y);
+        return {(px + py) * by_q, (px - py) * by_q};
+    }
+
+    // p² = (w·x ax)² + (w·y ay)², the projected roughness times sin θ, squared (Heitz 2014 eq. 80)
+    PB_MODEL_INLINE F projected_length2(const Vec3<F>& w) const { return mul_add(alpha_x2, w.x * w.x, alpha_y2 * (w.y * w.y)); }
+
+    // Λ(w), n·w > 0 (Heitz 2014 eq. 72): (-1 + sqrt(1 + p²/cos²θ)) / 2 written as
+    // p² / (2 cos θ (cos θ + sqrt(cos²θ + p²))), which does not cancel as p -> 0
+    // and is +inf at cos θ = 0, its value there
+    PB_MODEL_INLINE F lambda(const Vec3<F>& w) const {
+        const F p2 = projected_length2(w);
+        return p2 * reciprocal(F(2.0) * w.z * (w.z + square_root(mul_add(w.z, w.z, p2))));
+    }
+
+    // G1(w) = 1 / (1 + Λ(w)) = 2 n·w / smith_denominator(w), n·w >= 0
+    PB_MODEL_INLINE F g1(const Vec3<F>& w) const { return F(2.0) * w.z * reciprocal(smith_denominator(w)); }
+
+    // height-correlated G2 = 1 / (1 + Λ(wi) + Λ(wo)) (Heitz 2014 eq. 99) =
+    // 2 cos θi cos θo / (cos θi |Vo| + cos θo |Vi|), V the stretched direction
+    PB_MODEL_INLINE F g2_height_correlated(const Vec3<F>& wi, const Vec3<F>& wo) const {
+        const F length_i = square_root(stretched_length2(wi)), length_o = square_root(stretched_length2(wo));
+        const F denominator = mul_add(wi.z, length_o, wo.z * length_i);
+        // a quotient, not a reciprocal: the denominator may be subnormal
+        return select(denominator > F(0.0), F(2.0) * wi.z * wo.z / denominator, F(0.0));
+    }
+
+    // ---- sampling: each draw gives an unnormalised half vector d (h = d / |d|)
+    // from φ = 2π u1 as (sin φ, cos φ) and u2
+
+    // V = (ax w.x, ay w.y, w.z): w in the configuration stretched to alpha 1,
+    // where the distribution is the uniform one of unit normals (Heitz 2018)
+    PB_MODEL_INLINE Vec3<F> stretch(const Vec3<F>& w) const { return {alpha_x * w.x, alpha_y * w.y, w.z}; }
+
+    // L cos θ = (1 - u2)(L + V.z) - V.z: the height of a point drawn uniformly
+    // on the spherical cap of normals visible from V / L (Dupuy & Benyoub 2023),
+    // scaled by L = |V| so that V need not be normalised
+    static PB_MODEL_INLINE F cap_scaled_cos(F u2, F length, F stretched_z) {
+        return mul_sub(F(1.0) - u2, length + stretched_z, stretched_z);
+    }
+
+    // visible normals of wo, n·wo > 0: the cap point about V / L, offset by it,
+    // scaled by L and unstretched: d = (ax (L sin θ cos φ + V.x), ay (L sin θ sin φ + V.y), L cos θ + V.z)
+    PB_MODEL_INLINE Vec3<F> sample_visible(const Vec3<F>& wo, F sin_phi, F cos_phi, F u2) const {
+        const Vec3<F> v = stretch(wo);
+        const F length2 = squared_length(v);
+        const F scaled_cos = cap_scaled_cos(u2, square_root(length2), v.z);
+        const F scaled_sin = square_root(neg_mul_add(scaled_cos, scaled_cos, length2));
+        return {alpha_x * mul_add(scaled_sin, cos_phi, v.x), alpha_y * mul_add(scaled_sin, sin_phi, v.y),
+                max(scaled_cos + v.z, F(0.0))};
+    }
+
+    // the distribution, D cos θh (Burley 2012 eq. 14-15): d = (ax sqrt(u2) cos φ, ay sqrt(u2) sin φ, sqrt(1 - u2))
+    PB_MODEL_INLINE Vec3<F> sample_distribution(F sin_phi, F cos_phi, F u2) const {
+        const F radius = square_root(u2);
+        return {alpha_x * radius * cos_phi, alpha_y * radius * sin_phi, square_root(F(1.0) - u2)};
+    }
 };
 
 // Anisotropic Beckmann (Walter et al. 2007), slope density
 // P22 = exp(-(x²/ax² + y²/ay²)) / (π ax ay):
 //   D(h) = exp(-((h·x/ax)² + (h·y/ay)²) / (h·n)²) / (π ax ay (h·n)⁴),
 // with (h·n)⁴ taken into the exponent (one exp: no 0 · inf at the horizon).
+// Λ and the draw use erfc and log1p, which only the double operations define:
+// no kernel instantiates them.
 template <class F>
 struct Beckmann {
+    F alpha_x, alpha_y;
+    F alpha_x2, alpha_y2;          // ax², ay²
     F inv_alpha_x2, inv_alpha_y2;  // 1/ax², 1/ay²
     F norm;                        // 1/(π ax ay)
 
     static PB_MODEL_INLINE Beckmann from_alphas(F ax, F ay) {
         Beckmann d;
-        d.inv_alpha_x2 = reciprocal(ax * ax);
-        d.inv_alpha_y2 = reciprocal(ay * ay);
+        d.alpha_x = ax;
+        d.alpha_y = ay;
+        d.alpha_x2 = ax * ax;
+        d.alpha_y2 = ay * ay;
+        d.inv_alpha_x2 = reciprocal(d.alpha_x2);
+        d.inv_alpha_y2 = reciprocal(d.alpha_y2);
         d.norm = F(kInvPi) * reciprocal(ax * ay);
         return d;
     }
@@ -85,6 +180,29 @@ struct Beckmann {
         const F tan2_stretched = mul_add(h.hx2, inv_alpha_x2, h.hy2 * inv_alpha_y2) * reciprocal(h.hz2);
         const F log_cos = log(h.hz * reciprocal_sqrt(h.h_len2));
         return norm * exp(neg_mul_add(F(4.0), log_cos, -tan2_stretched));
+    }
+
+    // Λ(w), n·w >= 0 (Walter et al. 2007; Heitz 2014 eq. 83):
+    //   Λ = (erf(a) - 1)/2 + exp(-a²) / (2 a sqrt(π)),  a = cos θ / sqrt((w·x ax)² + (w·y ay)²),
+    // with erf(a) - 1 = -erfc(a); 0 at the normal (p = 0), +inf at grazing
+    PB_MODEL_INLINE F lambda(const Vec3<F>& w) const {
+        const F p2 = mul_add(alpha_x2, w.x * w.x, alpha_y2 * (w.y * w.y));
+        const F a = w.z * reciprocal_sqrt(p2);
+        const F value = mul_add(F(-0.5), erfc(a), exp(-a * a) * reciprocal(F(2.0 * kSqrtPi) * a));
+        return select(p2 > F(0.0), value, F(0.0));
+    }
+
+    PB_MODEL_INLINE F g1(const Vec3<F>& w) const { return reciprocal(F(1.0) + lambda(w)); }
+
+    // D cos θh: the stretched slope radius ρ = sqrt(-ln(1 - u2)) at azimuth φ,
+    // d = (ρ ax cos φ, ρ ay sin φ, 1), divided by ρ where ρ > 1 (it is only a
+    // direction) and the tangent itself at u2 = 1
+    PB_MODEL_INLINE Vec3<F> sample_distribution(F sin_phi, F cos_phi, F u2) const {
+        const F radius = square_root(-log_one_plus(-u2));
+        const MaskOf<F> steep = radius > F(1.0);
+        const F tangent_scale = select(steep, F(1.0), radius);
+        const F height = select(u2 < F(1.0), select(steep, reciprocal(radius), F(1.0)), F(0.0));
+        return {tangent_scale * (alpha_x * cos_phi), tangent_scale * (alpha_y * sin_phi), height};
     }
 };
 
@@ -103,31 +221,138 @@ PB_MODEL_INLINE F smith_denominator_iso(const Vec3<F>& w, F a2) {
     return Ggx<F>::smith_denominator_of(w.z, mul_add(a2, mul_add(w.x, w.x, w.y * w.y), w.z * w.z));
 }
 
-// GTR1 (Berry; GTR at γ = 1, Burley 2012 appendix B eq. 4), alpha < 1:
+// (e^x - 1) / x given e^x - 1, 1 at x = 0
+template <class F>
+PB_MODEL_INLINE F ratio_exp_minus_one(F x, F exp_minus_one_of_x) {
+    const MaskOf<F> zero = x == F(0.0);
+    return select(zero, F(1.0), exp_minus_one_of_x * reciprocal(select(zero, F(1.0), x)));
+}
+
+template <class F>
+PB_MODEL_INLINE F exp_minus_one_over_x(F x) { return ratio_exp_minus_one(x, exp_minus_one(x)); }
+
+// ∂ln smith_denominator_iso(w, a2)/∂a2 = ((w·x)² + (w·y)²) ∂ln/∂q
+template <class F>
+PB_MODEL_INLINE F log_smith_denominator_iso_partial(const Vec3<F>& w, F a2) {
+    const F sin2 = mul_add(w.x, w.x, w.y * w.y);
+    return sin2 * log_smith_denominator_partial(w.z, mul_add(a2, sin2, w.z * w.z));
+}
+
+// GTR1 (Berry; GTR at γ = 1, Burley 2012 appendix B eq. 4), alpha in (0, 1):
 //   D(h) = (a² - 1) / (π ln a² (a² cos²θh + sin²θh))
-// drawn by eq. 5 as sin²θh = a² (a^(-2 u) - 1) / (1 - a²).
+// drawn by eq. 5 as sin²θh = a² (a^(-2 u) - 1) / (1 - a²), cos²θh = (1 - a^(2 (1 - u))) / (1 - a²).
+// a² - 1 and 1 - a² are written e^L - 1 with L = ln a², which keeps their
+// digits as a -> 1; D's normaliser is 1/π at a = 1, the draw needs a < 1.
 template <class F>
 struct Gtr1 {
-    F alpha2;      // a²
-    F log_alpha2;  // ln a²
-    F norm;        // (a² - 1) / (π ln a²)
-    F sin2_scale;  // a² / (1 - a²)
+    F alpha2;                // a²
+    F log_alpha2;            // L = ln a²
+    F inv_one_minus_alpha2;  // 1 / (1 - a²) = -1 / (e^L - 1)
+    F norm;                  // (a² - 1) / (π ln a²)
+    F sin2_scale;            // a² / (1 - a²)
 
     static PB_MODEL_INLINE Gtr1 from_alpha(F alpha) {
         Gtr1 d;
         d.alpha2 = alpha * alpha;
         d.log_alpha2 = log(d.alpha2);
-        d.norm = F(kInvPi) * (d.alpha2 - F(1.0)) * reciprocal(d.log_alpha2);
-        d.sin2_scale = d.alpha2 * reciprocal(F(1.0) - d.alpha2);
+        const F alpha2_minus_1 = exp_minus_one(d.log_alpha2);
+        d.inv_one_minus_alpha2 = -reciprocal(alpha2_minus_1);
+        d.norm = F(kInvPi) * ratio_exp_minus_one(d.log_alpha2, alpha2_minus_1);
+        d.sin2_scale = d.alpha2 * d.inv_one_minus_alpha2;
         return d;
     }
 
     // |H|² (a² cos²θh + sin²θh) = a² Hz² + Hx² + Hy²: D(h) is norm |H|² over this
     PB_MODEL_INLINE F denominator(const HalfVector<F>& h) const { return mul_add(alpha2, h.hz2, h.hx2 + h.hy2); }
 
+    PB_MODEL_INLINE F d(const HalfVector<F>& h) const { return norm * h.h_len2 * reciprocal(denominator(h)); }
+
     // D(h) cos θh / (4 cos θd) = norm Hz / (2 denominator), the density in wi
     PB_MODEL_INLINE F pdf(const HalfVector<F>& h) const { return norm * h.hz * reciprocal(F(2.0) * denominator(h)); }
 
-    // sin²θh of the draw at u (eq. 5, through e^x - 1 with x = -u ln a² in [0, 14])
+    // ∂ln D/∂a² = 1/(a² - 1) - 1/(a² ln a²) - Hz² / denominator
+    PB_MODEL_INLINE F log_d_partial_alpha2(const HalfVector<F>& h) const {
+        const F log_norm = -inv_one_minus_alpha2 - reciprocal(alpha2 * log_alpha2);
+        return neg_mul_add(h.hz2, reciprocal(denominator(h)), log_norm);
+    }
+
+    // sin²θh of the draw at u (eq. 5, through e^x - 1 with x = -u ln a² in [0, -L])
     PB_MODEL_INLINE F draw_sin2(F u) const { return min(sin2_scale * exp_minus_one(-u * log_alpha2), F(1.0)); }
+
+    // cos²θh of the same draw, without 1 - sin²θh: -(e^((1-u) L) - 1) / (1 - a²)
+    PB_MODEL_INLINE F draw_cos2(F u) const {
+        return min(-exp_minus_one((F(1.0) - u) * log_alpha2) * inv_one_minus_alpha2, F(1.0));
+    }
+};
+
+// ln((1 - w) + w e^z) = ln(1 + w (e^z - 1)) for a weight w in [0, 1] given
+// with its complement: log1p where w (e^z - 1) is small, else the log of a sum
+// of two positive terms (e^z taken out when z > 0), so that it neither
+// cancels nor overflows.
+template <class F>
+PB_MODEL_INLINE F log_mix_exp(F weight, F weight_complement, F z) {
+    const F y = weight * exp_minus_one(min(z, F(700.0)));
+    const MaskOf<F> small = (z < F(700.0)) & (y <= F(0.5)) & (y >= F(-0.5));
+    const F large = select(z > F(0.0), z + log(mul_add(weight_complement, exp(-z), weight)),
+                           log(mul_add(weight, exp(min(z, F(0.0))), weight_complement)));
+    return select(small, log_one_plus(y), large);
+}
+
+// The GTR family (Burley 2012 appendix B eq. 1-3), isotropic, any γ > 0, alpha in (0, 1]:
+//   D(h) = c / t^γ,  t = a² cos²θh + sin²θh,  c = (γ - 1)(a² - 1) / (π (1 - (a²)^(1-γ))).
+// With L = ln a² and x = (1 - γ) L the normaliser is c = (expm1(L)/L) / (π expm1(x)/x),
+// which tends smoothly to GTR1's as γ -> 1 and to 1/π as a -> 1. For x > 0
+// the factor e^(-x) = (a²)^(γ-1) moves onto t^-γ, giving (a²/t)^γ / a² with
+// a²/t in (0, 1], so nothing overflows for small alpha and large γ.
+// The draw (eq. 3) as the pair (cos²θh, sin²θh): with k = 1 - γ,
+//   M = ln((1-u) (a²)^k + u) / k,  cos²θh = expm1(M) / expm1(L),
+//   q = ln(u (a²)^-k + (1-u)) / k,  sin²θh = e^M expm1(-q) / expm1(L)
+// needs no 1 - cos²θh; both logarithms tend to eq. 5's as k -> 0 (M -> (1-u) L,
+// q -> -u L). Λ has no closed form for general γ: none is offered.
+// Uses pow and log1p, which only the double operations define.
+template <class F>
+struct Gtr {
+    F alpha2, log_alpha2, gamma;
+    F k;                 // 1 - γ
+    MaskOf<F> ratio_form;  // x > 0: D = norm (a²/t)^γ, else norm t^-γ
+    F norm;              // c (a²)^(γ-1) / a² where ratio_form, else c
+
+    static PB_MODEL_INLINE Gtr from(F alpha, F gamma) {
+        Gtr d;
+        d.alpha2 = alpha * alpha;
+        d.log_alpha2 = F(2.0) * log(alpha);
+        d.gamma = gamma;
+        d.k = F(1.0) - gamma;
+        const F x = d.k * d.log_alpha2;
+        d.ratio_form = x > F(0.0);
+        const F normaliser_l = exp_minus_one_over_x(d.log_alpha2) * F(kInvPi);
+        d.norm = select(d.ratio_form, normaliser_l * reciprocal(exp_minus_one_over_x(-x)) * reciprocal(d.alpha2),
+                        normaliser_l * reciprocal(exp_minus_one_over_x(x)));
+        return d;
+    }
+
+    // D for cos²θh > 0
+    PB_MODEL_INLINE F d(F cos2, F sin2) const {
+        const F t = mul_add(alpha2, cos2, sin2);
+        return norm * select(ratio_form, pow(alpha2 * reciprocal(t), gamma), pow(t, -gamma));
+    }
+
+    // (cos²θh, sin²θh) of the draw at u2 < 1 (u2 = 1: the horizon, (0, 1))
+    PB_MODEL_INLINE std::pair<F, F> draw_cos2_sin2(F u2) const {
+        const F one(1.0), zero(0.0);
+        const F u_complement = one - u2;
+        const MaskOf<F> exponential = k == zero;  // γ = 1: eq. 5
+        const F safe_k = select(exponential, one, k);
+        const F m = select(exponential, u_complement * log_alpha2,
+                           log_mix_exp(u_complement, u2, k * log_alpha2) * reciprocal(safe_k));
+        const F q = select(exponential, -u2 * log_alpha2, log_mix_exp(u2, u_complement, -k * log_alpha2) * reciprocal(safe_k));
+        const F inv_expm1_l = reciprocal(exp_minus_one(log_alpha2));
+        const F cos2 = exp_minus_one(m) * inv_expm1_l;
+        const F sin2 = exp(m) * exp_minus_one(-q) * inv_expm1_l;
+        const MaskOf<F> uniform = log_alpha2 == zero;  // a = 1: cos²θh uniform
+        const MaskOf<F> horizon = u2 >= one;
+        const F cos2_drawn = select(horizon, zero, select(uniform, u_complement, min(max(cos2, zero), one)));
+        const F sin2_drawn = select(horizon, one, select(uniform, u2, min(max(sin2, zero), one)));
+        return {cos2_drawn, sin2_drawn};
+    }
 };

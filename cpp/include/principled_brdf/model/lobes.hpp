@@ -68,6 +68,31 @@ struct DiffuseLobe {
     }
 };
 
+// D and its partials in roughness and subsurface (gradients.hpp).
+template <class F>
+struct DiffusePartials {
+    F value, roughness, subsurface;
+};
+
+// DiffuseLobe::value with its partials: fd and Fss are products of two lines
+// in roughness, (1 + (F90 - 1) FL)(1 + (F90 - 1) FV), and D = mix(fd, ss, subsurface)
+template <class F>
+PB_MODEL_INLINE DiffusePartials<F> diffuse_partials(const DiffuseLobe<F>& lobe, const Geometry<F>& g, const Fresnel<F>& fresnel) {
+    const F one(1.0), half(0.5);
+    const F cos2_theta_d = F(0.25) * g.h_len2;
+    const F fd90_minus_1 = mul_add(F(2.0) * lobe.roughness, cos2_theta_d, F(-0.5));
+    const F fd_l = mul_add(fd90_minus_1, fresnel.fl, one), fd_v = mul_add(fd90_minus_1, fresnel.fv, one);
+    const F fd = fd_l * fd_v;
+    const F fd_roughness = F(2.0) * cos2_theta_d * mul_add(fresnel.fl, fd_v, fresnel.fv * fd_l);
+    const F fss90_minus_1 = mul_sub(lobe.roughness, cos2_theta_d, one);
+    const F fss_l = mul_add(fss90_minus_1, fresnel.fl, one), fss_v = mul_add(fss90_minus_1, fresnel.fv, one);
+    const F fss_roughness = cos2_theta_d * mul_add(fresnel.fl, fss_v, fresnel.fv * fss_l);
+    const F inv_cos_sum_minus_half = reciprocal(g.wi.z + g.wo.z) - half;
+    const F ss = F(1.25) * mul_add(fss_l * fss_v, inv_cos_sum_minus_half, half);
+    const F ss_roughness = F(1.25) * fss_roughness * inv_cos_sum_minus_half;
+    return {mix(fd, ss, lobe.subsurface), mix(fd_roughness, ss_roughness, lobe.subsurface), ss - fd};
+}
+
 // Sheen: FH sheen Csheen (1 - metallic), Csheen = mix(1, Ctint, sheen_tint).
 template <class F>
 struct SheenLobe {
@@ -99,6 +124,23 @@ struct SpecularLobe {
     // w1 = max(lum(mix(Cspec0, 1, FV)), 0.02)
     PB_MODEL_INLINE F weight(F fv) const { return max(mix(f0_luminance, F(1.0), fv), F(0.02)); }
 
+    // the log-derivatives of Gs Ds in ax and ay (the 2012 model's Smith term
+    // reads alpha_g, not ax and ay)
+    template <Model model>
+    PB_MODEL_INLINE LogAlphaPartials<F> log_value_partials(const Geometry<F>& g) const {
+        LogAlphaPartials<F> d = ggx.log_d_partials(g);
+        if constexpr (model == Model::kDisney2014) {
+            const LogAlphaPartials<F> smith_i = ggx.log_smith_partials(g.wi), smith_o = ggx.log_smith_partials(g.wo);
+            d = {d.sum - (smith_i.sum + smith_o.sum), d.difference - (smith_i.difference + smith_o.difference)};
+        }
+        return d;
+    }
+
+    // ∂ln(Gs Ds)/∂alpha_g² (the 2012 model's isotropic Smith term; 0 in the 2014 model)
+    PB_MODEL_INLINE F log_value_partial_alpha_g2(const Geometry<F>& g) const {
+        return -(log_smith_denominator_iso_partial(g.wi, alpha_g2) + log_smith_denominator_iso_partial(g.wo, alpha_g2));
+    }
+
     // the density in wi of the half vector drawn by `sampler`
     PB_MODEL_INLINE F pdf(const Geometry<F>& g, F smith_visible_wo, SpecularSampler sampler) const {
         const F d_h = ggx.d(g);
@@ -129,6 +171,14 @@ struct ClearcoatLobe {
         const F fr = mul_add(F(0.96), fh, F(0.04));
         const F denominator = smith_denominator_iso_small(g.wi.z, F(kSmithAlpha2)) * smith_wo;
         return scale * fr * g.h_len2 * reciprocal(gtr1.denominator(g) * denominator);
+    }
+
+    // the value per unit clearcoat, 0.25 Gr Fr Dr, computed whether or not the lobe is present
+    PB_MODEL_INLINE F unit_value(const Geometry<F>& g, F fh) const {
+        const F fr = mul_add(F(0.96), fh, F(0.04));
+        const F alpha2 = F(kSmithAlpha2);
+        const F denominator = smith_denominator_iso_small(g.wi.z, alpha2) * smith_denominator_iso_small(g.wo.z, alpha2);
+        return F(0.25) * gtr1.norm * fr * g.h_len2 * reciprocal(gtr1.denominator(g) * denominator);
     }
 
     // w2 = 0.25 clearcoat mix(0.04, 1, FV)

@@ -8,3 +8,4 @@
 #include "distributions.hpp"
 #include "lobes.hpp"
 #include "principled.hpp"
+#include "gradients.hpp"

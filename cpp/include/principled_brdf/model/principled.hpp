@@ -193,8 +193,10 @@ struct Direction {
 //               c = normalize(ax wo.x, ay wo.y, wo.z), cosθ = (1 - u2)(1 + c.z) - c.z,
 //               s = (ax, ay), h ∝ d
 // specular, distribution (Burley 2012 eq. 14-15): sin²θ = u2, c = 0, s = (ax, ay), h ∝ d
-// and wi = 2 (wo·h) h - wo for the reflected lobes. So every lane does one
-// draw, whatever the mixture of lobes in its batch; the parts of a lobe no
+// and wi = 2 (wo·h) h - wo for the reflected lobes: the distributions' own
+// draws (Ggx::sample_visible, sample_distribution, Gtr1::draw_sin2) merged
+// into one construction, so that every lane does one draw, whatever the
+// mixture of lobes in its batch; the parts of a lobe no
 // lane chose are skipped, which changes no result. A d of length 0 (u2 = 1 at
 // special angles) gives h = 0 and wi = -wo: below the horizon like every
 // other u2 = 1 sample of the reflected lobes.
@@ -207,7 +209,7 @@ PB_MODEL_INLINE Direction<F> sample_direction(const Vec3<F>& wo, const Uniforms<
     // the visible-normal cap construction scaled by L = |V|, V = (ax wo.x, ay wo.y, wo.z),
     // so V need not be normalised: L cosθ = (1 - u2)(L + V.z) - V.z, L² sin²θ = L² - (L cosθ)²;
     // cos θv + L is the View's smith_visible, which the weight needs anyway
-    const Vec3<F> stretched{ggx.alpha_x * wo.x, ggx.alpha_y * wo.y, wo.z};
+    const Vec3<F> stretched = ggx.stretch(wo);
     const F length2 = squared_length(stretched);
     const F length = square_root(length2);
     const F smith_visible = wo.z + length;
@@ -224,7 +226,7 @@ PB_MODEL_INLINE Direction<F> sample_direction(const Vec3<F>& wo, const Uniforms<
     F scaled_cos = zero;  // L cosθ of the visible-normal specular
     F centre_x = zero, centre_y = zero;
     if (visible_normals && any(lobe.specular)) {
-        scaled_cos = mul_sub(one - u.u2, length + stretched.z, stretched.z);
+        scaled_cos = Ggx<F>::cap_scaled_cos(u.u2, length, stretched.z);
         sin2_theta = select(lobe.specular, neg_mul_add(scaled_cos, scaled_cos, length2), sin2_theta);
         centre_x = select(lobe.specular, stretched.x, zero);
         centre_y = select(lobe.specular, stretched.y, zero);

@@ -22,6 +22,11 @@ inline bool all(bool mask) { return mask; }
 inline double log(double x) { return std::log(x); }
 inline double exp(double x) { return std::exp(x); }
 inline double exp_minus_one(double x) { return std::expm1(x); }
+// only the double instantiation's: parts of the model no kernel uses (Beckmann's Λ
+// and draw, the general GTR family)
+inline double log_one_plus(double x) { return std::log1p(x); }
+inline double pow(double x, double y) { return std::pow(x, y); }
+inline double erfc(double x) { return std::erfc(x); }
 inline double largest_finite(double) { return std::numeric_limits<double>::max(); }
 
 // (sin 2πu, cos 2πu)

@@ -63,3 +63,4 @@ template <class F>
 PB_MODEL_INLINE F luminance_of(const Rgb<F>& c) { return mul_add(F(0.3), c.r, mul_add(F(0.6), c.g, F(0.1) * c.b)); }
 
 inline constexpr double kInvPi = 0.318309886183790671538;
+inline constexpr double kSqrtPi = 1.772453850905516027298;

@@ -1,0 +1,236 @@
+"""Fitting the model to measured values of f (README "Fitting").
+
+Least squares (``scipy.optimize.least_squares``, trust-region reflective) on
+residuals between the model and the measurements at given direction pairs,
+with the analytic Jacobian of :func:`principled_brdf.eval_grad`: scipy's
+finite differences through a float32 kernel take steps that vanish in its
+rounding, and stop at the start point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _validate
+from ._batch import eval_grad
+from ._gradient import GRADIENT_NAMES
+from .material import PARAMETERS, Material
+from . import reference
+
+__all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES"]
+
+# Default bounds for fitting: the domains, with the unbounded parameters held
+# to [0, 1] as the BRDF Explorer's sliders are (pass bounds= to widen them).
+FIT_BOUNDS = {name: (max(info.lower, 0.0), min(info.upper, 1.0)) for name, info in PARAMETERS.items()}
+LOSSES = ("log", "relative", "linear")
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """What :func:`fit` returns; for a batch of problems every field has a leading batch axis."""
+
+    material: Material  # the fitted material (per element along the batch axis for a batch)
+    slots: np.ndarray  # (..., 13) its values in the parameter slots (GRADIENT_NAMES' order)
+    cost: np.ndarray  # 0.5 * sum of squared (weighted) residuals, per problem
+    residuals: np.ndarray  # (..., N, 3) unweighted, at the fitted material; NaN where measured is NaN
+    iterations: np.ndarray  # Jacobian evaluations, per problem
+    success: np.ndarray  # scipy's convergence flag, per problem
+    message: tuple  # scipy's message, per problem
+    names: tuple  # the fitted parameters (slot names, base_color as three)
+
+    def summary(self) -> str:
+        rows = np.atleast_2d(self.slots)
+        lines = []
+        for row, values in enumerate(rows):
+            converged = bool(np.atleast_1d(self.success)[row])
+            head = f"problem {row}: " if len(rows) > 1 else ""
+            lines.append(f"{head}{'converged' if converged else 'NOT converged'} after "
+                         f"{int(np.atleast_1d(self.iterations)[row])} iterations, "
+                         f"cost {float(np.atleast_1d(self.cost)[row]):.6g}")
+            shown = []
+            for name, info in PARAMETERS.items():
+                v = values[info.first_slot:info.first_slot + info.slots]
+                shown.append(f"{name}=({', '.join(f'{c:.4g}' for c in v)})" if info.slots == 3 else f"{name}={v[0]:.4g}")
+            lines.append("  " + ", ".join(shown))
+        lines.append("  fitted: " + ", ".join(self.names))
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.summary()
+
+
+def _slots(fit_names) -> list:
+    """Slot indices of the parameters to fit: None (all), or names (base_color = three slots)."""
+    if fit_names is None:
+        return list(range(len(GRADIENT_NAMES)))
+    names = [fit_names] if isinstance(fit_names, str) else list(fit_names)
+    slots = set()
+    for name in names:
+        if name == "base_color":
+            slots |= {0, 1, 2}
+        elif name in GRADIENT_NAMES:
+            slots.add(GRADIENT_NAMES.index(name))
+        else:
+            raise ValueError(f"fit: unknown parameter {name!r}; expected names of {', '.join(PARAMETERS)} "
+                             "(or base_color_r/g/b)")
+    if not slots:
+        raise ValueError("fit: no parameter to fit")
+    return sorted(slots)
+
+
+def _slot_bounds(bounds) -> tuple:
+    merged = dict(FIT_BOUNDS)
+    for name, pair in (bounds or {}).items():
+        if name not in PARAMETERS:
+            raise ValueError(f"bounds: unknown parameter {name!r}")
+        lower, upper = (float(v) for v in pair)
+        info = PARAMETERS[name]
+        if not (info.lower <= lower <= upper <= info.upper):
+            raise ValueError(f"bounds[{name!r}]: ({lower}, {upper}) is not an interval inside its domain "
+                             f"[{info.lower}, {info.upper}]")
+        merged[name] = (lower, upper)
+    lower = np.empty(len(GRADIENT_NAMES))
+    upper = np.empty(len(GRADIENT_NAMES))
+    for name, info in PARAMETERS.items():
+        lower[info.first_slot:info.first_slot + info.slots] = merged[name][0]
+        upper[info.first_slot:info.first_slot + info.slots] = merged[name][1]
+    return lower, upper
+
+
+def _initial_slots(init) -> np.ndarray:
+    if init is None:
+        init = Material()
+    if isinstance(init, dict):
+        init = Material(**init)
+    if not isinstance(init, Material) or not init.is_uniform:
+        raise TypeError("init: expected a uniform principled_brdf.Material or a dict of its parameters")
+    return np.asarray(init.packed(()), dtype=np.float64).reshape(-1)
+
+
+def _material_of(slot_values: np.ndarray) -> Material:
+    """A material from slot values ``(..., 13)``, uniform when one row."""
+    values = {}
+    for name, info in PARAMETERS.items():
+        block = slot_values[..., info.first_slot:info.first_slot + info.slots]
+        values[name] = block if info.slots == 3 else block[..., 0]
+    return Material(**values)
+
+
+def _residual_and_jacobian(value, jacobian, measured, cos_theta, loss, scale):
+    """Residuals r (n, 3) and dr/dslot (n, 3, 13) for one problem."""
+    if loss == "log":
+        model = value * cos_theta[:, None]
+        residual = np.log1p(model) - np.log1p(measured * cos_theta[:, None])
+        derivative = (cos_theta[:, None] / (1.0 + model))[..., None] * jacobian
+    elif loss == "relative":
+        residual = (value - measured) / scale
+        derivative = jacobian / scale[..., None]
+    else:
+        residual = (value - measured) * cos_theta[:, None]
+        derivative = jacobian * cos_theta[:, None, None]
+    return residual, derivative
+
+
+def fit(wi, wo, measured, *, init=None, fit=None, loss: str = "log", weights=None, bounds=None,
+        model: str = "disney2014", cosine: bool = True, precision: str = "float32",
+        max_iterations: int = 200) -> FitResult:
+    """The material that best matches ``measured`` values of f (1/sr) at the pairs (wi, wo).
+
+    ``wi``, ``wo``: unit directions ``(N, 3)``; ``measured``: ``(N, 3)``, or
+    ``(B, N, 3)`` for B independent problems (one material per row, e.g. the
+    texels of a texture; ``wi``, ``wo`` may then be ``(B, N, 3)`` too). NaN
+    marks a missing sample. ``init``: the start (a uniform Material or a dict;
+    default ``Material()``), which also holds the parameters not in ``fit``
+    (names; default all, ``base_color`` as three channels).
+    ``loss``: ``"log"`` (``log(1 + f c) - log(1 + m c)``, c = cos θl if
+    ``cosine`` else 1: robust over the dynamic range of specular peaks),
+    ``"relative"`` (``(f - m) / max(m, 1e-3 max m)``) or ``"linear"`` (``(f -
+    m) c``). ``weights`` ``(N,)`` or ``(B, N)`` scale each pair's squared
+    residuals. ``bounds``: ``{name: (lower, upper)}`` over :data:`FIT_BOUNDS`
+    (the domains, with the unbounded parameters held to [0, 1]).
+    ``precision``: ``"float32"`` (the SIMD kernels) or ``"float64"`` (the reference).
+    """
+    try:
+        from scipy.optimize import least_squares
+    except ImportError as error:  # pragma: no cover - scipy is in the test and fit extras
+        raise ImportError("pb.fit needs scipy: pip install 'principled-brdf[fit]'") from error
+    if loss not in LOSSES:
+        raise ValueError(f"loss: expected one of {', '.join(LOSSES)}, got {loss!r}")
+    if precision not in ("float32", "float64"):
+        raise ValueError(f"precision: expected 'float32' or 'float64', got {precision!r}")
+    cosine = _validate.flag("cosine", cosine)
+    max_iterations = _validate.integer("max_iterations", max_iterations)
+    measured = np.asarray(_validate.as_real_array("measured", measured), dtype=np.float64)
+    if measured.ndim not in (2, 3) or measured.shape[-1] != 3:
+        raise ValueError(f"measured: expected (N, 3) or (B, N, 3) values of f, got shape {measured.shape}")
+    finite_or_missing = np.isfinite(measured) | np.isnan(measured)
+    if not finite_or_missing.all() or np.any(measured < 0):
+        raise ValueError("measured: values must be finite and >= 0 (NaN marks a missing sample)")
+    batched = measured.ndim == 3
+    problems = measured if batched else measured[None]
+    wi = np.asarray(_validate.directions("wi", wi), dtype=np.float64)
+    wo = np.asarray(_validate.directions("wo", wo), dtype=np.float64)
+    count, n = problems.shape[:2]
+    for w in (wi, wo):
+        if w.shape not in ((n, 3), (count, n, 3)):
+            raise ValueError(f"wi, wo: expected (N, 3) or (B, N, 3) with B, N = {count}, {n}, got {wi.shape} and {wo.shape}")
+    wi_rows = np.broadcast_to(wi, (count, n, 3))
+    wo_rows = np.broadcast_to(wo, (count, n, 3))
+    if weights is not None:
+        weights = np.broadcast_to(np.asarray(_validate.as_real_array("weights", weights), dtype=np.float64), (count, n))
+        if np.any(~np.isfinite(weights)) or np.any(weights < 0):
+            raise ValueError("weights: expected finite values >= 0")
+    slots = _slots(fit)
+    lower, upper = _slot_bounds(bounds)
+    start = _initial_slots(init)
+    start[slots] = np.clip(start[slots], lower[slots], upper[slots])
+    _validate.model_index(model)  # checked before any work; eval_grad takes the name
+
+    fitted = np.empty((count, len(GRADIENT_NAMES)))
+    costs, iterations, success, messages = np.empty(count), np.empty(count, np.int64), np.empty(count, bool), []
+    residuals_out = np.full(problems.shape, np.nan)
+    dtype = np.float32 if precision == "float32" else np.float64
+    for row in range(count):
+        target = problems[row]
+        present = ~np.isnan(target).any(axis=-1)
+        wi_p = np.ascontiguousarray(wi_rows[row][present], dtype=dtype)
+        wo_p = np.ascontiguousarray(wo_rows[row][present], dtype=dtype)
+        m = target[present]
+        cos_theta = np.maximum(wi_rows[row][present][:, 2], 0.0) if cosine else np.ones(len(m))
+        scale = np.maximum(m, 1e-3 * max(float(m.max(initial=0.0)), 1e-300))
+        root_weight = np.sqrt(weights[row][present])[:, None] if weights is not None else np.ones((len(m), 1))
+        values = start.copy()
+        last = {}
+
+        def evaluate(x):
+            """Unweighted residuals (n, 3) and their Jacobian (n, 3, len(slots)) at x, kept for the next call."""
+            if last.get("x") is None or not np.array_equal(last["x"], x):
+                values[slots] = x
+                material = _material_of(values)
+                if precision == "float32":
+                    g = eval_grad(material, wi_p, wo_p, model=model, check=False)
+                else:
+                    g = reference.eval_grad(material, wi_p, wo_p, model=model)
+                r, d = _residual_and_jacobian(g.value.astype(np.float64), g.jacobian.astype(np.float64), m, cos_theta,
+                                              loss, scale)
+                last.update(x=x.copy(), r=r, d=d[..., slots])
+            return last["r"], last["d"]
+
+        solution = least_squares(lambda x: (evaluate(x)[0] * root_weight).reshape(-1), start[slots],
+                                 jac=lambda x: (evaluate(x)[1] * root_weight[..., None]).reshape(-1, len(slots)),
+                                 bounds=(lower[slots], upper[slots]), method="trf", x_scale="jac",
+                                 max_nfev=max_iterations)
+        values[slots] = solution.x
+        fitted[row] = values
+        costs[row] = solution.cost
+        iterations[row] = solution.njev if solution.njev is not None else solution.nfev
+        success[row] = solution.success
+        messages.append(solution.message)
+        residuals_out[row][present] = evaluate(solution.x)[0]
+
+    take = (lambda a: a) if batched else (lambda a: a[0])
+    return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
+                     residuals=take(residuals_out), iterations=take(iterations), success=take(success),
+                     message=tuple(messages) if batched else messages[0], names=tuple(GRADIENT_NAMES[k] for k in slots))
