@@ -22,6 +22,7 @@ namespace pb = principled_brdf;
 namespace {
 
 constexpr std::int64_t kSizes[] = {4096, 65536, 16 << 20};
+constexpr std::int64_t kGradientInCache = 1024;
 
 // Random pairs in the upper hemisphere and random per-element materials, in
 // both layouts, made once per size.
@@ -86,10 +87,14 @@ int threads_of(const benchmark::State& state) {
     return state.range(1) == 0 ? pb::hardware_threads() : static_cast<int>(state.range(1));
 }
 
-void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_element, bool checked) {
+void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_element, bool checked,
+               pb::Output output) {
     Data& d = data_for(state.range(0));
     pb::EvalJob job = make_job(d, soa, per_element);
     if (checked) job.check = pb::direction_check(1e-3);  // what pb.eval does by default
+    job.output = output;
+    std::vector<float> pdf(output == pb::Output::kValuePdf ? d.n : 0);
+    job.pdf = pdf.data();
     const int threads = threads_of(state);
     for (auto _ : state) {
         pb::eval(job, d.n, threads, isa);
@@ -196,21 +201,36 @@ void register_all() {
                     for (bool per_element : {false, true}) {
                         const std::string name = "eval/" + isa + (soa ? "/soa" : "/aos") +
                                                  (per_element ? "/per_element" : "/uniform");
-                        benchmark::RegisterBenchmark(name.c_str(), simd_eval, isa, soa, per_element, false)
+                        benchmark::RegisterBenchmark(name.c_str(), simd_eval, isa, soa, per_element, false, pb::Output::kTotal)
                             ->Args({n, threads})
                             ->UseRealTime()
                             ->Unit(benchmark::kMicrosecond);
                         if (!soa && !per_element) {  // the default call: the direction check on
                             const std::string checked_name = "eval_checked/" + isa + "/aos/uniform";
-                            benchmark::RegisterBenchmark(checked_name.c_str(), simd_eval, isa, false, false, true)
+                            benchmark::RegisterBenchmark(checked_name.c_str(), simd_eval, isa, false, false, true, pb::Output::kTotal)
                                 ->Args({n, threads})
                                 ->UseRealTime()
                                 ->Unit(benchmark::kMicrosecond);
                         }
                         if (n == kSizes[0] && threads == 1) {
+                            // also at 1024 pairs, where the Jacobian (156 bytes a pair) stays in L2, beside eval there
+                            benchmark::RegisterBenchmark(name.c_str(), simd_eval, isa, soa, per_element, false, pb::Output::kTotal)
+                                ->Args({kGradientInCache, 1})
+                                ->UseRealTime()
+                                ->Unit(benchmark::kMicrosecond);
                             const std::string grad_name = "eval_grad/" + isa + (soa ? "/soa" : "/aos") +
                                                           (per_element ? "/per_element" : "/uniform");
-                            benchmark::RegisterBenchmark(grad_name.c_str(), simd_eval_grad, isa, soa, per_element)
+                            for (std::int64_t size : {kGradientInCache, n})
+                                benchmark::RegisterBenchmark(grad_name.c_str(), simd_eval_grad, isa, soa, per_element)
+                                    ->Args({size, threads})
+                                    ->UseRealTime()
+                                    ->Unit(benchmark::kMicrosecond);
+                        }
+                        if (n == kSizes[0] && threads == 1 && !soa) {  // f and the pdf in one pass
+                            const std::string value_pdf_name = "eval_pdf/" + isa + "/aos" +
+                                                               (per_element ? "/per_element" : "/uniform");
+                            benchmark::RegisterBenchmark(value_pdf_name.c_str(), simd_eval, isa, soa, per_element, false,
+                                                         pb::Output::kValuePdf)
                                 ->Args({n, threads})
                                 ->UseRealTime()
                                 ->Unit(benchmark::kMicrosecond);

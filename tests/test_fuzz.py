@@ -218,7 +218,7 @@ def assert_matches_reference(actual, expected, wi, wo):
 
 @FUZZ
 @given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1),
-       entry=st.sampled_from(("eval", "eval_out", "eval_lobes", "pdf")))
+       entry=st.sampled_from(("eval", "eval_out", "eval_lobes", "pdf", "eval_grad")))
 def test_fuzz_evaluation(data, leading, seed, entry):
     rng = rng_from(seed)
     n = int(np.prod(leading))
@@ -260,11 +260,12 @@ def test_fuzz_evaluation(data, leading, seed, entry):
     call = {"eval": lambda: pb.eval(material, wi, wo, **opts),
             "eval_out": lambda: pb.eval(material, wi, wo, out=out, **opts),
             "eval_lobes": lambda: pb.eval_lobes(material, wi, wo, **opts),
-            "pdf": lambda: pb.pdf(material, wi, wo, **opts)}[entry]
+            "pdf": lambda: pb.pdf(material, wi, wo, **opts),
+            "eval_grad": lambda: pb.eval_grad(material, wi, wo, **opts)}[entry]
     result = outcome(call)
     if result is None:
         return
-    arrays = list(result) if entry == "eval_lobes" else [result]
+    arrays = list(result) if entry == "eval_lobes" else [result.value, result.jacobian] if entry == "eval_grad" else [result]
     for array in arrays:
         assert array.dtype == np.float32
         assert np.isfinite(array).all(), "non-finite output for accepted input"
@@ -278,7 +279,7 @@ def test_fuzz_evaluation(data, leading, seed, entry):
     reference = pb.reference.eval_lobes if entry == "eval_lobes" else pb.reference.eval
     expected = reference(material, a, b, model=opts.get("model", "disney2014"),
                          cosine=bool(opts.get("cosine", False)))
-    for actual, wanted in zip(arrays, list(expected) if entry == "eval_lobes" else [expected]):
+    for actual, wanted in zip(arrays, list(expected) if entry == "eval_lobes" else [expected]):  # eval_grad: its value
         actual = np.moveaxis(actual, 0, -1) if layout == "soa" else actual
         assert_matches_reference(actual, wanted, *np.broadcast_arrays(a, b))
 
@@ -335,7 +336,7 @@ def test_fuzz_albedo_and_uniforms(data, seed):
 
 @FUZZ
 @given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1),
-       entry=st.sampled_from(("eval", "eval_lobes", "pdf", "sample", "lobe_probabilities")))
+       entry=st.sampled_from(("eval", "eval_lobes", "pdf", "sample", "lobe_probabilities", "eval_grad")))
 def test_fuzz_reference(data, leading, seed, entry):
     rng = rng_from(seed)
     n = int(np.prod(leading))
@@ -354,10 +355,12 @@ def test_fuzz_reference(data, leading, seed, entry):
             "eval_lobes": lambda: pb.reference.eval_lobes(material, wi, wo, **opts),
             "pdf": lambda: pb.reference.pdf(material, wi, wo, **opts),
             "sample": lambda: pb.reference.sample(material, wo, u, **opts),
-            "lobe_probabilities": lambda: pb.reference.lobe_probabilities(material, wo)}[entry]
+            "lobe_probabilities": lambda: pb.reference.lobe_probabilities(material, wo),
+            "eval_grad": lambda: pb.reference.eval_grad(material, wi, wo, **opts)}[entry]
     result = outcome(call)
     if result is not None:
-        for array in (result if isinstance(result, tuple) else [result]):
+        arrays = result[:2] if entry == "eval_grad" else result if isinstance(result, tuple) else [result]
+        for array in arrays:
             assert np.isfinite(array).all()
 
 

@@ -87,20 +87,28 @@ void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, p
     }
 }
 
+// The inputs of an evaluation: directions, parameters, model, cosine and check.
+EvalJob eval_job(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout, const py::sequence& params,
+                 std::int64_t n, int model, Output output, bool cosine, double check_tolerance, py::list& keep_alive) {
+    EvalJob job;
+    job.wi = vec3_view(wi, wi_layout, n, "wi");
+    job.wo = vec3_view(wo, wo_layout, n, "wo");
+    fill_params(params, n, job.params, keep_alive);
+    job.model = model_from(model);
+    job.output = output;
+    job.cosine = cosine;
+    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
+    return job;
+}
+
 // Returns -1, or with check_tolerance > 0 the index of an element whose wi or
 // wo is not a unit vector (the outputs then hold the results of some elements only).
 std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                         const py::sequence& params, const py::sequence& outputs, int out_layout, std::int64_t n, int model,
                         bool lobes, bool cosine, double check_tolerance, int threads, const std::string& isa) {
-    EvalJob job;
-    job.wi = vec3_view(wi, wi_layout, n, "wi");
-    job.wo = vec3_view(wo, wo_layout, n, "wo");
     py::list keep_alive;
-    fill_params(params, n, job.params, keep_alive);
-    job.model = model_from(model);
-    job.output = lobes ? Output::kLobes : Output::kTotal;
-    job.cosine = cosine;
-    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, model, lobes ? Output::kLobes : Output::kTotal, cosine,
+                           check_tolerance, keep_alive);
     std::vector<Float32Array> keep_outputs;
     output_views(outputs, lobes ? kLobeCount : 1, out_layout, n, "out", job.out, keep_outputs);
     if (n == 0) return -1;
@@ -113,15 +121,9 @@ std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float3
                              const py::sequence& params, Float32Array out, Float32Array jacobian, int out_layout,
                              std::int64_t n, int model, bool cosine, double check_tolerance, int threads,
                              const std::string& isa) {
-    EvalJob job;
-    job.wi = vec3_view(wi, wi_layout, n, "wi");
-    job.wo = vec3_view(wo, wo_layout, n, "wo");
     py::list keep_alive;
-    fill_params(params, n, job.params, keep_alive);
-    job.model = model_from(model);
-    job.output = Output::kGradient;
-    job.cosine = cosine;
-    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, model, Output::kGradient, cosine, check_tolerance,
+                           keep_alive);
     job.out[0] = output_view(out, out_layout, n, "out");
     const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
     const bool shape_ok = rows ? (jacobian.ndim() == 3 && jacobian.shape(0) == 3 && jacobian.shape(1) == kParamSlots &&
@@ -146,18 +148,23 @@ T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const ch
     return a.mutable_data();
 }
 
+// The sampling pdf alone (out is None) or with f into out, in one pass.
 std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                        const py::sequence& params, Float32Array pdf, std::int64_t n, int sampler,
-                       double check_tolerance, int threads, const std::string& isa) {
-    EvalJob job;
-    job.wi = vec3_view(wi, wi_layout, n, "wi");
-    job.wo = vec3_view(wo, wo_layout, n, "wo");
+                       double check_tolerance, int threads, const std::string& isa, const py::object& out,
+                       int out_layout, int model, bool cosine) {
     py::list keep_alive;
-    fill_params(params, n, job.params, keep_alive);
-    job.output = Output::kPdf;
+    const bool with_value = !out.is_none();
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, model, with_value ? Output::kValuePdf : Output::kPdf,
+                           cosine, check_tolerance, keep_alive);
     job.sampler = sampler_from(sampler);
     job.pdf = scalar_output(pdf, n, "pdf");
-    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
+    Float32Array value;
+    if (with_value) {
+        value = py::cast<Float32Array>(out);
+        if (!value.is(out)) throw std::invalid_argument("out: expected a C-contiguous float32 array");
+        job.out[0] = output_view(value, out_layout, n, "out");
+    }
     if (n == 0) return -1;
     py::gil_scoped_release release;
     return eval(job, n, threads, isa);
@@ -243,7 +250,9 @@ void bind_batch(py::module_& m) {
           "SIMD f and its Jacobian over the parameter slots into preallocated float32 outputs.");
     m.def("batch_pdf", &batch_pdf, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
           py::arg("params"), py::arg("pdf"), py::arg("n"), py::arg("sampler"), py::arg("check_tolerance"),
-          py::arg("threads"), py::arg("isa"), "SIMD sampling pdf into a preallocated float32 array.");
+          py::arg("threads"), py::arg("isa"), py::arg("out") = py::none(), py::arg("out_layout") = 0,
+          py::arg("model") = 0, py::arg("cosine") = false,
+          "SIMD sampling pdf into a preallocated float32 array (and f into out, in the same pass, if given).");
     m.def("batch_sample", &batch_sample, py::arg("wo"), py::arg("wo_layout"), py::arg("u"), py::arg("u_layout"),
           py::arg("seed"), py::arg("params"), py::arg("wi"), py::arg("weight"), py::arg("out_layout"), py::arg("pdf"),
           py::arg("lobe"), py::arg("n"), py::arg("model"), py::arg("sampler"), py::arg("check_tolerance"),

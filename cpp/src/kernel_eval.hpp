@@ -14,25 +14,42 @@ struct Prepared {
 
 template <Output output>
 PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
-    Prepared<output> p;
-    p.shading = shading_of(m);
-    if constexpr (output == Output::kGradient) p.partials = material_partials_of(m.slot);
-    return p;
+    // built in place: assigning into a default-constructed one copied the whole Shading per batch
+    if constexpr (output == Output::kGradient) {
+        return {shading_of(m), material_partials_of(m.slot)};
+    } else {
+        return {shading_of(m), NoPartials{}};
+    }
 }
 
-// A batch's Jacobian, row r = kParamSlots c + p holding ∂f_c/∂p of every lane:
-// stored by rows, or transposed through the stack to element-major order.
-PB_KERNEL_INLINE void store_jacobian(const EvalJob& job, std::int64_t i, const Floats (&rows)[kJacobianWidth]) {
-    if (job.jacobian_row_stride > 0) {
-        for (int r = 0; r < kJacobianWidth; ++r) rows[r].store_unaligned(job.jacobian + r * job.jacobian_row_stride + i);
-        return;
+// Where a batch's Jacobian goes, row r = kParamSlots c + p holding ∂f_c/∂p of
+// every lane: straight to memory by rows (the (3, N) layout), or through the
+// stack, transposed to element-major order when the batch is done (finish).
+template <Layouts layouts>
+struct JacobianStore {
+    const EvalJob& job;
+    std::int64_t i;
+    alignas(64) float lanes[padded_rows(kJacobianWidth)][kLanes];
+
+    bool by_rows() const {
+        return layouts == Layouts::kRows || (layouts == Layouts::kMixed && job.jacobian_row_stride > 0);
     }
-    alignas(64) float lanes[kJacobianWidth][kLanes];
-    for (int r = 0; r < kJacobianWidth; ++r) rows[r].store_aligned(lanes[r]);
-    float* out = job.jacobian + kJacobianWidth * i;
-    for (std::int64_t lane = 0; lane < kLanes; ++lane)
-        for (int r = 0; r < kJacobianWidth; ++r) out[kJacobianWidth * lane + r] = lanes[r][lane];
-}
+
+    PB_KERNEL_INLINE void put(int c, int p, Floats value) {
+        const int r = kParamSlots * c + p;
+        if (by_rows()) {
+            value.store_unaligned(job.jacobian + r * job.jacobian_row_stride + i);
+        } else {
+            value.store_aligned(lanes[r]);
+        }
+    }
+
+    PB_KERNEL_INLINE void finish() {
+        if (by_rows()) return;
+        for (int r = kJacobianWidth; r < padded_rows(kJacobianWidth); ++r) Floats(0.0f).store_aligned(lanes[r]);
+        store_rows_by_element<kJacobianWidth>(lanes, job.jacobian + kJacobianWidth * i);
+    }
+};
 
 template <Model model, Output output, Layouts layouts>
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
@@ -43,16 +60,23 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
     const Mask above = above_surface(g);
     const View<Floats> view = view_of<model>(wo, s);
     if constexpr (output == Output::kGradient) {
-        const ValueGradient<Floats> v = eval_gradient<model>(g, s, view, material.partials);
-        auto masked = [&](Floats x) { return select(above, job.cosine ? wi.z * x : x, Floats(0.0f)); };
-        store_rgb<layouts>(job.out[0], i, {masked(v.value.r), masked(v.value.g), masked(v.value.b)});
-        Floats rows[kJacobianWidth];
-        for (int c = 0; c < 3; ++c)
-            for (int p = 0; p < kParamSlots; ++p) rows[kParamSlots * c + p] = masked(v.jacobian[c][p]);
-        store_jacobian(job, i, rows);
+        // x cos θl or x times 1 (the same bits), then 0 below the surface
+        const Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
+        auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
+        JacobianStore<layouts> store{job, i};
+        const Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked,
+                                                   [&](int c, int p, Floats x) { store.put(c, p, x); });
+        store.finish();
+        store_rgb<layouts>(job.out[0], i, {masked(f.r), masked(f.g), masked(f.b)});
     } else if constexpr (output == Output::kPdf) {
         const Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
+    } else if constexpr (output == Output::kValuePdf) {
+        const Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
+        select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
+        const Rgb<Floats> f = eval_lobes<model>(g, s, view).total(s);
+        auto masked = [&](Floats x) { return select(above, job.cosine ? wi.z * x : x, Floats(0.0f)); };
+        store_rgb<layouts>(job.out[0], i, {masked(f.r), masked(f.g), masked(f.b)});
     } else {
         const LobeValues<Floats> lobes = eval_lobes<model>(g, s, view);
         const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
@@ -102,7 +126,7 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const Prepared<output>& u
     if (!eval_one_batch<model, output, per_element, Layouts::kMixed>(padded, 0, uniform)) return false;
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
-    if (output == Output::kPdf) unpad_scalars(job.pdf, pad, pdf);
+    if (output == Output::kPdf || output == Output::kValuePdf) unpad_scalars(job.pdf, pad, pdf);
     if constexpr (output == Output::kGradient) {
         for (std::int64_t j = 0; j < pad.count; ++j)
             for (int r = 0; r < kJacobianWidth; ++r) {
@@ -132,6 +156,7 @@ inline Layouts layouts_of(const EvalJob& job) {
     for (Vec3Layout layout : {Vec3Layout::kInterleaved, Vec3Layout::kRows}) {
         bool all = job.wi.layout == layout && job.wo.layout == layout;
         for (int k = 0; k < outputs; ++k) all = all && job.out[k].layout == layout;
+        if (job.output == Output::kGradient) all = all && (job.jacobian_row_stride > 0) == (layout == Vec3Layout::kRows);
         if (all) return layout == Vec3Layout::kInterleaved ? Layouts::kInterleaved : Layouts::kRows;
     }
     return Layouts::kMixed;
@@ -166,6 +191,9 @@ inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int6
     switch (job.output) {
         case Output::kPdf:  // the pdf does not depend on the model
             return eval_range_for<Model::kDisney2014, Output::kPdf>(job, begin, end);
+        case Output::kValuePdf:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kValuePdf>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kValuePdf>(job, begin, end);
         case Output::kGradient:
             return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kGradient>(job, begin, end)
                                                    : eval_range_for<Model::kDisney2014, Output::kGradient>(job, begin, end);

@@ -251,6 +251,79 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
 
 #endif
 
+// ---------------------------------------------------------------- rows to elements
+// out[width * lane + r] = rows[r][lane] for r < width and every lane: a batch's
+// rows (its Jacobian) written element after element. `rows` holds
+// padded_rows(width) aligned rows; the padding rows are read, never written out.
+#if defined(__AVX2__) && !defined(__AVX512F__)
+inline constexpr int kTransposeBlock = 8;  // 8 x 8 blocks in registers
+
+template <int width>
+PB_KERNEL_INLINE void store_rows_by_element(const float (*rows)[kLanes], float* out) {
+    for (int b = 0; b < width; b += 8) {
+        __m256 r[8], t[8], u[8];
+        for (int k = 0; k < 8; ++k) r[k] = _mm256_load_ps(rows[b + k]);
+        for (int k = 0; k < 8; k += 2) {
+            t[k] = _mm256_unpacklo_ps(r[k], r[k + 1]);
+            t[k + 1] = _mm256_unpackhi_ps(r[k], r[k + 1]);
+        }
+        for (int k = 0; k < 8; k += 4) {
+            u[k] = _mm256_shuffle_ps(t[k], t[k + 2], 0x44);
+            u[k + 1] = _mm256_shuffle_ps(t[k], t[k + 2], 0xEE);
+            u[k + 2] = _mm256_shuffle_ps(t[k + 1], t[k + 3], 0x44);
+            u[k + 3] = _mm256_shuffle_ps(t[k + 1], t[k + 3], 0xEE);
+        }
+        const int valid = width - b < 8 ? width - b : 8;
+        const __m256i first_valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(valid), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        for (int lane = 0; lane < 8; ++lane) {
+            // element `lane`: low halves of u[0..3] for lanes 0-3, high halves for 4-7
+            const int k = lane & 3;
+            const __m256 column = lane < 4 ? _mm256_permute2f128_ps(u[k], u[k + 4], 0x20)
+                                           : _mm256_permute2f128_ps(u[k], u[k + 4], 0x31);
+            float* p = out + width * lane + b;
+            if (valid == 8) {
+                _mm256_storeu_ps(p, column);
+            } else {
+                _mm256_maskstore_ps(p, first_valid, column);
+            }
+        }
+    }
+}
+#elif defined(__SSE2__) && !defined(__AVX512F__)
+inline constexpr int kTransposeBlock = 4;  // 4 x 4 blocks in registers
+
+template <int width>
+PB_KERNEL_INLINE void store_rows_by_element(const float (*rows)[kLanes], float* out) {
+    for (int b = 0; b < width; b += 4) {
+        __m128 r0 = _mm_load_ps(rows[b]), r1 = _mm_load_ps(rows[b + 1]), r2 = _mm_load_ps(rows[b + 2]),
+               r3 = _mm_load_ps(rows[b + 3]);
+        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+        const __m128 columns[4] = {r0, r1, r2, r3};
+        const int valid = width - b < 4 ? width - b : 4;
+        for (int lane = 0; lane < 4; ++lane) {
+            float* p = out + width * lane + b;
+            if (valid == 4) {
+                _mm_storeu_ps(p, columns[lane]);
+            } else {
+                alignas(16) float column[4];
+                _mm_store_ps(column, columns[lane]);
+                for (int k = 0; k < valid; ++k) p[k] = column[k];
+            }
+        }
+    }
+}
+#else
+inline constexpr int kTransposeBlock = 1;
+
+template <int width>
+PB_KERNEL_INLINE void store_rows_by_element(const float (*rows)[kLanes], float* out) {
+    for (std::int64_t lane = 0; lane < kLanes; ++lane)
+        for (int r = 0; r < width; ++r) out[width * lane + r] = rows[r][lane];
+}
+#endif
+
+constexpr int padded_rows(int width) { return (width + kTransposeBlock - 1) / kTransposeBlock * kTransposeBlock; }
+
 // ---------------------------------------------------------------- what the model calls
 // (docs/model.md: the same names for double are in model/scalar_ops.hpp)
 

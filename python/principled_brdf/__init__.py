@@ -3,13 +3,18 @@
 See the README for the model and the API tour.
 """
 
-from . import microfacet, plot, presets, reference, render
+from . import frames, measured, microfacet, plot, presets, reference, render
 from .fit import FitResult, fit
-from ._batch import Lobes, Sample, cpu_info, eval, eval_grad, eval_lobes, pdf, random_uniforms, sample
+from ._batch import Lobes, Sample, ValuePdf, cpu_info, eval, eval_grad, eval_lobes, eval_pdf, pdf, random_uniforms, sample
 from ._gradient import GRADIENT_NAMES, Gradient
 from .albedo import Albedo, albedo
-from .material import PARAMETERS, Material, gamma22_to_linear
+from .material import PARAMETERS, BrightColorWarning, Material, gamma22_to_linear, srgb_to_linear
 
-__all__ = ["Material", "PARAMETERS", "Lobes", "Sample", "Albedo", "albedo", "gamma22_to_linear", "eval", "eval_lobes", "pdf", "sample",
-           "eval_grad", "Gradient", "GRADIENT_NAMES", "fit", "FitResult", "random_uniforms", "cpu_info", "reference", "microfacet", "presets", "render", "plot"]
+__all__ = [
+    "Material", "PARAMETERS", "BrightColorWarning", "srgb_to_linear", "gamma22_to_linear",
+    "eval", "eval_lobes", "eval_pdf", "pdf", "sample", "random_uniforms", "cpu_info",
+    "Lobes", "Sample", "ValuePdf", "Albedo", "albedo",
+    "eval_grad", "Gradient", "GRADIENT_NAMES", "fit", "FitResult",
+    "reference", "microfacet", "measured", "frames", "presets", "render", "plot",
+]
 __version__ = "0.1.0"

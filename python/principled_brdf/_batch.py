@@ -38,7 +38,7 @@ from . import _gradient
 from ._gradient import GRADIENT_NAMES, Gradient
 from .material import PARAMETERS, Material
 
-__all__ = ["eval", "eval_lobes", "eval_grad", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
+__all__ = ["eval", "eval_lobes", "eval_grad", "eval_pdf", "ValuePdf", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
 
 _INTERLEAVED, _ROWS, _SINGLE = 0, 1, 2
 
@@ -273,8 +273,9 @@ def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, o
                                     jacobian.reshape((n, 3, -1) if layout == "aos" else (3, -1, n)), out_layout, n,
                                     model_id, cosine, tolerance, thread_count, isa_name)
     elif pdf_sampler is not None:
+        value = _flat_vec3(outputs[1], layout)[0] if len(outputs) == 2 else None  # eval_pdf: f in the same pass
         bad = _core.batch_pdf(wi_flat, wi_code, wo_flat, wo_code, params, outputs[0].reshape(n), n, pdf_sampler,
-                              tolerance, thread_count, isa_name)
+                              tolerance, thread_count, isa_name, value, out_layout, model_id, cosine)
     else:
         flat_outputs = [_flat_vec3(o, layout)[0] for o in outputs]
         bad = _core.batch_eval(wi_flat, wi_code, wo_flat, wo_code, params, flat_outputs,
@@ -366,6 +367,34 @@ def pdf(material: Material, wi, wo, *, specular_sampler: str = "visible", layout
     return density
 
 
+class ValuePdf(NamedTuple):
+    """What :func:`eval_pdf` returns."""
+
+    value: np.ndarray  # f, as eval returns it
+    pdf: np.ndarray  # the sampling density of wi given wo, as pdf returns it
+
+
+def eval_pdf(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False,
+             specular_sampler: str = "visible", layout: str = "aos", threads=None, out=None, check: bool = True,
+             isa=None) -> ValuePdf:
+    """f and the sampling pdf of (wi, wo) in one kernel pass (what multiple importance
+    sampling needs): ``value`` as :func:`eval` returns it, ``pdf`` as :func:`pdf` does.
+    ``out=(value, pdf)`` writes into preallocated float32 arrays of those shapes."""
+    if out is not None and not (isinstance(out, tuple) and len(out) == 2):
+        raise TypeError("out: expected a tuple (value, pdf) of float32 arrays")
+
+    def outputs(leading, layout):
+        value = _output(None if out is None else out[0], _vec3_shape(leading, layout), "out[0]")
+        density = _output(None if out is None else out[1], leading, "out[1]")
+        if out is not None and np.may_share_memory(value, density):
+            raise ValueError("out: the value and pdf arrays overlap")
+        return [density, value]
+
+    density, value = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
+                               pdf_sampler=sampler_index(specular_sampler))
+    return ValuePdf(value, density)
+
+
 def random_uniforms(seed: int, n: int, first: int = 0) -> np.ndarray:
     """The ``(n, 3)`` uniforms :func:`sample` draws for elements ``first .. first + n - 1``
     when given ``seed`` and no ``u`` (a counter-based generator keyed by seed and index)."""
@@ -379,7 +408,12 @@ def random_uniforms(seed: int, n: int, first: int = 0) -> np.ndarray:
     return _core.counter_uniforms(seed_value(seed), start, count)
 
 
-def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disney2014",
+def _fresh_seed() -> int:
+    """A seed from the operating system's randomness, as numpy's default_rng() takes one."""
+    return int(np.random.SeedSequence().generate_state(1, np.uint64)[0])
+
+
+def sample(material: Material, wo, *, u=None, seed=None, n=None, model: str = "disney2014",
            specular_sampler: str = "visible", layout: str = "aos", threads=None, check: bool = True,
            isa=None, with_lobes: bool = False):
     """Importance-sample ``wi`` for each ``wo`` (README "Sampling and pdf").
@@ -387,7 +421,12 @@ def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disne
     ``u``: three uniforms in [0, 1] per element, ``(..., 3)`` (``(3, ...)`` for
     ``layout="soa"``), broadcast with ``wo`` and the material; without it they
     come from a counter-based generator keyed by ``(seed, element index)``
-    (C order over the broadcast leading shape), independent of ``threads``.
+    (C order over the broadcast leading shape), independent of ``threads``:
+    an integer ``seed`` reproduces them, ``seed=None`` (the default) takes a
+    fresh one from the operating system, as ``np.random.default_rng()`` does.
+    ``n``: that many samples of every element, the result's leading shape
+    ``(n,) + `` the broadcast one (``pb.sample(m, wo, n=1 << 20)`` for one
+    ``wo`` of shape ``(3,)``); not with ``u``.
     Returns a :class:`Sample` of float32 ``wi``, ``pdf``, ``weight`` and int32 ``lobe``;
     with ``with_lobes=True``, ``(Sample, Lobes)``: each lobe's share of the weight,
     ``f_k(wi, wo) cos θl / pdf``, from the same pass (they sum to ``weight``).
@@ -398,7 +437,7 @@ def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disne
     layout = _layout(layout)
     thread_count = _threads(threads)
     isa_name = _isa(isa)
-    seed = seed_value(seed)
+    seed = _fresh_seed() if seed is None else seed_value(seed)
     check, with_lobes = flag("check", check), flag("with_lobes", with_lobes)
     wo_dirs = _Directions("wo", wo, layout)
     shapes = dict(wo=wo_dirs.leading, material=material.shape)
@@ -408,6 +447,13 @@ def sample(material: Material, wo, *, u=None, seed: int = 0, model: str = "disne
         require_in_domain("u", uniforms.given, 0.0, 1.0)  # the values as given, as pb.reference checks them
         shapes["u"] = uniforms.leading
     leading = broadcast_leading(**shapes)
+    if n is not None:
+        if u is not None:
+            raise ValueError("n: not with u (the uniforms give the number of samples)")
+        count = integer("n", n)
+        if count < 0:
+            raise ValueError(f"n: expected a count >= 0, got {count}")
+        leading = (count,) + leading  # n samples of every element
     n = _size(leading)
     wi_out = np.empty(_vec3_shape(leading, layout), np.float32)
     weight_out = np.empty_like(wi_out)

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from . import _core
-from ._validate import as_real_array, broadcast_leading, require_in_domain
+from ._validate import as_real_array, broadcast_leading, flag, require_in_domain
 
 
 class _ParamInfo:
@@ -45,9 +47,14 @@ class Material:
         sheen_tint=PARAMETERS["sheen_tint"].default,
         clearcoat=PARAMETERS["clearcoat"].default,
         clearcoat_gloss=PARAMETERS["clearcoat_gloss"].default,
+        *,
+        bright_base_color: bool = False,
     ):
         values = dict(locals())
         for name, info in PARAMETERS.items():
+            if name == "base_color" and isinstance(values[name], np.ndarray) and values[name].dtype == np.uint8:
+                raise TypeError("base_color: a uint8 colour (0-255) is not linear RGB; convert it explicitly, "
+                                "e.g. pb.srgb_to_linear(texture), which scales uint8 by 1/255")
             array = as_real_array(name, values[name])
             if info.slots == 3 and (array.ndim == 0 or array.shape[-1] != 3):
                 raise ValueError(f"{name}: expected an RGB triple, shape (3,) or (..., 3), got shape {array.shape}")
@@ -57,6 +64,10 @@ class Material:
             object.__setattr__(self, name, array)
         object.__setattr__(self, "_float32_cache", {})
         self.shape  # raises now if the parameters' shapes do not broadcast
+        if not flag("bright_base_color", bright_base_color) and self.base_color.size and self.base_color.max() > 1.0:
+            warnings.warn(f"base_color: {self.base_color.max():g} > 1 reflects more than it receives (a 0-255 or "
+                          "display-encoded colour?); pass bright_base_color=True if it is meant", BrightColorWarning,
+                          stacklevel=2)
 
     def __setattr__(self, name, value):
         raise AttributeError("Material is immutable; build a new one (or use Material.replace)")
@@ -82,7 +93,34 @@ class Material:
         unknown = set(changes) - set(PARAMETERS)
         if unknown:
             raise TypeError(f"unknown parameter(s): {', '.join(sorted(unknown))}")
-        return Material(**{**self.as_dict(), **changes})
+        # a bright base_color kept from self was reported when self was made
+        return Material(**{**self.as_dict(), **changes}, bright_base_color="base_color" not in changes)
+
+    def _per_element(self, transform) -> "Material":
+        """A material whose per-element parameters are ``transform(array broadcast to the
+        leading shape + its trailing shape, trailing ndim)``; uniform ones stay uniform."""
+        shape = self.shape
+        values = {}
+        for name, info in PARAMETERS.items():
+            array = getattr(self, name)
+            trailing = () if info.slots == 1 else (3,)
+            values[name] = array if array.shape == trailing else transform(np.broadcast_to(array, shape + trailing))
+        return Material(**values, bright_base_color=True)
+
+    def __getitem__(self, key) -> "Material":
+        """The material of some elements: ``m[i]``, ``m[2:5, ::2]``, ``m[mask]`` index the
+        leading shape, as numpy indexes an array of that shape."""
+        if self.shape == ():
+            raise IndexError("material: a uniform material has no elements to index")
+        if key is Ellipsis or (isinstance(key, tuple) and any(k is Ellipsis for k in key)):
+            raise IndexError("material: index the leading shape without Ellipsis")
+        np.empty(self.shape, dtype=np.int8)[key]  # numpy's IndexError for a bad key, before any copy
+        return self._per_element(lambda array: array[key])
+
+    def reshape(self, *shape) -> "Material":
+        """The same elements in a new leading shape (``m.reshape(-1)`` for flattened directions)."""
+        new_shape = np.empty(self.shape, dtype=np.int8).reshape(*shape).shape
+        return self._per_element(lambda array: array.reshape(new_shape + array.shape[len(self.shape):]))
 
     def as_dict(self) -> dict:
         return {name: getattr(self, name) for name in PARAMETERS}
@@ -105,7 +143,7 @@ class Material:
             start, end = getattr(a, name), getattr(b, name)
             w = weight[..., None] if info.slots == 3 else weight
             mixed[name] = start + (end - start) * w
-        return Material(**mixed)
+        return Material(**mixed, bright_base_color=True)  # no brighter than a or b
 
     def packed(self, leading_shape: tuple) -> np.ndarray:
         """All parameters broadcast to ``leading_shape`` as contiguous ``(N, 13)`` float64 rows."""
@@ -135,7 +173,7 @@ class Material:
 
     def __reduce__(self):
         # pickling (multiprocessing, dask): rebuild through __init__, which re-checks
-        return (Material, tuple(getattr(self, name) for name in PARAMETERS))
+        return (_rebuilt, tuple(getattr(self, name) for name in PARAMETERS))
 
     def __eq__(self, other):
         if not isinstance(other, Material):
@@ -155,6 +193,25 @@ class Material:
             else:
                 parts.append(f"{name}=<{array.shape} in [{array.min():g}, {array.max():g}]>")
         return "Material(" + ", ".join(parts) + ")"
+
+
+def _rebuilt(*values) -> Material:
+    return Material(*values, bright_base_color=True)
+
+
+class BrightColorWarning(UserWarning):
+    """A base_color above 1 without bright_base_color=True."""
+
+
+def srgb_to_linear(color):
+    """sRGB-encoded colour to linear RGB by the exact piecewise curve (IEC 61966-2-1):
+    ``c / 12.92`` for ``c <= 0.04045``, else ``((c + 0.055) / 1.055) ** 2.4``. A uint8
+    array is taken as 0-255 and scaled by 1/255 first; other values must lie in [0, 1]."""
+    if isinstance(color, np.ndarray) and color.dtype == np.uint8:
+        color = color / 255.0
+    array = as_real_array("color", color)
+    require_in_domain("color", array, 0.0, 1.0)
+    return np.where(array <= 0.04045, array / 12.92, ((array + 0.055) / 1.055) ** 2.4)
 
 
 def gamma22_to_linear(color):

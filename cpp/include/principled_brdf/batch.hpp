@@ -46,6 +46,7 @@ enum class Output : int {
     kLobes = 1,  // diffuse, sheen, specular, clearcoat
     kPdf = 2,    // the sampling pdf of (wi, wo)
     kGradient = 3,  // f and its Jacobian in the parameter slots
+    kValuePdf = 4,  // f and the sampling pdf of (wi, wo), in one pass
 };
 
 // The Jacobian's values per element: ∂f_c/∂p for the 3 channels c and the kParamSlots slots p.
@@ -96,7 +97,7 @@ struct EvalJob {
     // (a (3, 13, N) array).
     float* jacobian = nullptr;
     std::int64_t jacobian_row_stride = 0;
-    // Output::kPdf: one float per element, for this specular sampler.
+    // Output::kPdf and kValuePdf: one float per element, for this specular sampler.
     float* pdf = nullptr;
     SpecularSampler sampler = SpecularSampler::kVisibleNormals;
     // The direction check, fused into the evaluation. On a bad direction the

@@ -159,10 +159,9 @@ Gradient gradient_of(const GradientShading& prepared, const Vec3<double>& wi, co
     const Geometry<double> g = geometry_of(wi, wo);
     Gradient out;
     if (!above_surface(g)) return out;
-    const ValueGradient<double> v = f64::eval_gradient<model>(g, s, view_of<model>(wo, s), prepared.partials);
-    out.value = vector3d(v.value);
-    for (int c = 0; c < 3; ++c)
-        for (int p = 0; p < kParamSlots; ++p) out.jacobian(c, p) = v.jacobian[c][p];
+    out.value = vector3d(f64::eval_gradient<model>(g, s, view_of<model>(wo, s), prepared.partials,
+                                                   [](double x) { return x; },
+                                                   [&](int c, int p, double value) { out.jacobian(c, p) = value; }));
     return out;
 }
 

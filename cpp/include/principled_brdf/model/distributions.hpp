@@ -83,7 +83,8 @@ struct Ggx {
     // D ∝ (|H|²/s)² / (ax ay):  ax ∂ln D/∂ax = 4 tx / s - 1, ay ∂ln D/∂ay = 4 ty / s - 1
     PB_MODEL_INLINE LogAlphaPartials<F> log_d_partials(const HalfVector<F>& h) const {
         const F tx = h.hx2 * inv_alpha_x2, ty = h.hy2 * inv_alpha_y2;
-        const F inv_s = reciprocal(tx + ty + h.hz2);
+        // s as d() forms it, so that the two share one reciprocal
+        const F inv_s = reciprocal(mul_add(h.hx2, inv_alpha_x2, mul_add(h.hy2, inv_alpha_y2, h.hz2)));
         return {F(2.0) * (tx + ty - h.hz2) * inv_s, F(4.0) * (tx - ty) * inv_s};
     }
 
@@ -241,8 +242,8 @@ PB_MODEL_INLINE F log_smith_denominator_iso_partial(const Vec3<F>& w, F a2) {
 // GTR1 (Berry; GTR at γ = 1, Burley 2012 appendix B eq. 4), alpha in (0, 1):
 //   D(h) = (a² - 1) / (π ln a² (a² cos²θh + sin²θh))
 // drawn by eq. 5 as sin²θh = a² (a^(-2 u) - 1) / (1 - a²), cos²θh = (1 - a^(2 (1 - u))) / (1 - a²).
-// a² - 1 and 1 - a² are written e^L - 1 with L = ln a², which keeps their
-// digits as a -> 1; D's normaliser is 1/π at a = 1, the draw needs a < 1.
+// Near a = 1, a² - 1 is taken as e^L - 1 with L = ln a², which keeps its
+// digits; D's normaliser is 1/π at a = 1, the draw needs a < 1.
 template <class F>
 struct Gtr1 {
     F alpha2;                // a²
@@ -255,7 +256,9 @@ struct Gtr1 {
         Gtr1 d;
         d.alpha2 = alpha * alpha;
         d.log_alpha2 = log(d.alpha2);
-        const F alpha2_minus_1 = exp_minus_one(d.log_alpha2);
+        // a² - 1 itself keeps its digits while a² is small (the clearcoat's a <= 0.1, so
+        // the kernels never take e^L - 1); e^L - 1 keeps them as a -> 1
+        const F alpha2_minus_1 = all(d.alpha2 <= F(0.25)) ? d.alpha2 - F(1.0) : exp_minus_one(d.log_alpha2);
         d.inv_one_minus_alpha2 = -reciprocal(alpha2_minus_1);
         d.norm = F(kInvPi) * ratio_exp_minus_one(d.log_alpha2, alpha2_minus_1);
         d.sin2_scale = d.alpha2 * d.inv_one_minus_alpha2;

@@ -9,7 +9,9 @@
 // S (specular, from roughness and anisotropic) and C (clearcoat, linear in
 // clearcoat, through GTR1 in clearcoat_gloss). So the Jacobian is
 //   ∂f_c/∂p = ∂D/∂p dc_c + D ∂dc_c/∂p + FH ∂sc_c/∂p + ∂S/∂p ((1 - FH) f0_c + FH) + T ∂f0_c/∂p + ∂C/∂p:
-// the colours' partials are per-material constants (MaterialPartials), the
+// the colours' partials are per-material constants (MaterialPartials, only
+// the non-zero ones: Cspec0 and Csheen move with base_color through Ctint, the
+// diffuse colour only in its own channel), the
 // scalars' partials come from methods beside the lobes and distributions they
 // differentiate (diffuse_partials, SpecularLobe::log_value_partials,
 // ClearcoatLobe::unit_value, Gtr1::log_d_partial_alpha2, ...). Where the model
@@ -17,23 +19,28 @@
 // Ctint = 1 where lum(base_color) <= 0 has derivative 0.
 #pragma once  // (per namespace that includes the model)
 
-// ∂c/∂p of one colour c for every parameter slot p (zero where c does not depend on p).
 template <class F>
-struct ColourPartials {
-    Rgb<F> slot[kParamSlots];
-};
+PB_MODEL_INLINE F channel_of(const Rgb<F>& colour, int c) { return c == 0 ? colour.r : c == 1 ? colour.g : colour.b; }
 
-// The material's constants of the Jacobian: its colours' partials and the
-// partials of the roughnesses the lobes read.
+// The material's constants of the Jacobian: its colours' non-zero partials and
+// the partials of the roughnesses the lobes read.
 template <class F>
 struct MaterialPartials {
-    ColourPartials<F> diffuse, sheen, f0;
+    // base_color: ∂dc_c/∂base_k = δ_ck (1 - metallic)/π, ∂sc_c/∂base_k = sheen_tint_scale ∂Ctint_c/∂base_k,
+    // ∂f0_c/∂base_k = δ_ck metallic + specular_tint_scale ∂Ctint_c/∂base_k
+    F dielectric_over_pi, metallic;
+    F sheen_tint_scale;     // sheen (1 - metallic) sheen_tint
+    F specular_tint_scale;  // (1 - metallic) 0.08 specular specular_tint
+    F tint_base[3][3];      // ∂Ctint_c/∂base_k = (δ_ck - Ctint_c w_k) / lum, 0 where Ctint = 1
+    Rgb<F> diffuse_metallic, sheen_metallic, f0_metallic;  // ∂dc, ∂sc, ∂f0 / ∂metallic
+    Rgb<F> f0_specular, f0_specular_tint;                  // ∂f0/∂specular, ∂f0/∂specular_tint
+    Rgb<F> sheen_sheen, sheen_sheen_tint;                  // ∂sc/∂sheen, ∂sc/∂sheen_tint
     // (∂ln ax/∂p ± ∂ln ay/∂p) / 2 for p = roughness, anisotropic (0 for an alpha its clamp holds):
     // what multiplies LogAlphaPartials' sum and difference
     F roughness_sum, roughness_difference;
     F anisotropic_sum, anisotropic_difference;
-    F alpha_g2_roughness;                        // ∂alpha_g²/∂roughness (the 2012 model's Smith term)
-    F clearcoat_alpha2_gloss;                    // ∂ac²/∂clearcoat_gloss
+    F alpha_g2_roughness;      // ∂alpha_g²/∂roughness (the 2012 model's Smith term)
+    F clearcoat_alpha2_gloss;  // ∂ac²/∂clearcoat_gloss
 };
 
 template <class F>
@@ -44,41 +51,33 @@ PB_MODEL_INLINE MaterialPartials<F> material_partials_of(const F* p) {
     const F luminance = luminance_of(base);
     const MaskOf<F> has_luminance = luminance > zero;
     const F inv_luminance = reciprocal(select(has_luminance, luminance, one));
-    const F tint_of[3] = {select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
-                          select(has_luminance, base.b * inv_luminance, one)};
+    const Rgb<F> tint{select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
+                      select(has_luminance, base.b * inv_luminance, one)};
     const F weight_of[3] = {F(0.3), F(0.6), F(0.1)};  // lum's weights
-    // ∂Ctint_c/∂base_k = (δ_ck - Ctint_c w_k) / lum, 0 where Ctint = 1
-    auto tint_partial = [&](int c, int k) {
-        const F delta = c == k ? one : zero;
-        return select(has_luminance, neg_mul_add(tint_of[c], weight_of[k], delta) * inv_luminance, zero);
-    };
-    auto channel = [](Rgb<F>& colour, int c) -> F& { return c == 0 ? colour.r : c == 1 ? colour.g : colour.b; };
-
-    MaterialPartials<F> d{};
-    for (int s = 0; s < kParamSlots; ++s) d.diffuse.slot[s] = d.sheen.slot[s] = d.f0.slot[s] = {zero, zero, zero};
     const F sheen = p[kSheen], sheen_tint = p[kSheenTint];
     const F specular_scale = F(0.08) * p[kSpecular], specular_tint = p[kSpecularTint];
-    for (int c = 0; c < 3; ++c) {
-        const F base_c = c == 0 ? base.r : c == 1 ? base.g : base.b;
-        const F sheen_mix = mix(one, tint_of[c], sheen_tint);     // Csheen_c
-        const F specular_mix = mix(one, tint_of[c], specular_tint);
-        // dc_c = (1 - metallic) base_c / π
-        channel(d.diffuse.slot[kBaseColorR + c], c) = dielectric * F(kInvPi);
-        channel(d.diffuse.slot[kMetallic], c) = -base_c * F(kInvPi);
-        // sc_c = sheen (1 - metallic) Csheen_c
+    const Rgb<F> white{one, one, one};
+    const Rgb<F> sheen_mix = mix(white, tint, sheen_tint);        // Csheen
+    const Rgb<F> specular_mix = mix(white, tint, specular_tint);  // mix(1, Ctint, specular_tint)
+    const Rgb<F> tint_minus_one{tint.r - one, tint.g - one, tint.b - one};
+
+    MaterialPartials<F> d;
+    d.dielectric_over_pi = dielectric * F(kInvPi);
+    d.metallic = metallic;
+    d.sheen_tint_scale = sheen * dielectric * sheen_tint;
+    d.specular_tint_scale = dielectric * specular_scale * specular_tint;
+    for (int c = 0; c < 3; ++c)
         for (int k = 0; k < 3; ++k)
-            channel(d.sheen.slot[kBaseColorR + k], c) = sheen * dielectric * sheen_tint * tint_partial(c, k);
-        channel(d.sheen.slot[kMetallic], c) = -sheen * sheen_mix;
-        channel(d.sheen.slot[kSheen], c) = dielectric * sheen_mix;
-        channel(d.sheen.slot[kSheenTint], c) = sheen * dielectric * (tint_of[c] - one);
-        // f0_c = metallic base_c + (1 - metallic) 0.08 specular mix(1, Ctint_c, specular_tint)
-        for (int k = 0; k < 3; ++k)
-            channel(d.f0.slot[kBaseColorR + k], c) =
-                    mul_add(dielectric * specular_scale * specular_tint, tint_partial(c, k), c == k ? metallic : zero);
-        channel(d.f0.slot[kMetallic], c) = neg_mul_add(specular_scale, specular_mix, base_c);
-        channel(d.f0.slot[kSpecular], c) = dielectric * F(0.08) * specular_mix;
-        channel(d.f0.slot[kSpecularTint], c) = dielectric * specular_scale * (tint_of[c] - one);
-    }
+            d.tint_base[c][k] = select(has_luminance, neg_mul_add(channel_of(tint, c), weight_of[k], c == k ? one : zero) *
+                                                              inv_luminance, zero);
+    d.diffuse_metallic = F(-kInvPi) * base;
+    d.sheen_metallic = -sheen * sheen_mix;
+    d.f0_metallic = {neg_mul_add(specular_scale, specular_mix.r, base.r), neg_mul_add(specular_scale, specular_mix.g, base.g),
+                     neg_mul_add(specular_scale, specular_mix.b, base.b)};
+    d.f0_specular = (dielectric * F(0.08)) * specular_mix;
+    d.f0_specular_tint = (dielectric * specular_scale) * tint_minus_one;
+    d.sheen_sheen = dielectric * sheen_mix;
+    d.sheen_sheen_tint = (sheen * dielectric) * tint_minus_one;
 
     // ax = max(0.001, r² / aspect), ay = max(0.001, r² aspect), aspect = sqrt(1 - 0.9 anisotropic):
     // ∂ln ax/∂r = ∂ln ay/∂r = 2 / r, ∂ln ax/∂anisotropic = -∂ln ay/∂anisotropic = 0.45 / aspect²
@@ -115,17 +114,16 @@ PB_MODEL_INLINE F one_minus_schlick_weight(const Geometry<F>& g) {
     return min(max(g.cos_theta_d, zero), one) * mul_add(m, mul_add(m, mul_add(m, m + one, one), one), one);
 }
 
-// f (per channel, as eval_lobes(...).total) and its Jacobian, jacobian[c][p] = ∂f_c/∂p.
-template <class F>
-struct ValueGradient {
-    Rgb<F> value;
-    F jacobian[3][kParamSlots];
-};
-
-template <Model model, class F>
-PB_MODEL_INLINE ValueGradient<F> eval_gradient(const Geometry<F>& g, const Shading<F>& s, const View<F>& view,
-                                               const MaterialPartials<F>& d) {
-    const F one(1.0);
+// f (per channel, as eval_lobes(...).total), returned, and its Jacobian, given
+// to `jacobian(c, p, value)` for every channel c and slot p: the kernels store
+// each value as it comes instead of holding 39 of them. Every Jacobian entry
+// is a sum of products of a per-material constant with one of nine scalars of
+// the pair; `weigh` is applied to those scalars (the kernels: times cos θl
+// if asked, 0 below the surface, where they may not be finite), so the 39
+// entries need no masking of their own.
+template <Model model, class F, class Weigh, class Sink>
+PB_MODEL_INLINE Rgb<F> eval_gradient(const Geometry<F>& g, const Shading<F>& s, const View<F>& view,
+                                     const MaterialPartials<F>& d, const Weigh& weigh, Sink&& jacobian) {
     const LobeValues<F> lobes = eval_lobes<model>(g, s, view);
     const F fh = lobes.fh, one_minus_fh = one_minus_schlick_weight(g);
     // D, S, C per unit clearcoat, with their partials
@@ -136,28 +134,39 @@ PB_MODEL_INLINE ValueGradient<F> eval_gradient(const Geometry<F>& g, const Shadi
         log_specular_roughness = mul_add(s.specular.log_value_partial_alpha_g2(g), d.alpha_g2_roughness, log_specular_roughness);
     const F log_specular_anisotropic =
             mul_add(log_specular.sum, d.anisotropic_sum, log_specular.difference * d.anisotropic_difference);
-    const F specular_roughness = lobes.specular * log_specular_roughness;
-    const F specular_anisotropic = lobes.specular * log_specular_anisotropic;
-    const F clearcoat_unit = s.clearcoat.unit_value(g, fh);
-    const F clearcoat_gloss = F(4.0) * s.clearcoat.lobe_weight * clearcoat_unit *
-                              s.clearcoat.gtr1.log_d_partial_alpha2(g) * d.clearcoat_alpha2_gloss;
+    const F clearcoat_unit_raw = s.clearcoat.unit_value(g, fh);
+    const F clearcoat_gloss = weigh(F(4.0) * s.clearcoat.lobe_weight * clearcoat_unit_raw *
+                                    s.clearcoat.gtr1.log_d_partial_alpha2(g) * d.clearcoat_alpha2_gloss);
+    // the weighed scalars (fh and 1 - fh stay as they are inside specular_factor, a finite factor)
+    const F specular_roughness = weigh(lobes.specular * log_specular_roughness);
+    const F specular_anisotropic = weigh(lobes.specular * log_specular_anisotropic);
+    const F clearcoat_unit = weigh(clearcoat_unit_raw);
+    const F diffuse_value = weigh(lobes.diffuse), diffuse_roughness = weigh(diffuse.roughness);
+    const F diffuse_subsurface = weigh(diffuse.subsurface), fh_weighed = weigh(fh);
+    const F specular_tinted = weigh(lobes.specular * one_minus_fh);  // T
 
-    const F specular_tinted = lobes.specular * one_minus_fh;  // T
-    const Rgb<F> dc = s.diffuse.color, f0 = s.specular.f0;
-    ValueGradient<F> out;
-    out.value = lobes.total(s);
+    // base_color: ∂f_c/∂base_k = δ_ck (D (1 - metallic)/π + T metallic) + (FH sheen_tint_scale + T specular_tint_scale) ∂Ctint_c/∂base_k
+    const F own_channel = mul_add(diffuse_value, d.dielectric_over_pi, specular_tinted * d.metallic);
+    const F through_tint = mul_add(fh_weighed, d.sheen_tint_scale, specular_tinted * d.specular_tint_scale);
     for (int c = 0; c < 3; ++c) {
-        auto at = [c](const Rgb<F>& colour) { return c == 0 ? colour.r : c == 1 ? colour.g : colour.b; };
-        F* row = out.jacobian[c];
-        // the colours' parameters: D ∂dc + FH ∂sc + T ∂f0
-        for (int p : {kBaseColorR, kBaseColorG, kBaseColorB, kMetallic, kSpecular, kSpecularTint, kSheen, kSheenTint})
-            row[p] = mul_add(lobes.diffuse, at(d.diffuse.slot[p]), mul_add(fh, at(d.sheen.slot[p]), specular_tinted * at(d.f0.slot[p])));
-        const F specular_factor = mul_add(one_minus_fh, at(f0), fh);  // ∂f_c/∂S = (1 - FH) f0_c + FH
-        row[kSubsurface] = diffuse.subsurface * at(dc);
-        row[kRoughness] = mul_add(diffuse.roughness, at(dc), specular_roughness * specular_factor);
-        row[kAnisotropic] = specular_anisotropic * specular_factor;
-        row[kClearcoat] = clearcoat_unit;
-        row[kClearcoatGloss] = clearcoat_gloss;
+        const F dc = channel_of(s.diffuse.color, c), f0 = channel_of(s.specular.f0, c);
+        for (int k = 0; k < 3; ++k) {
+            const F tinted = through_tint * d.tint_base[c][k];
+            jacobian(c, kBaseColorR + k, c == k ? own_channel + tinted : tinted);
+        }
+        jacobian(c, kMetallic,
+                 mul_add(diffuse_value, channel_of(d.diffuse_metallic, c),
+                         mul_add(fh_weighed, channel_of(d.sheen_metallic, c), specular_tinted * channel_of(d.f0_metallic, c))));
+        jacobian(c, kSubsurface, diffuse_subsurface * dc);
+        jacobian(c, kSpecular, specular_tinted * channel_of(d.f0_specular, c));
+        jacobian(c, kSpecularTint, specular_tinted * channel_of(d.f0_specular_tint, c));
+        const F specular_factor = mul_add(one_minus_fh, f0, fh);  // ∂f_c/∂S = (1 - FH) f0_c + FH
+        jacobian(c, kRoughness, mul_add(diffuse_roughness, dc, specular_roughness * specular_factor));
+        jacobian(c, kAnisotropic, specular_anisotropic * specular_factor);
+        jacobian(c, kSheen, fh_weighed * channel_of(d.sheen_sheen, c));
+        jacobian(c, kSheenTint, fh_weighed * channel_of(d.sheen_sheen_tint, c));
+        jacobian(c, kClearcoat, clearcoat_unit);
+        jacobian(c, kClearcoatGloss, clearcoat_gloss);
     }
-    return out;
+    return lobes.total(s);
 }

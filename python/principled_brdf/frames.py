@@ -1,0 +1,70 @@
+"""Directions and shading frames (README "Directions"), float64, vectorised.
+
+The library's directions live in a local shading frame: normal z, tangent x
+(the alpha_x axis), bitangent y. These helpers build such frames from
+normals (and tangents) and move directions between world and local
+coordinates; angles are in radians.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _validate
+from .measured import half_diff_to_wiwo, wiwo_to_half_diff
+
+__all__ = ["spherical_to_direction", "direction_to_spherical", "frame_from_normal", "to_local", "to_world",
+           "wiwo_to_half_diff", "half_diff_to_wiwo"]
+
+
+def spherical_to_direction(theta, phi=0.0) -> np.ndarray:
+    """(sin θ cos φ, sin θ sin φ, cos θ) ``(..., 3)``: θ from the normal, φ from the tangent."""
+    theta, phi = np.broadcast_arrays(np.asarray(_validate.as_real_array("theta", theta), dtype=np.float64),
+                                     np.asarray(_validate.as_real_array("phi", phi), dtype=np.float64))
+    sin_theta = np.sin(theta)
+    return np.stack([sin_theta * np.cos(phi), sin_theta * np.sin(phi), np.cos(theta)], axis=-1)
+
+
+def direction_to_spherical(w) -> tuple:
+    """(θ, φ) of unit directions ``(..., 3)``: θ in [0, π] (by atan2, accurate near the
+    normal), φ in (-π, π]."""
+    w = _validate.directions("w", w)
+    return np.arctan2(np.hypot(w[..., 0], w[..., 1]), w[..., 2]), np.arctan2(w[..., 1], w[..., 0])
+
+
+def frame_from_normal(normal, tangent=None) -> np.ndarray:
+    """Orthonormal frames ``(..., 3, 3)`` whose rows are (tangent, bitangent, normal).
+
+    Without ``tangent``, the tangent is the branchless construction of Duff et
+    al. 2017 ("Building an Orthonormal Basis, Revisited"), continuous except
+    across n.z = 0's sign change; with one, the tangent is its part
+    orthogonal to the normal (Gram-Schmidt), so anisotropic materials follow it."""
+    n = _validate.directions("normal", normal)
+    if tangent is None:
+        sign = np.where(n[..., 2] >= 0.0, 1.0, -1.0)
+        a = -1.0 / (sign + n[..., 2])
+        b = n[..., 0] * n[..., 1] * a
+        t = np.stack([1.0 + sign * n[..., 0] ** 2 * a, sign * b, -sign * n[..., 0]], axis=-1)
+    else:
+        t = np.asarray(_validate.as_real_array("tangent", tangent), dtype=np.float64)
+        t, n = np.broadcast_arrays(t, n)
+        t = t - np.sum(t * n, axis=-1, keepdims=True) * n
+        length = np.linalg.norm(t, axis=-1, keepdims=True)
+        if np.any(~(length > 1e-12)):
+            raise ValueError("tangent: parallel to the normal (or zero, or not finite) at element "
+                             f"{_validate.first_true(~(length > 1e-12).reshape(-1))}")
+        t = t / length
+    bitangent = np.cross(n, t)
+    return np.stack(np.broadcast_arrays(t, bitangent, n), axis=-2)
+
+
+def to_local(w, frame) -> np.ndarray:
+    """World directions ``(..., 3)`` in the frames ``(..., 3, 3)`` of :func:`frame_from_normal`."""
+    w = np.asarray(_validate.as_real_array("w", w), dtype=np.float64)
+    return np.einsum("...ij,...j->...i", np.asarray(frame, dtype=np.float64), w)
+
+
+def to_world(w, frame) -> np.ndarray:
+    """Local directions ``(..., 3)`` back to world coordinates (the frames' transpose)."""
+    w = np.asarray(_validate.as_real_array("w", w), dtype=np.float64)
+    return np.einsum("...ji,...j->...i", np.asarray(frame, dtype=np.float64), w)

@@ -1,0 +1,194 @@
+"""Measured BRDFs in the MERL format (Matusik et al. 2003), README "Measured data".
+
+A MERL file holds three int32 dimensions (90, 90, 180) for (θh, θd, φd) and
+then three blocks (red, green, blue) of 90 · 90 · 180 float64 values, cell
+``(i_θh · 90 + i_θd) · 180 + i_φd``; a stored value times its channel's scale
+(1/1500, 1.15/1500, 1.66/1500) is f in 1/sr, and a negative value marks a
+cell without data. The indices:
+
+    i_θh = floor(sqrt(θh / (π/2)) · 90)   (finer near the specular peak)
+    i_θd = floor(θd / (π/2) · 90)
+    i_φd = floor(φd / π · 180),  φd folded into [0, π) by reciprocity (φd >= π -> φd - π)
+
+each clamped to its range; (θh, φh, θd, φd) are Rusinkiewicz's half and
+difference angles (``wiwo_to_half_diff``). All arrays here are float64.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from . import _validate
+
+__all__ = ["MerlBRDF", "load_merl", "save_merl", "merl_pairs", "wiwo_to_half_diff", "half_diff_to_wiwo",
+           "MERL_SHAPE", "MERL_SCALE"]
+
+MERL_SHAPE = (90, 90, 180)  # (θh, θd, φd) cells
+MERL_SCALE = np.array([1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0])  # stored value x scale = f in 1/sr
+_CELLS = MERL_SHAPE[0] * MERL_SHAPE[1] * MERL_SHAPE[2]
+_HEADER_BYTES = 3 * 4
+_FILE_BYTES = _HEADER_BYTES + 3 * _CELLS * 8
+_HALF_PI = 0.5 * np.pi
+
+
+def _rotate_z(v: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1], v[..., 2]], axis=-1)
+
+
+def _rotate_y(v: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]], axis=-1)
+
+
+def wiwo_to_half_diff(wi, wo) -> tuple:
+    """Rusinkiewicz's angles (θh, φh, θd, φd) of unit directions ``(..., 3)``:
+    h = normalize(wi + wo) at (θh, φh), and wi in the frame of h (rotated by
+    -φh about n, then by -θh about the bitangent) at (θd, φd); φ in (-π, π]."""
+    wi = _validate.directions("wi", wi).astype(np.float64)
+    wo = _validate.directions("wo", wo).astype(np.float64)
+    wi, wo = np.broadcast_arrays(wi, wo)
+    half = wi + wo
+    half = half / np.linalg.norm(half, axis=-1, keepdims=True)
+    # polar angles by atan2, which keeps its digits near 0 where arccos does not
+    theta_h = np.arctan2(np.hypot(half[..., 0], half[..., 1]), half[..., 2])
+    phi_h = np.arctan2(half[..., 1], half[..., 0])
+    diff = _rotate_y(_rotate_z(wi, -phi_h), -theta_h)
+    theta_d = np.arctan2(np.hypot(diff[..., 0], diff[..., 1]), diff[..., 2])
+    phi_d = np.arctan2(diff[..., 1], diff[..., 0])
+    return theta_h, phi_h, theta_d, phi_d
+
+
+def half_diff_to_wiwo(theta_h, phi_h, theta_d, phi_d) -> tuple:
+    """(wi, wo) ``(..., 3)`` from Rusinkiewicz's angles, the inverse of :func:`wiwo_to_half_diff`."""
+    theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64)
+                                                            for a in (theta_h, phi_h, theta_d, phi_d)))
+    diff = np.stack([np.sin(theta_d) * np.cos(phi_d), np.sin(theta_d) * np.sin(phi_d), np.cos(theta_d)], axis=-1)
+    half = np.stack([np.sin(theta_h) * np.cos(phi_h), np.sin(theta_h) * np.sin(phi_h), np.cos(theta_h)], axis=-1)
+    wi = _rotate_z(_rotate_y(diff, theta_h), phi_h)
+    wo = 2.0 * np.sum(wi * half, axis=-1, keepdims=True) * half - wi
+    return wi, wo
+
+
+def _cell_coordinates(theta_h, theta_d, phi_d) -> tuple:
+    """Continuous cell coordinates (cell i spans [i, i + 1)), φd folded into [0, π)."""
+    phi_d = np.where(phi_d < 0.0, phi_d + 2.0 * np.pi, phi_d)
+    phi_d = np.where(phi_d >= np.pi, phi_d - np.pi, phi_d)
+    x_h = np.sqrt(np.clip(theta_h, 0.0, None) / _HALF_PI) * MERL_SHAPE[0]
+    x_d = theta_d / _HALF_PI * MERL_SHAPE[1]
+    x_p = phi_d / np.pi * MERL_SHAPE[2]
+    return x_h, x_d, x_p
+
+
+def _indices(theta_h, theta_d, phi_d) -> tuple:
+    coordinates = _cell_coordinates(theta_h, theta_d, phi_d)
+    return tuple(np.clip(np.floor(x).astype(np.int64), 0, size - 1) for x, size in zip(coordinates, MERL_SHAPE))
+
+
+def _centres() -> tuple:
+    """(θh, θd, φd) at the centre of every cell, each ``MERL_SHAPE``."""
+    i_h, i_d, i_p = np.meshgrid(*(np.arange(size) + 0.5 for size in MERL_SHAPE), indexing="ij")
+    theta_h = (i_h / MERL_SHAPE[0]) ** 2 * _HALF_PI
+    return theta_h, i_d / MERL_SHAPE[1] * _HALF_PI, i_p / MERL_SHAPE[2] * np.pi
+
+
+def merl_pairs() -> tuple:
+    """(wi, wo), each ``(90 · 90 · 180, 3)``, at the cells' centres in the file's
+    order (φh = 0): the pairs to evaluate a model at, or to fit one to a
+    table's :meth:`MerlBRDF.values`. Some lie below the horizon (θh + θd > 90°)."""
+    theta_h, theta_d, phi_d = _centres()
+    wi, wo = half_diff_to_wiwo(theta_h.reshape(-1), 0.0, theta_d.reshape(-1), phi_d.reshape(-1))
+    return wi, wo
+
+
+class MerlBRDF:
+    """A MERL table: ``table`` ``(3, 90, 90, 180)`` of f in 1/sr, NaN where there is no data."""
+
+    def __init__(self, table):
+        table = np.array(table, dtype=np.float64)
+        if table.shape != (3,) + MERL_SHAPE:
+            raise ValueError(f"table: expected shape {(3,) + MERL_SHAPE} (channel, θh, θd, φd), got {table.shape}")
+        self.table = table
+
+    def values(self) -> np.ndarray:
+        """f ``(90 · 90 · 180, 3)`` in :func:`merl_pairs`' order, NaN where missing."""
+        return self.table.reshape(3, -1).T.copy()
+
+    def eval(self, wi, wo, interpolation: str = "nearest") -> np.ndarray:
+        """f(wi, wo) ``(..., 3)`` in 1/sr from the table: the cell the format's indices name
+        (``"nearest"``), or trilinear between cell centres (``"linear"``, φd periodic with
+        period π, the other axes clamped). NaN where a cell used has no data; 0 where wi or
+        wo lies at or below the horizon."""
+        if interpolation not in ("nearest", "linear"):
+            raise ValueError(f"interpolation: expected 'nearest' or 'linear', got {interpolation!r}")
+        theta_h, _, theta_d, phi_d = wiwo_to_half_diff(wi, wo)
+        wi = np.asarray(wi, dtype=np.float64)
+        wo = np.asarray(wo, dtype=np.float64)
+        above = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
+        if interpolation == "nearest":
+            i_h, i_d, i_p = _indices(theta_h, theta_d, phi_d)
+            f = np.moveaxis(self.table[:, i_h, i_d, i_p], 0, -1)
+        else:
+            f = self._trilinear(*_cell_coordinates(theta_h, theta_d, phi_d))
+        return np.where(above[..., None], f, 0.0)
+
+    def _trilinear(self, x_h, x_d, x_p) -> np.ndarray:
+        result = 0.0
+        corners = []
+        for x, size, periodic in ((x_h, MERL_SHAPE[0], False), (x_d, MERL_SHAPE[1], False), (x_p, MERL_SHAPE[2], True)):
+            position = x - 0.5  # centres sit at i + 0.5
+            low = np.floor(position)
+            weight = position - low
+            low = low.astype(np.int64)
+            high = low + 1
+            if periodic:
+                low, high = low % size, high % size
+            else:
+                low, high = np.clip(low, 0, size - 1), np.clip(high, 0, size - 1)
+            corners.append(((low, 1.0 - weight), (high, weight)))
+        for index_h, weight_h in corners[0]:
+            for index_d, weight_d in corners[1]:
+                for index_p, weight_p in corners[2]:
+                    cell = np.moveaxis(self.table[:, index_h, index_d, index_p], 0, -1)
+                    result = result + (weight_h * weight_d * weight_p)[..., None] * cell
+        return result
+
+
+def load_merl(path) -> MerlBRDF:
+    """Reads a MERL ``.binary`` file. A file of the wrong size or header is a ValueError saying what was expected."""
+    size = os.path.getsize(path)
+    with open(path, "rb") as f:
+        header = np.fromfile(f, dtype="<i4", count=3)
+        if header.size != 3 or tuple(int(v) for v in header) != MERL_SHAPE:
+            raise ValueError(f"{path}: expected a MERL header of three int32 dimensions {MERL_SHAPE}, "
+                             f"got {tuple(int(v) for v in header)}")
+        if size != _FILE_BYTES:
+            raise ValueError(f"{path}: expected {_FILE_BYTES} bytes (a 12-byte header and 3 x {_CELLS} float64), "
+                             f"got {size}")
+        stored = np.fromfile(f, dtype="<f8", count=3 * _CELLS).reshape((3,) + MERL_SHAPE)
+    table = stored * MERL_SCALE[:, None, None, None]
+    table[stored < 0.0] = np.nan
+    return MerlBRDF(table)
+
+
+def save_merl(path, brdf) -> None:
+    """Writes a MERL ``.binary`` file: ``brdf`` a :class:`MerlBRDF`, or any callable
+    ``f(wi, wo) -> (..., 3)`` in 1/sr (e.g. ``lambda wi, wo: pb.reference.eval(m, wi, wo)``),
+    evaluated at the cells' centres. NaN (missing) is written as -1."""
+    if isinstance(brdf, MerlBRDF):
+        table = brdf.table
+    elif callable(brdf):
+        wi, wo = merl_pairs()
+        values = np.asarray(brdf(wi, wo), dtype=np.float64)
+        if values.shape != (_CELLS, 3):
+            raise ValueError(f"brdf: expected the callable to return ({_CELLS}, 3) values, got {values.shape}")
+        table = values.T.reshape((3,) + MERL_SHAPE)
+    else:
+        raise TypeError(f"brdf: expected a MerlBRDF or a callable f(wi, wo), got {type(brdf).__name__}")
+    stored = table / MERL_SCALE[:, None, None, None]
+    stored = np.where(np.isnan(stored), -1.0, stored)
+    with open(path, "wb") as f:
+        np.asarray(MERL_SHAPE, dtype="<i4").tofile(f)
+        stored.astype("<f8").tofile(f)
