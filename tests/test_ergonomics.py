@@ -121,3 +121,52 @@ def test_frames_and_spherical_angles():
     wo_world = wo_world / np.linalg.norm(wo_world, axis=-1, keepdims=True)
     f = pb.reference.eval(m, frames.to_local(wi_world, frame[3:]), frames.to_local(wo_world, frame[3:]))
     assert np.all(np.isfinite(f)) and np.any(f > 0)
+
+
+def test_one_signature_for_the_simd_and_reference_calls():
+    rng = np.random.default_rng(4)
+    wi = rng.normal(size=(50, 3))
+    wi[:, 2] = np.abs(wi[:, 2])
+    wi /= np.linalg.norm(wi, axis=-1, keepdims=True)
+    wo = np.roll(wi, 1, axis=0)
+    m = pb.presets.get("car_paint")
+    for call in (pb.reference.eval, pb.reference.pdf):
+        np.testing.assert_array_equal(call(m, wi.T, wo.T, layout="soa"), np.moveaxis(call(m, wi, wo), -1, 0)
+                                      if call is pb.reference.eval else call(m, wi, wo))
+    lobes = pb.reference.eval_lobes(m, wi.T, wo.T, layout="soa")
+    np.testing.assert_array_equal(lobes.specular, pb.reference.eval_lobes(m, wi, wo).specular.T)
+    grad = pb.reference.eval_grad(m, wi.T, wo.T, layout="soa")
+    assert grad.jacobian.shape == (3, 13, 50)
+    np.testing.assert_array_equal(grad.jacobian, np.moveaxis(pb.reference.eval_grad(m, wi, wo).jacobian, 0, -1))
+    u = rng.random((50, 3))
+    s_soa, s_aos = pb.reference.sample(m, wo.T, u.T, layout="soa"), pb.reference.sample(m, wo, u)
+    np.testing.assert_array_equal(s_soa.wi, s_aos.wi.T)
+    np.testing.assert_array_equal(s_soa.pdf, s_aos.pdf)
+    wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
+    np.testing.assert_array_equal(pb.pdf(m, wi32, wo32, model="disney2012"), pb.pdf(m, wi32, wo32))
+    with pytest.raises(ValueError, match="model"):
+        pb.pdf(m, wi32, wo32, model="disney2099")
+    with pytest.raises(ValueError, match="layout: expected 'aos' or 'soa'"):
+        pb.reference.eval(m, wi, wo, layout="aosoa")
+    with pytest.raises(ValueError, match=r"wi: expected shape \(3, ...\) with layout='soa'"):
+        pb.reference.eval(m, wi, wo, layout="soa")
+
+
+def test_tone_mapping_keeps_hue_and_shading():
+    from principled_brdf import render
+    rng = np.random.default_rng(8)
+    hdr = rng.uniform(0, 1, (200, 3)) * rng.uniform(0, 20, (200, 1))
+    display = render.tone_map(hdr)
+    assert display.min() >= 0.0 and display.max() <= 1.0
+    # hue: the channel ratios survive (no per-channel clipping)
+    np.testing.assert_allclose(display / display.sum(-1, keepdims=True), hdr / hdr.sum(-1, keepdims=True), rtol=1e-12)
+    grey = np.linspace(0.0, 3.9, 100)[:, None] * np.ones(3)
+    mapped = render.tone_map(grey)[:, 0]
+    assert np.all(np.diff(mapped) > 0)  # bright greys stay distinguishable below white
+    assert render.tone_map(np.full(3, render.REINHARD_WHITE))[0] == pytest.approx(1.0)
+    np.testing.assert_array_equal(render.tone_map(hdr, curve="clip"), np.clip(hdr, 0, 1))
+    gold = np.array([8.0, 5.0, 1.0])  # a bright gold highlight stays gold, not white
+    g = render.tone_map(gold)
+    assert g[0] == pytest.approx(1.0) and g[2] < 0.2
+    with pytest.raises(ValueError, match="curve: expected one of reinhard, clip"):
+        render.tone_map(hdr, curve="aces")

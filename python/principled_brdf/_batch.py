@@ -356,11 +356,13 @@ def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014"
     return Gradient(value, selected, tuple(GRADIENT_NAMES[k] for k in wanted))
 
 
-def pdf(material: Material, wi, wo, *, specular_sampler: str = "visible", layout: str = "aos", threads=None,
-        check: bool = True, isa=None) -> np.ndarray:
+def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampler: str = "visible",
+        layout: str = "aos", threads=None, check: bool = True, isa=None) -> np.ndarray:
     """The density (solid angle) with which :func:`sample` draws ``wi`` given ``wo``:
     the lobe mixture of README "Sampling and pdf", float32 ``(...)``; 0 when
-    either direction is at or below the horizon. It does not depend on the model."""
+    either direction is at or below the horizon. It does not depend on the model
+    (``model`` is checked and accepted, as every call takes it)."""
+    model_index(model)
     (density,) = _evaluate(material, wi, wo, 0, False, layout, threads, check, isa,
                            lambda leading, layout: [np.empty(leading, np.float32)],
                            pdf_sampler=sampler_index(specular_sampler))

@@ -241,7 +241,7 @@ def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel:
             scale = np.divide(level, luminance, out=np.zeros_like(luminance), where=luminance > 0.0)
             color = f * scale[..., None]
         else:
-            color = _render.to_srgb8(f / top).astype(np.float64) / 255.0
+            color = _render.to_srgb8(f / top, curve="clip").astype(np.float64) / 255.0  # f scaled to [0, 1] already
         color = color / np.maximum(1.0, color.max(axis=-1, keepdims=True))  # keep the hue where it clips
         image = np.empty(color.shape[:-1] + (4,))
         image[..., :3] = np.where(valid[..., None], color, colors.to_rgb(_BACKGROUND))

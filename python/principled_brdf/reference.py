@@ -14,6 +14,33 @@ from .material import Material
 __all__ = ["eval", "eval_lobes", "eval_grad", "Lobes", "Gradient", "sample", "pdf", "lobe_probabilities", "Sample"]
 
 
+_LAYOUTS = ("aos", "soa")
+
+
+def _layout(layout) -> bool:
+    """True for "soa" ((3, ...) arrays, as the SIMD calls take them), False for "aos"."""
+    if layout not in _LAYOUTS:
+        raise ValueError(f"layout: expected 'aos' or 'soa', got {layout!r}")
+    return layout == "soa"
+
+
+def _as_aos(name: str, value, soa: bool):
+    """A 3-vector argument with its components last: ``(3, ...)`` moved for layout="soa"."""
+    if not soa:
+        return value
+    array = _validate.as_real_array(name, value)
+    if array.ndim == 0 or array.shape[0] != 3:
+        raise ValueError(f"{name}: expected shape (3, ...) with layout='soa', got {array.shape}")
+    return np.moveaxis(array, 0, -1)
+
+
+def _as_layout(array: np.ndarray, soa: bool, trailing: int = 1) -> np.ndarray:
+    """A result with its ``trailing`` last axes moved to the front for layout="soa"."""
+    if not soa:
+        return array
+    return np.ascontiguousarray(np.moveaxis(array, tuple(range(-trailing, 0)), tuple(range(trailing))))
+
+
 def _prepare(material, wi, wo, model):
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
@@ -25,23 +52,32 @@ def _prepare(material, wi, wo, model):
     return shape, rows(wi), rows(wo), _material_rows(material, shape), model_id
 
 
-def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False) -> np.ndarray:
-    """f(wi, wo) in 1/sr as float64 ``(..., 3)``; times cos θl if ``cosine``."""
-    shape, wi_rows, wo_rows, params, model_id = _prepare(material, wi, wo, model)
+# The functions here take the SIMD calls' options where they apply (model,
+# cosine, layout, specular_sampler); threads, out, check and isa do not: the
+# reference is one float64 loop, and always checks its directions.
+
+def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False,
+         layout: str = "aos") -> np.ndarray:
+    """f(wi, wo) in 1/sr as float64 ``(..., 3)`` (``(3, ...)`` for ``layout="soa"``); times cos θl if ``cosine``."""
+    soa = _layout(layout)
+    shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     cosine = _validate.flag("cosine", cosine)
     f = _core.reference_eval(wi_rows, wo_rows, params, model_id, False)
     if cosine:
         f *= np.maximum(wi_rows[:, 2:3], 0.0)
-    return f.reshape(shape + (3,))
+    return _as_layout(f.reshape(shape + (3,)), soa)
 
 
-def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014", cosine: bool = False) -> Gradient:
+def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014", cosine: bool = False,
+              layout: str = "aos") -> Gradient:
     """f in float64 and its Jacobian in the material's parameters (README "Gradients"):
     ``value`` ``(..., 3)`` as :func:`eval`, ``jacobian`` ``(..., 3, P)`` with
     ``jacobian[..., c, k] = ∂f_c/∂names[k]``, ``names`` the P parameters ``wrt``
     selects (default all 13, ``base_color`` as three channels). A uniform
-    parameter still gets a per-element derivative."""
-    shape, wi_rows, wo_rows, params, model_id = _prepare(material, wi, wo, model)
+    parameter still gets a per-element derivative. ``layout="soa"``: ``(3, ...)``
+    and ``(3, P, ...)``."""
+    soa = _layout(layout)
+    shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     cosine = _validate.flag("cosine", cosine)
     wanted = _gradient.columns(wrt)
     value, jacobian = _core.reference_eval_grad(wi_rows, wo_rows, params, model_id)
@@ -49,17 +85,20 @@ def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014"
         cos_theta_l = np.maximum(wi_rows[:, 2], 0.0)
         value *= cos_theta_l[:, None]
         jacobian *= cos_theta_l[:, None, None]
-    return _gradient.result(value.reshape(shape + (3,)), jacobian.reshape(shape + jacobian.shape[1:]), wanted)
+    result = _gradient.result(value.reshape(shape + (3,)), jacobian.reshape(shape + jacobian.shape[1:]), wanted)
+    return Gradient(_as_layout(result.value, soa), _as_layout(result.jacobian, soa, trailing=2), result.names)
 
 
-def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False) -> Lobes:
-    """The four lobes as a :class:`Lobes` of float64 ``(..., 3)`` arrays."""
-    shape, wi_rows, wo_rows, params, model_id = _prepare(material, wi, wo, model)
+def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False,
+               layout: str = "aos") -> Lobes:
+    """The four lobes as a :class:`Lobes` of float64 ``(..., 3)`` (``(3, ...)``) arrays."""
+    soa = _layout(layout)
+    shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     cosine = _validate.flag("cosine", cosine)
     lobes = _core.reference_eval(wi_rows, wo_rows, params, model_id, True)
     if cosine:
         lobes *= np.maximum(wi_rows[:, None, 2:3], 0.0)
-    return Lobes(*(lobes[:, k, :].reshape(shape + (3,)) for k in range(len(Lobes._fields))))
+    return Lobes(*(_as_layout(lobes[:, k, :].reshape(shape + (3,)), soa) for k in range(len(Lobes._fields))))
 
 
 # --------------------------------------------------------------------------
@@ -100,7 +139,8 @@ def _check_material(material) -> None:
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
 
 
-def sample(material: Material, wo, u, *, model: str = "disney2014", specular_sampler: str = "visible") -> Sample:
+def sample(material: Material, wo, u, *, model: str = "disney2014", specular_sampler: str = "visible",
+           layout: str = "aos") -> Sample:
     """Draws ``wi`` for each ``wo`` from the three-lobe mixture of README "Sampling and pdf".
 
     ``u`` holds three uniforms in [0, 1] per element, ``(u0, u1, u2)`` on the last
@@ -108,24 +148,28 @@ def sample(material: Material, wo, u, *, model: str = "disney2014", specular_sam
     and ``u`` broadcast over their leading shapes. Returns a :class:`Sample` of
     float64 arrays (``lobe`` int32); ``pdf`` is the mixture density, the number
     :func:`pdf` gives for the returned pair, and ``weight = f cos θl / pdf``;
-    both are 0 when ``wi`` or ``wo`` is at or below the horizon.
+    both are 0 when ``wi`` or ``wo`` is at or below the horizon. ``layout="soa"``:
+    ``wo``, ``u``, ``wi`` and ``weight`` as ``(3, ...)``.
     """
     _check_material(material)
     model_id = _validate.model_index(model)
     sampler_id = _validate.sampler_index(specular_sampler)
-    wo = _validate.directions("wo", wo)
-    u = _uniforms("u", u)
+    soa = _layout(layout)
+    wo = _validate.directions("wo", _as_aos("wo", wo, soa))
+    u = _uniforms("u", _as_aos("u", u, soa))
     shape = _validate.broadcast_leading(wo=wo.shape[:-1], u=u.shape[:-1], material=material.shape)
     if int(np.prod(shape, dtype=np.int64)) == 0:
-        return Sample(np.zeros(shape + (3,)), np.zeros(shape), np.zeros(shape + (3,)), np.zeros(shape, np.int32))
+        empty = _as_layout(np.zeros(shape + (3,)), soa)
+        return Sample(empty, np.zeros(shape), empty.copy(), np.zeros(shape, np.int32))
     wi, density, weight, lobe = _core.reference_sample(
         _shared_or_rows(wo, shape, 3), _shared_or_rows(u, shape, 3), _material_rows(material, shape),
         model_id, sampler_id)
-    return Sample(_to_shape(wi, shape, (3,)), _to_shape(density, shape), _to_shape(weight, shape, (3,)),
-                  _to_shape(lobe, shape))
+    return Sample(_as_layout(_to_shape(wi, shape, (3,)), soa), _to_shape(density, shape),
+                  _as_layout(_to_shape(weight, shape, (3,)), soa), _to_shape(lobe, shape))
 
 
-def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampler: str = "visible") -> np.ndarray:
+def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampler: str = "visible",
+        layout: str = "aos") -> np.ndarray:
     """The mixture density ``P0 pdf0 + P1 pdf1 + P2 pdf2`` of ``wi`` given ``wo``, float64 ``(...)``.
 
     0 unless both directions lie strictly above the horizon. It does not depend on
@@ -134,8 +178,9 @@ def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampl
     _check_material(material)
     model_id = _validate.model_index(model)
     sampler_id = _validate.sampler_index(specular_sampler)
-    wi = _validate.directions("wi", wi)
-    wo = _validate.directions("wo", wo)
+    soa = _layout(layout)
+    wi = _validate.directions("wi", _as_aos("wi", wi, soa))
+    wo = _validate.directions("wo", _as_aos("wo", wo, soa))
     shape = _validate.broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
     if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape)

@@ -3,7 +3,8 @@
 A unit sphere seen from +z (orthographic), each pixel shaded in its own
 tangent frame (normal n, tangent along the sphere's latitude), lit by one
 directional light plus a constant ambient term. Returns linear RGB; use
-:func:`to_srgb8` for a displayable image.
+:func:`to_srgb8` (a Reinhard-type tone curve on luminance, then sRGB) for a
+displayable image.
 """
 
 from __future__ import annotations
@@ -19,8 +20,8 @@ from ._batch import random_uniforms as _random_uniforms
 from ._batch import sample as _sample
 from .material import Material
 
-__all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_frames", "to_srgb8", "write_png",
-           "DEFAULT_LIGHT", "MAX_RESOLUTION"]
+__all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_frames", "tone_map", "to_srgb8",
+           "write_png", "DEFAULT_LIGHT", "MAX_RESOLUTION", "TONE_CURVES", "REINHARD_WHITE"]
 
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
 
@@ -147,9 +148,35 @@ def render_environment(material: Material, resolution: int = 256, environment=No
     return total
 
 
-def to_srgb8(linear: np.ndarray, exposure: float = 1.0) -> np.ndarray:
-    """Linear RGB to 8-bit sRGB (clipped), for saving or showing."""
-    c = np.clip(np.asarray(linear, dtype=np.float64) * exposure, 0.0, 1.0)
+TONE_CURVES = ("reinhard", "clip")
+REINHARD_WHITE = 4.0  # the luminance the default curve maps to display white
+
+
+def tone_map(linear: np.ndarray, exposure: float = 1.0, curve: str = "reinhard") -> np.ndarray:
+    """Scene-referred linear RGB ``(..., 3)`` to display-referred linear RGB in [0, 1].
+
+    ``"reinhard"``: the extended Reinhard curve on luminance, ``Y' = Y (1 + Y /
+    W²) / (1 + Y)`` with white ``W`` = :data:`REINHARD_WHITE`, each pixel's
+    colour scaled by ``Y'/Y`` and, where a channel would still exceed 1,
+    divided by that channel (so a gold highlight stays gold and a white
+    material keeps its shading instead of clipping flat). ``"clip"``: each
+    channel clipped to [0, 1]. Both after multiplying by ``exposure``."""
+    if curve not in TONE_CURVES:
+        raise ValueError(f"curve: expected one of {', '.join(TONE_CURVES)}, got {curve!r}")
+    exposure = _non_negative("exposure", exposure)
+    c = np.maximum(np.asarray(linear, dtype=np.float64) * exposure, 0.0)
+    if curve == "clip":
+        return np.minimum(c, 1.0)
+    luminance = c @ np.array([0.2126, 0.7152, 0.0722])
+    mapped = luminance * (1.0 + luminance / REINHARD_WHITE**2) / (1.0 + luminance)
+    scale = np.divide(mapped, luminance, out=np.zeros_like(luminance), where=luminance > 0.0)
+    c = c * scale[..., None]
+    return c / np.maximum(1.0, c.max(axis=-1, keepdims=True))
+
+
+def to_srgb8(linear: np.ndarray, exposure: float = 1.0, curve: str = "reinhard") -> np.ndarray:
+    """Linear RGB to 8-bit sRGB for saving or showing: :func:`tone_map`, then the sRGB encoding."""
+    c = tone_map(linear, exposure, curve)
     srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
     return np.round(srgb * 255.0).astype(np.uint8)
 
