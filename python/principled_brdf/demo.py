@@ -11,7 +11,7 @@ from . import _core, presets, reference
 from ._batch import cpu_info, eval as _eval, sample as _sample
 from .benchmark import best_seconds, random_pairs
 from .material import Material
-from .render import render_sphere, to_srgb8, write_png
+from .render import render_environment, render_sphere, to_srgb8, write_png
 
 DEMO_MATERIAL = dict(base_color=(0.9, 0.55, 0.25), metallic=0.3, roughness=0.35, anisotropic=0.4, sheen=0.3,
                      clearcoat=0.6, clearcoat_gloss=0.8)
@@ -62,10 +62,44 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
            f"{np.round(drawn.weight.mean(axis=0), 4).tolist()}")
 
     report(f"rendering {len(PICTURE_PRESETS)} presets and a roughness sweep ...")
-    spheres = [render_sphere(presets.get(name), resolution=160) for name in PICTURE_PRESETS]
-    sweep = [render_sphere(Material(base_color=(0.9, 0.55, 0.25), metallic=1.0, roughness=r), resolution=160)
-             for r in np.linspace(0.05, 1.0, len(PICTURE_PRESETS))]
-    image = to_srgb8(np.concatenate([np.concatenate(spheres, axis=1), np.concatenate(sweep, axis=1)], axis=0))
-    write_png(output, image)
-    report(f"wrote {output}: presets {', '.join(PICTURE_PRESETS)} (top); a metal with roughness 0.05 to 1 (bottom)")
+    roughness = np.linspace(0.05, 1.0, len(PICTURE_PRESETS))
+    materials = [presets.get(name) for name in PICTURE_PRESETS] + [
+        Material(base_color=(0.9, 0.55, 0.25), metallic=1.0, roughness=r) for r in roughness]
+    labels = list(PICTURE_PRESETS) + [f"roughness {r:.2f}" for r in roughness]
+    write_picture(output, [lit_sphere(m) for m in materials], labels, columns=len(PICTURE_PRESETS))
+    report(f"wrote {output}: presets {', '.join(PICTURE_PRESETS)} (top); a metal with roughness 0.05 to 1 (bottom), "
+           "under a sky and a key light")
     return {"rates": rates, "max_relative_error": error, "output": output}
+
+
+def lit_sphere(material: Material, resolution: int = 160) -> np.ndarray:
+    """A sphere under the key light of render_sphere and the default sky (linear RGB):
+    metals need something to reflect."""
+    return render_sphere(material, resolution, ambient=0.0) + render_environment(material, resolution, samples=256)
+
+
+def write_picture(output: str, images: list, labels: list, columns: int) -> None:
+    """The tone-mapped images in a grid, each labelled (with matplotlib; without it, unlabelled)."""
+    rows = [np.concatenate(images[k:k + columns], axis=1) for k in range(0, len(images), columns)]
+    grid = to_srgb8(np.concatenate(rows, axis=0))
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        write_png(output, grid)
+        return
+    size = images[0].shape[0]
+    figure = plt.figure(figsize=(grid.shape[1] / 100, (grid.shape[0] + 22 * len(rows)) / 100), dpi=100)
+    for index, label in enumerate(labels):
+        row, column = divmod(index, columns)
+        axes = figure.add_axes([column / columns, 1 - (row + 1) / len(rows), 1 / columns, 1 / len(rows)])
+        axes.imshow(grid[row * size:(row + 1) * size, column * size:(column + 1) * size], extent=(0, 1, 0, 1))
+        axes.set_xlim(0, 1)
+        axes.set_ylim(0, 1.14)
+        axes.text(0.5, 1.07, label, ha="center", va="center", color="white", fontsize=9)
+        axes.set_facecolor("black")
+        axes.set_axis_off()
+    figure.patch.set_facecolor("black")
+    figure.savefig(output, facecolor="black")
+    plt.close(figure)
