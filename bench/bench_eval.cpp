@@ -92,22 +92,9 @@ void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_elem
     Data& d = data_for(state.range(0));
     pb::EvalJob job = make_job(d, soa, per_element);
     if (checked) job.check = pb::direction_check(1e-3);  // what pb.eval does by default
-    job.output = output;
+    job.output = output;  // f; with the pdf (pb.eval_pdf); with the Jacobian (pb.eval_grad)
     std::vector<float> pdf(output == pb::Output::kValuePdf ? d.n : 0);
     job.pdf = pdf.data();
-    const int threads = threads_of(state);
-    for (auto _ : state) {
-        pb::eval(job, d.n, threads, isa);
-        benchmark::ClobberMemory();
-    }
-    state.SetItemsProcessed(state.iterations() * d.n);
-}
-
-// f and its Jacobian in the 13 parameter slots (pb.eval_grad).
-void simd_eval_grad(benchmark::State& state, std::string isa, bool soa, bool per_element) {
-    Data& d = data_for(state.range(0));
-    pb::EvalJob job = make_job(d, soa, per_element);
-    job.output = pb::Output::kGradient;
     job.jacobian = d.jacobian.data();
     job.jacobian_row_stride = soa ? d.n : 0;
     const int threads = threads_of(state);
@@ -221,7 +208,8 @@ void register_all() {
                             const std::string grad_name = "eval_grad/" + isa + (soa ? "/soa" : "/aos") +
                                                           (per_element ? "/per_element" : "/uniform");
                             for (std::int64_t size : {kGradientInCache, n})
-                                benchmark::RegisterBenchmark(grad_name.c_str(), simd_eval_grad, isa, soa, per_element)
+                                benchmark::RegisterBenchmark(grad_name.c_str(), simd_eval, isa, soa, per_element, false,
+                                                             pb::Output::kGradient)
                                     ->Args({size, threads})
                                     ->UseRealTime()
                                     ->Unit(benchmark::kMicrosecond);

@@ -313,6 +313,21 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
     return Lobes(*outputs)
 
 
+def _require_pair(out, second: str) -> None:
+    """``out=`` of a call with two results, f and ``second``: None or a tuple of two arrays."""
+    if out is not None and not (isinstance(out, tuple) and len(out) == 2):
+        raise TypeError(f"out: expected a tuple (value, {second}) of float32 arrays")
+
+
+def _output_pair(out, value_shape: tuple, second_shape: tuple, second: str) -> tuple:
+    """The two result arrays: fresh, or ``out``'s checked (shapes, dtype, no overlap)."""
+    value = _output(None if out is None else out[0], value_shape, "out[0]")
+    other = _output(None if out is None else out[1], second_shape, "out[1]")
+    if out is not None and np.may_share_memory(value, other):
+        raise ValueError(f"out: the value and {second} arrays overlap")
+    return value, other
+
+
 def _jacobian_shape(leading: tuple, layout: str, width: int) -> tuple:
     return leading + (3, width) if layout == "aos" else (3, width) + leading
 
@@ -333,15 +348,11 @@ def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014"
     """
     wanted = _gradient.columns(wrt)
     full = len(wanted) == len(GRADIENT_NAMES)
-    if out is not None and not (isinstance(out, tuple) and len(out) == 2):
-        raise TypeError("out: expected a tuple (value, jacobian) of float32 arrays")
+    _require_pair(out, "jacobian")
 
     def outputs(leading, layout):
-        value = _output(None if out is None else out[0], _vec3_shape(leading, layout), "out[0]")
-        jacobian_shape = _jacobian_shape(leading, layout, len(wanted))
-        jacobian = _output(None if out is None else out[1], jacobian_shape, "out[1]")
-        if out is not None and np.may_share_memory(value, jacobian):
-            raise ValueError("out: the value and jacobian arrays overlap")
+        value, jacobian = _output_pair(out, _vec3_shape(leading, layout), _jacobian_shape(leading, layout, len(wanted)),
+                                       "jacobian")
         return [value, jacobian if full else np.empty(_jacobian_shape(leading, layout, len(GRADIENT_NAMES)), np.float32)]
 
     value, jacobian_all = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
@@ -382,14 +393,10 @@ def eval_pdf(material: Material, wi, wo, *, model: str = "disney2014", cosine: b
     """f and the sampling pdf of (wi, wo) in one kernel pass (what multiple importance
     sampling needs): ``value`` as :func:`eval` returns it, ``pdf`` as :func:`pdf` does.
     ``out=(value, pdf)`` writes into preallocated float32 arrays of those shapes."""
-    if out is not None and not (isinstance(out, tuple) and len(out) == 2):
-        raise TypeError("out: expected a tuple (value, pdf) of float32 arrays")
+    _require_pair(out, "pdf")
 
     def outputs(leading, layout):
-        value = _output(None if out is None else out[0], _vec3_shape(leading, layout), "out[0]")
-        density = _output(None if out is None else out[1], leading, "out[1]")
-        if out is not None and np.may_share_memory(value, density):
-            raise ValueError("out: the value and pdf arrays overlap")
+        value, density = _output_pair(out, _vec3_shape(leading, layout), leading, "pdf")
         return [density, value]
 
     density, value = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,

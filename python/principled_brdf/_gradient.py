@@ -34,22 +34,23 @@ class Gradient(NamedTuple):
     names: tuple  # the P parameters, in the table's order
 
 
-def columns(wrt) -> list:
+def columns(wrt, argument: str = "wrt") -> list:
     """The slot indices for ``wrt``: None (all 13), a name or a sequence of names;
-    ``base_color`` stands for its three channels. Kept in the table's order."""
+    ``base_color`` stands for its three channels. Kept in the table's order;
+    errors name ``argument``."""
     if wrt is None:
         return list(range(len(GRADIENT_NAMES)))
     requested = [wrt] if isinstance(wrt, str) else list(wrt) if isinstance(wrt, (list, tuple)) else None
     if requested is None or not requested:
-        raise TypeError(f"wrt: expected None, a parameter name or a non-empty list of names, got {wrt!r}")
+        raise TypeError(f"{argument}: expected None, a parameter name or a non-empty list of names, got {wrt!r}")
     wanted = set()
     for name in requested:
         if not isinstance(name, str):
-            raise TypeError(f"wrt: expected parameter names, got {name!r}")
+            raise TypeError(f"{argument}: expected parameter names, got {name!r}")
         expanded = [f"{name}_{c}" for c in "rgb"] if name == "base_color" else [name]
         for slot_name in expanded:
             if slot_name not in GRADIENT_NAMES:
-                raise ValueError(f"wrt: unknown parameter {name!r}; expected one of {', '.join(GRADIENT_NAMES)} "
+                raise ValueError(f"{argument}: unknown parameter {name!r}; expected one of {', '.join(GRADIENT_NAMES)} "
                                  "or base_color")
             wanted.add(GRADIENT_NAMES.index(slot_name))
     return sorted(wanted)

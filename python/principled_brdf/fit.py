@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _validate
+from . import _gradient, _validate
 from ._batch import eval_grad
 from ._gradient import GRADIENT_NAMES
 from .material import PARAMETERS, Material
@@ -59,25 +59,6 @@ class FitResult:
 
     def __str__(self) -> str:
         return self.summary()
-
-
-def _slots(fit_names) -> list:
-    """Slot indices of the parameters to fit: None (all), or names (base_color = three slots)."""
-    if fit_names is None:
-        return list(range(len(GRADIENT_NAMES)))
-    names = [fit_names] if isinstance(fit_names, str) else list(fit_names)
-    slots = set()
-    for name in names:
-        if name == "base_color":
-            slots |= {0, 1, 2}
-        elif name in GRADIENT_NAMES:
-            slots.add(GRADIENT_NAMES.index(name))
-        else:
-            raise ValueError(f"fit: unknown parameter {name!r}; expected names of {', '.join(PARAMETERS)} "
-                             "(or base_color_r/g/b)")
-    if not slots:
-        raise ValueError("fit: no parameter to fit")
-    return sorted(slots)
 
 
 def _slot_bounds(bounds) -> tuple:
@@ -182,7 +163,7 @@ def fit(wi, wo, measured, *, init=None, fit=None, loss: str = "log", weights=Non
         weights = np.broadcast_to(np.asarray(_validate.as_real_array("weights", weights), dtype=np.float64), (count, n))
         if np.any(~np.isfinite(weights)) or np.any(weights < 0):
             raise ValueError("weights: expected finite values >= 0")
-    slots = _slots(fit)
+    slots = _gradient.columns(fit, "fit")
     lower, upper = _slot_bounds(bounds)
     start = _initial_slots(init)
     start[slots] = np.clip(start[slots], lower[slots], upper[slots])

@@ -212,11 +212,6 @@ inline Vec3 ggx_sample_h(double u1, double u2, double alpha_x, double alpha_y) {
     return normalized_draw(ggx_of(alpha_x, alpha_y).sample_distribution(sin_phi, cos_phi, u2));
 }
 
-// αx² wx² + αy² wy² = (α(φ) sinθ)², the projected roughness times sinθ, squared.
-inline double projected_roughness2_sin2(const Vec3& w, double alpha_x, double alpha_y) {
-    return ggx_of(alpha_x, alpha_y).projected_length2(model_vec(w));
-}
-
 // Λ(w) = (-1 + sqrt(1 + (αx² wx² + αy² wy²) / wz²)) / 2, in a form that neither
 // cancels nor overflows as wz -> 0 (it is +inf at wz = 0).
 inline double ggx_lambda(const Vec3& w, double alpha_x, double alpha_y) {
