@@ -255,38 +255,67 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
 // out[width * lane + r] = rows[r][lane] for r < width and every lane: a batch's
 // rows (its Jacobian) written element after element. `rows` holds
 // padded_rows(width) aligned rows; the padding rows are read, never written out.
+//
+// The blocks of a register transpose are stored whole, the last, partial one
+// first: its full-width store for an element runs into the start of the next
+// element, which block 0 writes afterwards. Only the batch's last element
+// stores its partial block in pieces (a masked store costs a dozen cycles on
+// some cores, and there would be one per element).
 #if defined(__AVX2__) && !defined(__AVX512F__)
 inline constexpr int kTransposeBlock = 8;  // 8 x 8 blocks in registers
 
+// The 8 x 8 block of rows b to b + 7 as columns: column[lane] holds those rows of element `lane`.
+PB_KERNEL_INLINE void transpose_block(const float (*rows)[kLanes], int b, __m256 (&column)[8]) {
+    __m256 r[8], t[8], u[8];
+    for (int k = 0; k < 8; ++k) r[k] = _mm256_load_ps(rows[b + k]);
+    for (int k = 0; k < 8; k += 2) {
+        t[k] = _mm256_unpacklo_ps(r[k], r[k + 1]);
+        t[k + 1] = _mm256_unpackhi_ps(r[k], r[k + 1]);
+    }
+    for (int k = 0; k < 8; k += 4) {
+        u[k] = _mm256_shuffle_ps(t[k], t[k + 2], 0x44);
+        u[k + 1] = _mm256_shuffle_ps(t[k], t[k + 2], 0xEE);
+        u[k + 2] = _mm256_shuffle_ps(t[k + 1], t[k + 3], 0x44);
+        u[k + 3] = _mm256_shuffle_ps(t[k + 1], t[k + 3], 0xEE);
+    }
+    // element `lane`: low halves of u[0..3] for lanes 0-3, high halves for 4-7
+    for (int lane = 0; lane < 4; ++lane) {
+        column[lane] = _mm256_permute2f128_ps(u[lane], u[lane + 4], 0x20);
+        column[lane + 4] = _mm256_permute2f128_ps(u[lane], u[lane + 4], 0x31);
+    }
+}
+
+// The first `count` (< 8) floats of x at p.
+PB_KERNEL_INLINE void store_first(float* p, __m256 x, int count) {
+    __m128 part = _mm256_castps256_ps128(x);
+    if (count >= 4) {
+        _mm_storeu_ps(p, part);
+        part = _mm256_extractf128_ps(x, 1);
+        p += 4;
+        count -= 4;
+    }
+    if (count >= 2) {
+        _mm_storel_pi(reinterpret_cast<__m64*>(p), part);
+        part = _mm_movehl_ps(part, part);
+        p += 2;
+        count -= 2;
+    }
+    if (count == 1) _mm_store_ss(p, part);
+}
+
 template <int width>
 PB_KERNEL_INLINE void store_rows_by_element(const float (*rows)[kLanes], float* out) {
-    for (int b = 0; b < width; b += 8) {
-        __m256 r[8], t[8], u[8];
-        for (int k = 0; k < 8; ++k) r[k] = _mm256_load_ps(rows[b + k]);
-        for (int k = 0; k < 8; k += 2) {
-            t[k] = _mm256_unpacklo_ps(r[k], r[k + 1]);
-            t[k + 1] = _mm256_unpackhi_ps(r[k], r[k + 1]);
-        }
-        for (int k = 0; k < 8; k += 4) {
-            u[k] = _mm256_shuffle_ps(t[k], t[k + 2], 0x44);
-            u[k + 1] = _mm256_shuffle_ps(t[k], t[k + 2], 0xEE);
-            u[k + 2] = _mm256_shuffle_ps(t[k + 1], t[k + 3], 0x44);
-            u[k + 3] = _mm256_shuffle_ps(t[k + 1], t[k + 3], 0xEE);
-        }
-        const int valid = width - b < 8 ? width - b : 8;
-        const __m256i first_valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(valid), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-        for (int lane = 0; lane < 8; ++lane) {
-            // element `lane`: low halves of u[0..3] for lanes 0-3, high halves for 4-7
-            const int k = lane & 3;
-            const __m256 column = lane < 4 ? _mm256_permute2f128_ps(u[k], u[k + 4], 0x20)
-                                           : _mm256_permute2f128_ps(u[k], u[k + 4], 0x31);
-            float* p = out + width * lane + b;
-            if (valid == 8) {
-                _mm256_storeu_ps(p, column);
-            } else {
-                _mm256_maskstore_ps(p, first_valid, column);
-            }
-        }
+    static_assert(width >= 8, "the partial block's overrun must land in a block written after it");
+    constexpr int full_blocks = width / 8, partial = width % 8;
+    __m256 column[8];
+    if constexpr (partial != 0) {
+        transpose_block(rows, 8 * full_blocks, column);
+        for (int lane = 0; lane < 7; ++lane) _mm256_storeu_ps(out + width * lane + 8 * full_blocks, column[lane]);
+        store_first(out + width * 7 + 8 * full_blocks, column[7], partial);
+    }
+    for (int b = 0; b < 8 * full_blocks; b += 8) {
+        transpose_block(rows, b, column);
+        for (int lane = 0; lane < 8; ++lane) _mm256_storeu_ps(out + width * lane + b, column[lane]);
     }
 }
 #elif defined(__SSE2__) && !defined(__AVX512F__)
@@ -294,22 +323,26 @@ inline constexpr int kTransposeBlock = 4;  // 4 x 4 blocks in registers
 
 template <int width>
 PB_KERNEL_INLINE void store_rows_by_element(const float (*rows)[kLanes], float* out) {
-    for (int b = 0; b < width; b += 4) {
-        __m128 r0 = _mm_load_ps(rows[b]), r1 = _mm_load_ps(rows[b + 1]), r2 = _mm_load_ps(rows[b + 2]),
-               r3 = _mm_load_ps(rows[b + 3]);
-        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-        const __m128 columns[4] = {r0, r1, r2, r3};
-        const int valid = width - b < 4 ? width - b : 4;
-        for (int lane = 0; lane < 4; ++lane) {
-            float* p = out + width * lane + b;
-            if (valid == 4) {
-                _mm_storeu_ps(p, columns[lane]);
-            } else {
-                alignas(16) float column[4];
-                _mm_store_ps(column, columns[lane]);
-                for (int k = 0; k < valid; ++k) p[k] = column[k];
-            }
-        }
+    static_assert(width >= 4, "the partial block's overrun must land in a block written after it");
+    constexpr int full_blocks = width / 4, partial = width % 4;
+    auto transpose_block = [&](int b, __m128(&column)[4]) {
+        column[0] = _mm_load_ps(rows[b]);
+        column[1] = _mm_load_ps(rows[b + 1]);
+        column[2] = _mm_load_ps(rows[b + 2]);
+        column[3] = _mm_load_ps(rows[b + 3]);
+        _MM_TRANSPOSE4_PS(column[0], column[1], column[2], column[3]);
+    };
+    __m128 column[4];
+    if constexpr (partial != 0) {
+        transpose_block(4 * full_blocks, column);
+        for (int lane = 0; lane < 3; ++lane) _mm_storeu_ps(out + width * lane + 4 * full_blocks, column[lane]);
+        float* last = out + width * 3 + 4 * full_blocks;
+        if (partial >= 2) _mm_storel_pi(reinterpret_cast<__m64*>(last), column[3]);
+        if (partial != 2) _mm_store_ss(last + partial - 1, _mm_shuffle_ps(column[3], column[3], _MM_SHUFFLE(0, 0, 0, partial - 1)));
+    }
+    for (int b = 0; b < 4 * full_blocks; b += 4) {
+        transpose_block(b, column);
+        for (int lane = 0; lane < 4; ++lane) _mm_storeu_ps(out + width * lane + b, column[lane]);
     }
 }
 #else
