@@ -60,6 +60,24 @@ def test_render_preset_with_parameters(tmp_path, capsys):
     assert "roughness=0.2" in capsys.readouterr().out
 
 
+def test_render_writes_linear_npy_and_exr_and_switches_the_sky(tmp_path):
+    common = ["render", "--preset", "chrome", "--resolution", "32", "--samples", "8"]
+    assert main(common + ["--output", str(tmp_path / "sky.npy")]) == 0
+    assert main(common + ["--no-environment", "--output", str(tmp_path / "key.npy")]) == 0
+    assert main(common + ["--exposure", "2", "--output", str(tmp_path / "sky2.npy")]) == 0
+    sky, key, brighter = (np.load(tmp_path / f"{name}.npy") for name in ("sky", "key", "sky2"))
+    assert sky.shape == (32, 32, 3) and sky.dtype == np.float32
+    # chrome reflects the sky: without it most of the sphere is black; exposure scales the linear values
+    assert np.count_nonzero(key.sum(-1) > 0.01) < np.count_nonzero(sky.sum(-1) > 0.01) // 4
+    np.testing.assert_allclose(brighter, 2 * sky, rtol=1e-6)
+    expected = pb.render.render_sphere(pb.presets.get("chrome"), 32, samples=8)
+    np.testing.assert_allclose(sky, expected, rtol=1e-6)
+    import OpenEXR  # a test extra
+    assert main(common + ["--output", str(tmp_path / "sky.exr")]) == 0
+    with OpenEXR.File(str(tmp_path / "sky.exr")) as exr:
+        np.testing.assert_array_equal(exr.channels()["RGB"].pixels, sky)
+
+
 def test_bench_compares_with_numpy(capsys):
     assert main(["bench", "--pairs", "20000", "--repeats", "1"]) == 0
     out = capsys.readouterr().out
@@ -72,6 +90,11 @@ def test_bench_compares_with_numpy(capsys):
         (["render", "--output", "x.png", "--param", "roughnes=0.3"], "expected NAME=VALUE"),
         (["render", "--output", "x.png", "--param", "base_color=1,2"], "base_color: expected 3"),
         (["render", "--output", "x.png", "--param", "roughness=-1"], "roughness: -1.0 is outside its domain"),
+        (["render", "--output", "x.png", "--param", "base_color=0.5,nan,0.5"], "base_color: nan is outside its domain"),
+        (["render", "--output", "x.png", "--param", "anisotropic=1.5"], "anisotropic: 1.5 is outside its domain [0, 1]"),
+        (["render", "--output", "x.tiff"], "cannot write '.tiff' images; supported: .png, .exr, .npy"),
+        (["render", "--output", "picture"], "cannot write 'a file without an extension' images"),
+        (["demo", "--output", "x.exr"], "cannot write '.exr' images; supported: .png"),
         (["render", "--output", "x.png", "--preset", "unobtainium"], "invalid choice"),
         (["render", "--output", "x.png", "--light", "0,0"], "three finite comma-separated numbers"),
         (["render", "--output", "x.png", "--resolution", "0"], "expected a positive integer"),

@@ -156,17 +156,42 @@ def test_tone_mapping_keeps_hue_and_shading():
     from principled_brdf import render
     rng = np.random.default_rng(8)
     hdr = rng.uniform(0, 1, (200, 3)) * rng.uniform(0, 20, (200, 1))
-    display = render.tone_map(hdr)
-    assert display.min() >= 0.0 and display.max() <= 1.0
-    # hue: the channel ratios survive (no per-channel clipping)
-    np.testing.assert_allclose(display / display.sum(-1, keepdims=True), hdr / hdr.sum(-1, keepdims=True), rtol=1e-12)
-    grey = np.linspace(0.0, 3.9, 100)[:, None] * np.ones(3)
-    mapped = render.tone_map(grey)[:, 0]
-    assert np.all(np.diff(mapped) > 0)  # bright greys stay distinguishable below white
-    assert render.tone_map(np.full(3, render.REINHARD_WHITE))[0] == pytest.approx(1.0)
+    for curve, white in (("filmic", render.FILMIC_WHITE), ("reinhard", render.REINHARD_WHITE)):
+        display = render.tone_map(hdr, curve=curve)
+        assert display.min() >= 0.0 and display.max() <= 1.0
+        # hue: the channel ratios survive (no per-channel clipping)
+        np.testing.assert_allclose(display / display.sum(-1, keepdims=True), hdr / hdr.sum(-1, keepdims=True),
+                                   rtol=1e-12)
+        grey = np.linspace(0.0, 0.99 * white, 100)[:, None] * np.ones(3)
+        mapped = render.tone_map(grey, curve=curve)[:, 0]
+        assert mapped[0] == 0.0 and np.all(np.diff(mapped) > 0)  # bright greys stay distinguishable below white
+        assert render.tone_map(np.full(3, white), curve=curve)[0] == pytest.approx(1.0)
+        assert render.tone_map(np.full(3, 2 * white), curve=curve)[0] == pytest.approx(1.0, abs=1e-15)
+        gold = np.array([8.0, 5.0, 1.0])  # a bright gold highlight stays gold, not white
+        g = render.tone_map(gold, curve=curve)
+        assert g[0] == pytest.approx(1.0) and g[2] < 0.2
+    # the default is the filmic curve, whose midtones stay near the identity (Reinhard's darken)
+    np.testing.assert_array_equal(render.tone_map(hdr), render.tone_map(hdr, curve="filmic"))
+    assert 0.75 < render.tone_map(np.ones(3))[0] < 0.85 and render.tone_map(np.ones(3), curve="reinhard")[0] < 0.55
     np.testing.assert_array_equal(render.tone_map(hdr, curve="clip"), np.clip(hdr, 0, 1))
-    gold = np.array([8.0, 5.0, 1.0])  # a bright gold highlight stays gold, not white
-    g = render.tone_map(gold)
-    assert g[0] == pytest.approx(1.0) and g[2] < 0.2
-    with pytest.raises(ValueError, match="curve: expected one of reinhard, clip"):
+    with pytest.raises(ValueError, match="curve: expected one of filmic, reinhard, clip"):
         render.tone_map(hdr, curve="aces")
+
+
+def test_save_image_by_extension(tmp_path):
+    from principled_brdf import render
+    import OpenEXR  # a test extra
+    hdr = np.random.default_rng(2).uniform(0, 30, (6, 7, 3))
+    assert render.save_image(tmp_path / "x.npy", hdr, exposure=0.5) == str(tmp_path / "x.npy")
+    np.testing.assert_array_equal(np.load(tmp_path / "x.npy"), (hdr * 0.5).astype(np.float32))
+    render.save_image(tmp_path / "x.exr", hdr)
+    with OpenEXR.File(str(tmp_path / "x.exr")) as exr:
+        np.testing.assert_array_equal(exr.channels()["RGB"].pixels, hdr.astype(np.float32))  # HDR kept
+    render.save_image(tmp_path / "x.PNG", hdr)
+    import matplotlib.image
+    read = matplotlib.image.imread(str(tmp_path / "x.PNG"))[..., :3]
+    np.testing.assert_allclose(read * 255, render.to_srgb8(hdr), atol=0.6)
+    with pytest.raises(ValueError, match=r"path: cannot write '\.jpg' images; supported: \.png, \.exr, \.npy"):
+        render.save_image(tmp_path / "x.jpg", hdr)
+    with pytest.raises(ValueError, match=r"linear: expected an \(H, W, 3\) RGB image"):
+        render.save_image(tmp_path / "x.png", hdr[..., :2])

@@ -82,10 +82,26 @@ def _parameter(text: str) -> tuple:
         parsed = tuple(float(v) for v in value.split(","))
     except ValueError:
         raise argparse.ArgumentTypeError(f"{name}: expected a number (base_color: R,G,B), got {value!r}") from None
-    expected = PARAMETERS[name].slots
-    if len(parsed) != expected:
-        raise argparse.ArgumentTypeError(f"{name}: expected {expected} comma-separated number(s), got {value!r}")
-    return name, parsed if expected == 3 else parsed[0]
+    info = PARAMETERS[name]
+    if len(parsed) != info.slots:
+        raise argparse.ArgumentTypeError(f"{name}: expected {info.slots} comma-separated number(s), got {value!r}")
+    for number in parsed:
+        if not info.lower <= number <= info.upper:  # NaN fails both
+            raise argparse.ArgumentTypeError(f"{name}: {number!r} is outside its domain [{info.lower:g}, {info.upper:g}]")
+    return name, parsed if info.slots == 3 else parsed[0]
+
+
+def _image_path(formats):
+    """An output path whose extension is one of ``formats`` (the error names the extension)."""
+    def parse(text: str) -> str:
+        import os
+
+        extension = os.path.splitext(text)[1].lower()
+        if extension not in formats:
+            raise argparse.ArgumentTypeError(f"cannot write {extension or 'a file without an extension'!r} images; "
+                                             f"supported: {', '.join(formats)}")
+        return text
+    return parse
 
 
 def _demo(args, report) -> None:
@@ -96,14 +112,16 @@ def _demo(args, report) -> None:
 
 def _render(args, report) -> None:
     from . import presets
-    from .render import render_sphere, to_srgb8, write_png
+    from .render import render_sphere, save_image
 
     params = presets.parameters(args.preset) if args.preset else {}
     params.update(dict(args.param or []))
     material = Material(**params)
-    report(f"rendering {material} at {args.resolution}x{args.resolution} ...")
-    image = render_sphere(material, resolution=args.resolution, light=args.light, model=args.model)
-    write_png(args.output, to_srgb8(image, exposure=args.exposure))
+    lighting = f"a key light and a sky ({args.samples} samples per pixel)" if args.environment else "a key light"
+    report(f"rendering {material} at {args.resolution}x{args.resolution} under {lighting} ...")
+    image = render_sphere(material, resolution=args.resolution, light=args.light, model=args.model,
+                          environment="sky" if args.environment else None, samples=args.samples)
+    save_image(args.output, image, exposure=args.exposure)
     report(f"wrote {args.output}")
 
 
@@ -136,12 +154,14 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--pairs", type=_at_most(MAX_PAIRS, "pairs"), default=1 << 22,
                       help="pairs to evaluate (default 4194304)")
     demo.add_argument("--repeats", type=_positive_int, default=5, help="timed runs, best kept (default 5)")
-    demo.add_argument("--output", default="principled_brdf_demo.png", help="picture to write (PNG)")
+    demo.add_argument("--output", type=_image_path((".png",)), default="principled_brdf_demo.png",
+                      help="picture to write (PNG)")
     demo.set_defaults(run=_demo)
 
-    render = commands.add_parser("render", help="render a preset or parameters on a lit sphere to PNG",
-                                 description="Render a material on a sphere lit by one directional light.")
+    render = commands.add_parser("render", help="render a preset or parameters on a lit sphere (PNG, EXR, NPY)",
+                                 description="Render a material on a sphere lit by a directional light and a sky.")
     from . import presets
+    from .render import DEFAULT_SAMPLES, IMAGE_FORMATS
 
     render.add_argument("--preset", choices=presets.names(), help="start from a named preset")
     render.add_argument("--param", action="append", type=_parameter, metavar="NAME=VALUE",
@@ -150,9 +170,15 @@ def build_parser() -> argparse.ArgumentParser:
                         help="image size in pixels (default 512)")
     render.add_argument("--light", type=_vector, default=(-0.5, 0.6, 0.75),
                         help="direction towards the light, camera space x,y,z (default -0.5,0.6,0.75)")
-    render.add_argument("--exposure", type=_exposure, default=1.0, help="scale before tone mapping (default 1)")
+    render.add_argument("--environment", action=argparse.BooleanOptionalAction, default=True,
+                        help="light by the sky too (default; --no-environment: the key light alone)")
+    render.add_argument("--samples", type=_at_most(1 << 16, "samples"), default=DEFAULT_SAMPLES,
+                        help=f"sky samples per pixel (default {DEFAULT_SAMPLES})")
+    render.add_argument("--exposure", type=_exposure, default=1.0,
+                        help="scale before tone mapping, or of the linear values in EXR/NPY (default 1)")
     render.add_argument("--model", choices=("disney2014", "disney2012"), default="disney2014")
-    render.add_argument("--output", required=True, help="PNG file to write")
+    render.add_argument("--output", required=True, type=_image_path(tuple(IMAGE_FORMATS)),
+                        help="file to write: .png (tone mapped, sRGB), .exr or .npy (linear float32)")
     render.set_defaults(run=_render)
 
     bench = commands.add_parser("bench", help="compare pb.eval with a numpy float32 implementation",

@@ -11,7 +11,7 @@ from . import _core, presets, reference
 from ._batch import cpu_info, eval as _eval, sample as _sample
 from .benchmark import best_seconds, random_pairs
 from .material import Material
-from .render import render_environment, render_sphere, to_srgb8, write_png
+from .render import render_sphere, to_srgb8, write_png
 
 DEMO_MATERIAL = dict(base_color=(0.9, 0.55, 0.25), metallic=0.3, roughness=0.35, anisotropic=0.4, sheen=0.3,
                      clearcoat=0.6, clearcoat_gloss=0.8)
@@ -73,9 +73,8 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
 
 
 def lit_sphere(material: Material, resolution: int = 160) -> np.ndarray:
-    """A sphere under the key light of render_sphere and the default sky (linear RGB):
-    metals need something to reflect."""
-    return render_sphere(material, resolution, ambient=0.0) + render_environment(material, resolution, samples=256)
+    """A sphere under render_sphere's key light and default sky (linear RGB)."""
+    return render_sphere(material, resolution)
 
 
 def write_picture(output: str, images: list, labels: list, columns: int) -> None:

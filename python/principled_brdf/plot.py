@@ -5,7 +5,7 @@
 
     pbplot.brdf_slice(pb.presets.get("car_paint"))          # (θh, θd) image slice, Axes
     pbplot.polar_lobes(pb.Material(roughness=0.3), 45)      # f in the plane of incidence, polar Axes
-    pbplot.lit_sphere(pb.presets.get("gold"), environment=True)   # Axes
+    pbplot.lit_sphere(pb.presets.get("gold"))                    # under a key light and a sky, Axes
     pbplot.albedo_curves(pb.presets.get("skin"))            # E(θo) per lobe, Axes
     pbplot.parameter_sweep()                                # Burley 2012 figure 16, Figure
     pbplot.blend_demo("gold", "blue_rubber")                # Material.mix with a mask, Axes
@@ -58,7 +58,6 @@ _LOBE_COLORS = {"diffuse": "tab:orange", "sheen": "tab:purple", "specular": "tab
 
 # Shading of pb.render.render_sphere, used where many spheres are shaded in one kernel call.
 _LIGHT_INTENSITY = 3.0
-_AMBIENT = 0.03
 _BACKGROUND = "0.75"  # masked (undefined) pixels
 
 
@@ -321,42 +320,35 @@ def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = 
 
 
 def lit_sphere(material, *, resolution: int = 256, light=_render.DEFAULT_LIGHT, light_intensity: float = 3.0,
-               environment=False, environment_samples: int = 64, seed: int = 0, exposure: float = 1.0,
-               model: str = "disney2014", ax=None):
-    """The material on a sphere (``pb.render.render_sphere``), shown as sRGB; returns the Axes.
+               environment="sky", environment_samples: int = _render.DEFAULT_SAMPLES, seed: int = 0,
+               exposure: float = 1.0, model: str = "disney2014", ax=None):
+    """The material on a sphere (``pb.render.render_sphere``), tone mapped to sRGB; returns the Axes.
 
     ``material`` is uniform or per pixel (leading shape ``(resolution,
     resolution)``). ``light``: direction towards the light in camera space
     (x right, y up, z to the viewer), ``light_intensity`` its irradiance
-    scale (0 turns it off). ``environment``: ``True`` adds the
-    :func:`pb.render.sky_environment` lighting, a callable ``L(w)`` (camera-space
-    directions ``(..., 3)`` to RGB radiance) adds that one; the integral
-    ``∫ f L cos θl dωi`` is estimated per pixel from ``environment_samples``
-    importance samples (``pb.sample``, reproducible from ``seed``), and
-    replaces render_sphere's constant ambient term. ``exposure`` scales the
-    linear image before the sRGB encoding. Off the sphere is transparent.
+    scale (0 turns it off). ``environment``: ``"sky"`` (default,
+    :func:`pb.render.sky_environment`), a callable ``L(w)`` (camera-space
+    directions ``(..., 3)`` to RGB radiance), or None / False for the light
+    alone; its integral ``∫ f L cos θl dωi`` is estimated per pixel from
+    ``environment_samples`` importance samples at lattice points (deterministic
+    for a ``seed``). ``exposure`` scales the linear image before the tone
+    curve (``pb.render.tone_map``). Off the sphere is transparent.
     """
     material = _material("material", material)
     n = _resolution(resolution)
     exposure = _real("exposure", exposure, 0.0)
     intensity = _real("light_intensity", light_intensity, 0.0)
-    if environment is True:
-        environment = _render.sky_environment
-    elif environment is False or environment is None:
-        environment = None
-    elif not callable(environment):
-        raise TypeError(f"environment: expected a bool or a callable L(direction), got {type(environment).__name__}")
     if material.shape not in ((), (n, n)):
         raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
                          f"got {material.shape}")
     count = _resolution(environment_samples, "environment_samples", minimum=1)
     _validate.model_index(model)
+    environment = _render._environment(environment)
     ax = _axes(ax)
 
-    image = _render.render_sphere(material, n, light=light, light_intensity=intensity,
-                          ambient=_AMBIENT if environment is None else 0.0, model=model)
-    if environment is not None:
-        image = image + _render.render_environment(material, n, environment, count, seed, model)
+    image = _render.render_sphere(material, n, light=light, light_intensity=intensity, model=model,
+                                  environment=environment, samples=count, seed=seed)
     inside, _ = _render.sphere_frames(n)
     ax.imshow(_rgba(image, inside, exposure), interpolation="nearest")
     _sphere_axes(ax, "lit sphere" + (" + environment" if environment is not None else ""))
@@ -417,7 +409,8 @@ def _default_sweep_base() -> Material:
 
 
 def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11, resolution: int = 64, ranges=None,
-                    light=_render.DEFAULT_LIGHT, exposure: float = 1.0, model: str = "disney2014", figsize=None):
+                    light=_render.DEFAULT_LIGHT, environment="sky", exposure: float = 1.0, model: str = "disney2014",
+                    figsize=None):
     """The grid of Burley 2012 figure 16: one row per parameter, that parameter
     going from 0 to 1 (or ``ranges[name] = (lo, hi)``) in ``steps`` spheres
     along the row, every other parameter as in ``base``; returns the Figure.
@@ -426,7 +419,8 @@ def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11,
     roughness 0.5). Rows of ``sheen_tint`` and ``clearcoat_gloss`` use
     ``sheen = 1`` / ``clearcoat = 1`` when the base has none, so the tint and
     gloss are visible. All spheres are shaded as ``pb.render.render_sphere``
-    does, in one ``pb.eval`` call (materials batched per pixel). The Figure
+    does (``environment`` as there), materials batched per pixel, in one
+    kernel call per pass. The Figure
     has one Axes per row (in ``fig.axes`` order), each showing its row image.
     """
     base = _default_sweep_base() if base is None else _uniform_material("base", base)
@@ -467,7 +461,8 @@ def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11,
     except ValueError as error:
         raise ValueError(f"ranges: {error}") from None
 
-    linear = _render.render_sphere(material, n, light=light, light_intensity=_LIGHT_INTENSITY, ambient=_AMBIENT, model=model)
+    linear = _render.render_sphere(material, n, light=light, light_intensity=_LIGHT_INTENSITY, model=model,
+                                   environment=environment)
     inside = _render.sphere_frames(n)[0]
     spheres = _rgba(linear, inside, exposure)  # (rows, steps, R, R, 4)
     pad = max(1, n // 16)
@@ -503,14 +498,14 @@ def _checker(resolution: int, cells: int = 8) -> np.ndarray:
     return ((index[:, None] + index[None, :]) % 2).astype(np.float64)
 
 
-def blend_demo(a, b, *, mask=None, resolution: int = 256, light=_render.DEFAULT_LIGHT, exposure: float = 1.0,
-               model: str = "disney2014", ax=None):
+def blend_demo(a, b, *, mask=None, resolution: int = 256, light=_render.DEFAULT_LIGHT, environment="sky",
+               exposure: float = 1.0, model: str = "disney2014", ax=None):
     """A sphere of ``Material.mix(a, b, mask)`` with a per-pixel mask; returns the Axes.
 
     ``a``, ``b``: Materials or preset names. ``mask``: weights of ``b`` in
     [0, 1], a number or an array of shape ``(resolution, resolution)`` (row 0
     at the top, like the image); default an 8 x 8 checker. Rendered with
-    ``pb.render.render_sphere`` in one kernel call.
+    ``pb.render.render_sphere`` (``environment`` as there).
     """
     a = _material("a", a)
     b = _material("b", b)
@@ -531,7 +526,7 @@ def blend_demo(a, b, *, mask=None, resolution: int = 256, light=_render.DEFAULT_
     material = Material.mix(a, b, np.broadcast_to(mask, (n, n)))
     _validate.model_index(model)
     ax = _axes(ax)
-    image = _render.render_sphere(material, n, light=light, model=model)
+    image = _render.render_sphere(material, n, light=light, model=model, environment=environment)
     inside, _ = _render.sphere_frames(n)
     ax.imshow(_rgba(image, inside, exposure), interpolation="nearest")
     _sphere_axes(ax, "Material.mix(a, b, mask)")

@@ -1,10 +1,14 @@
 """Lit-sphere pictures computed with the batched kernel.
 
 A unit sphere seen from +z (orthographic), each pixel shaded in its own
-tangent frame (normal n, tangent along the sphere's latitude), lit by one
-directional light plus a constant ambient term. Returns linear RGB; use
-:func:`to_srgb8` (a Reinhard-type tone curve on luminance, then sRGB) for a
-displayable image.
+tangent frame (normal n, tangent along the sphere's latitude), lit by a
+directional key light and, by default, a sky: metals need something to
+reflect. The sky's integral is estimated per pixel from importance samples
+(``pb.sample``) at a rank-1 lattice's points (a Kronecker sequence, randomly
+shifted per pixel), so the default picture is deterministic and reads
+noise-free. Returns linear RGB; :func:`to_srgb8` (a Reinhard-type tone curve
+on luminance, then sRGB) gives a displayable image and :func:`save_image`
+writes PNG, OpenEXR (linear) or ``.npy`` (linear) by the file's extension.
 """
 
 from __future__ import annotations
@@ -20,13 +24,15 @@ from ._batch import random_uniforms as _random_uniforms
 from ._batch import sample as _sample
 from .material import Material
 
-__all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_frames", "tone_map", "to_srgb8",
-           "write_png", "DEFAULT_LIGHT", "MAX_RESOLUTION", "TONE_CURVES", "REINHARD_WHITE"]
+__all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_frames", "lattice_uniforms", "tone_map",
+           "to_srgb8", "write_png", "save_image", "IMAGE_FORMATS", "DEFAULT_LIGHT", "DEFAULT_SAMPLES", "MAX_RESOLUTION",
+           "TONE_CURVES", "REINHARD_WHITE", "FILMIC_WHITE"]
 
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
 
 
 MAX_RESOLUTION = 16384
+DEFAULT_SAMPLES = 64  # sky samples per pixel: with the lattice below, no visible noise on any preset
 
 
 def _resolution(value) -> int:
@@ -85,9 +91,34 @@ def sphere_frames(resolution: int):
     return inside, to_local
 
 
+def _environment(value):
+    """``"sky"`` (the default sky), None or False (none), or a callable ``L(direction)``."""
+    if isinstance(value, str):
+        if value != "sky":
+            raise ValueError(f"environment: expected 'sky', None or a callable L(direction), got {value!r}")
+        return sky_environment
+    if value is None or value is False:
+        return None
+    if value is True:
+        return sky_environment
+    if not callable(value):
+        raise TypeError(f"environment: expected 'sky', None or a callable L(direction), got {type(value).__name__}")
+    return value
+
+
 def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT, light_intensity: float = 3.0,
-                  ambient: float = 0.03, model: str = "disney2014") -> np.ndarray:
+                  ambient: float = 0.0, model: str = "disney2014", *, environment="sky", samples: int = DEFAULT_SAMPLES,
+                  seed: int = 0) -> np.ndarray:
     """Linear RGB ``(resolution, resolution, 3)`` image of ``material`` on a sphere.
+
+    Lit by a directional light (``light``: direction towards it in camera
+    space, x right, y up, z to the viewer; ``light_intensity``: its
+    irradiance, 0 turns it off) and by ``environment``: ``"sky"`` (default,
+    :func:`sky_environment`), a callable ``L(direction)`` from camera-space
+    directions ``(..., 3)`` to RGB radiance, or None. The environment's
+    integral is :func:`render_environment`'s (``samples`` per pixel, ``seed``).
+    ``ambient``: an optional constant ``ambient * base_color`` term (an
+    approximation that ignores metallic; 0 by default).
 
     ``material`` may be uniform or per pixel (leading shape ``(resolution, resolution)``,
     e.g. made by :meth:`Material.mix` with a mask); a leading shape ``S + (1, 1)``
@@ -97,70 +128,122 @@ def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT
     light = _light_direction(light)
     light_intensity = _non_negative("light_intensity", light_intensity)
     ambient = _non_negative("ambient", ambient)
+    environment = _environment(environment)
     inside, to_local = sphere_frames(resolution)
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
     radiance = np.float32(light_intensity) * _eval(material, wi, wo, cosine=True, model=model)
-    radiance += np.float32(ambient) * np.asarray(material.base_color, dtype=np.float32)
+    if ambient > 0.0:
+        radiance += np.float32(ambient) * np.asarray(material.base_color, dtype=np.float32)
+    if environment is not None:
+        radiance += render_environment(material, resolution, environment, samples, seed, model).astype(np.float32)
     radiance[..., ~inside, :] = 0.0
     return radiance
 
 
-def sky_environment(direction, zenith=(0.25, 0.45, 1.0), horizon=(1.0, 1.0, 1.0), ground=(0.25, 0.22, 0.2)):
-    """A simple sky/ground gradient ``L(w)`` (RGB radiance) for camera-space directions ``(..., 3)``.
+def sky_environment(direction, zenith=(0.65, 0.75, 0.9), horizon=(1.0, 1.0, 1.0), ground=(0.12, 0.11, 0.1)):
+    """A simple sky/ground gradient ``L(w)`` (RGB radiance, float32) for camera-space directions ``(..., 3)``.
 
     y is up (as in :mod:`principled_brdf.render`): above the horizon the sky
     goes from ``horizon`` to ``zenith`` as ``sqrt(y)``; below it is ``ground``,
-    blended over a narrow band around the horizon.
+    blended over a narrow band around the horizon. The default colours are
+    nearly neutral, so that a metal shows its own colour, and the ground is
+    dark, so that its curvature shows.
     """
-    w = np.asarray(direction, dtype=np.float64)
-    up = w[..., 1:2]
-    zenith, horizon, ground = (np.asarray(c, dtype=np.float64) for c in (zenith, horizon, ground))
-    sky = horizon + (zenith - horizon) * np.sqrt(np.clip(up, 0.0, 1.0))
-    blend = np.clip(0.5 + up / 0.04, 0.0, 1.0)
-    return ground + (sky - ground) * blend
+    up = np.asarray(direction, dtype=np.float32)[..., 1]
+    zenith, horizon, ground = (np.asarray(c, dtype=np.float32) for c in (zenith, horizon, ground))
+    blend = np.clip(up * np.float32(25.0) + np.float32(0.5), 0.0, 1.0)  # 0 to 1 over |y| < 0.02
+    height = np.sqrt(np.clip(up, 0.0, 1.0))
+    # ground + blend (horizon - ground) + blend height (zenith - horizon), as one small matrix product
+    basis = np.stack([np.ones_like(up), blend, blend * height], axis=-1)
+    return basis @ np.stack([ground, horizon - ground, zenith - horizon])
 
 
-def render_environment(material: Material, resolution: int = 256, environment=None, samples: int = 64, seed: int = 0,
-                       model: str = "disney2014") -> np.ndarray:
-    """Linear RGB ``(resolution, resolution, 3)``: the sphere of :func:`render_sphere` lit by
-    ``environment`` (camera-space directions ``(..., 3)`` to RGB radiance; default
-    :func:`sky_environment`), per pixel ``∫ f L(wi) cos θl dωi`` estimated from
-    ``samples`` importance samples (``pb.sample``, reproducible from ``seed``)."""
-    environment = sky_environment if environment is None else environment
+# The Kronecker sequence of Roberts' generalised golden ratio in 3-d: x_k = frac(k α),
+# α_j = φ3^-(j+1) with φ3 the real root of x⁴ = x + 1 (the plastic number's analogue);
+# its points fill [0, 1)³ with low discrepancy for any count.
+_PHI3 = 1.2207440846057596
+_LATTICE_STEP = np.array([_PHI3 ** -1, _PHI3 ** -2, _PHI3 ** -3])
+
+
+def lattice_uniforms(count: int, shape: tuple, seed: int = 0, first: int = 0) -> np.ndarray:
+    """``(count,) + shape + (3,)`` float32 uniforms: sample ``k`` of each element is the
+    Kronecker point ``frac(k α + s)``, ``s`` the element's random shift (Cranley-Patterson
+    rotation, from ``seed``), for ``k = first .. first + count - 1``. Every element gets a
+    well-spread set of points, and neighbouring elements uncorrelated ones."""
+    elements = int(np.prod(shape, dtype=np.int64))
+    shift = _random_uniforms(seed, elements).reshape(tuple(shape) + (3,))
+    steps = np.mod(np.arange(first, first + count, dtype=np.float64)[:, None] * _LATTICE_STEP, 1.0).astype(np.float32)
+    points = shift + steps.reshape((count,) + (1,) * len(shape) + (3,))
+    points -= points >= 1.0  # frac of a sum of two numbers in [0, 1)
+    return np.minimum(points, np.nextafter(np.float32(1.0), np.float32(0.0)))
+
+
+def render_environment(material: Material, resolution: int = 256, environment=None, samples: int = DEFAULT_SAMPLES,
+                       seed: int = 0, model: str = "disney2014") -> np.ndarray:
+    """Linear RGB ``(resolution, resolution, 3)`` (or ``S + (resolution, resolution, 3)`` as
+    :func:`render_sphere`): the sphere lit by ``environment`` alone (camera-space directions
+    ``(..., 3)`` to RGB radiance; default :func:`sky_environment`), per pixel
+    ``∫ f L(wi) cos θl dωi`` estimated from ``samples`` importance samples (``pb.sample``) at
+    :func:`lattice_uniforms` points shifted per pixel from ``seed``: deterministic, and far
+    less noisy than independent samples."""
+    environment = sky_environment if environment is None else _environment(environment)
+    samples = _validate.integer("samples", samples)
+    if samples < 1:
+        raise ValueError(f"samples: expected at least 1, got {samples}")
     inside, to_local = sphere_frames(resolution)
     wo = to_local((0.0, 0.0, 1.0))
-    # to_local(e_k)[..., j] = frame_j[k]: the rows of the local-to-camera matrix.
-    to_camera = np.stack([to_local(e) for e in np.eye(3)], axis=-2)  # [..., k, j]
-    pixels = resolution * resolution
-    chunk = max(1, (1 << 20) // pixels)
-    total = np.zeros((resolution, resolution, 3))
+    # to_local(e_k)[..., j] = frame_j[k]: the tangent, bitangent and normal (j = 0, 1, 2) in camera space
+    frame = [to_local(e) for e in np.eye(3)]  # frame[k][..., j]
+    shape = np.broadcast_shapes(material.shape, inside.shape)
+    elements = int(np.prod(shape, dtype=np.int64))
+    chunk = max(1, (1 << 20) // elements)
+    total = np.zeros(shape + (3,))
+    # the points depend on the pixel alone: a sphere looks the same rendered alone or in a batch
+    spheres = (1,) * (len(shape) - inside.ndim)
     for start in range(0, samples, chunk):
         count = min(chunk, samples - start)
-        u = _random_uniforms(seed, count * pixels, first=start * pixels).reshape(count, resolution, resolution, 3)
-        drawn = _sample(material, wo, u=u, model=model)
-        direction = np.einsum("...kj,s...j->s...k", to_camera, drawn.wi)
-        radiance = np.asarray(environment(direction), dtype=np.float64)
+        u = lattice_uniforms(count, inside.shape, seed, first=start).reshape((count,) + spheres + inside.shape + (3,))
+        wi = _sample(material, wo, u=u, model=model)
+        local = [wi.wi[..., j] for j in range(3)]
+        direction = np.stack([local[0] * frame[k][..., 0] + local[1] * frame[k][..., 1] + local[2] * frame[k][..., 2]
+                              for k in range(3)], axis=-1)
+        radiance = np.asarray(environment(direction))
         if radiance.shape != direction.shape:
             raise ValueError(f"environment: expected RGB radiance of shape {direction.shape}, got {radiance.shape}")
-        total += np.einsum("s...c,s...c->...c", drawn.weight.astype(np.float64), radiance)
+        total += (wi.weight * radiance).sum(axis=0, dtype=np.float64)
     total /= samples
-    total[~inside] = 0.0
+    total[..., ~inside, :] = 0.0
     return total
 
 
-TONE_CURVES = ("reinhard", "clip")
-REINHARD_WHITE = 4.0  # the luminance the default curve maps to display white
+TONE_CURVES = ("filmic", "reinhard", "clip")
+REINHARD_WHITE = 4.0  # the luminance the "reinhard" curve maps to display white
+FILMIC_WHITE = (0.56 + (0.56**2 + 4 * 0.08 * 0.14) ** 0.5) / 0.16  # 7.24: the "filmic" curve reaches 1 (0.08 x² - 0.56 x - 0.14 = 0)
 
 
-def tone_map(linear: np.ndarray, exposure: float = 1.0, curve: str = "reinhard") -> np.ndarray:
+def _filmic(luminance: np.ndarray) -> np.ndarray:
+    # Narkowicz's 2015 fit of the ACES reference rendering transform, y = x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14):
+    # a toe, midtones near the identity (0.18 -> 0.27, 1 -> 0.80) and a shoulder reaching 1 at FILMIC_WHITE
+    mapped = luminance * (2.51 * luminance + 0.03) / (luminance * (2.43 * luminance + 0.59) + 0.14)
+    return np.where(luminance < FILMIC_WHITE, mapped, 1.0)
+
+
+def _reinhard(luminance: np.ndarray) -> np.ndarray:
+    return luminance * (1.0 + luminance / REINHARD_WHITE**2) / (1.0 + luminance)
+
+
+def tone_map(linear: np.ndarray, exposure: float = 1.0, curve: str = "filmic") -> np.ndarray:
     """Scene-referred linear RGB ``(..., 3)`` to display-referred linear RGB in [0, 1].
 
-    ``"reinhard"``: the extended Reinhard curve on luminance, ``Y' = Y (1 + Y /
-    W²) / (1 + Y)`` with white ``W`` = :data:`REINHARD_WHITE`, each pixel's
-    colour scaled by ``Y'/Y`` and, where a channel would still exceed 1,
-    divided by that channel (so a gold highlight stays gold and a white
-    material keeps its shading instead of clipping flat). ``"clip"``: each
-    channel clipped to [0, 1]. Both after multiplying by ``exposure``."""
+    The curve maps each pixel's luminance ``Y`` (Rec. 709 weights) to ``Y'``;
+    the pixel's colour is scaled by ``Y'/Y`` and, where a channel would still
+    exceed 1, divided by that channel, so a gold highlight stays gold and a
+    white material keeps its shading instead of clipping flat. ``"filmic"``
+    (default): the ACES fit of Narkowicz 2015, white at ``Y`` =
+    :data:`FILMIC_WHITE`; ``"reinhard"``: the extended Reinhard curve ``Y (1 +
+    Y / W²) / (1 + Y)``, white ``W`` = :data:`REINHARD_WHITE` (darker
+    midtones); ``"clip"``: each channel clipped to [0, 1]. All after
+    multiplying by ``exposure``."""
     if curve not in TONE_CURVES:
         raise ValueError(f"curve: expected one of {', '.join(TONE_CURVES)}, got {curve!r}")
     exposure = _non_negative("exposure", exposure)
@@ -168,13 +251,13 @@ def tone_map(linear: np.ndarray, exposure: float = 1.0, curve: str = "reinhard")
     if curve == "clip":
         return np.minimum(c, 1.0)
     luminance = c @ np.array([0.2126, 0.7152, 0.0722])
-    mapped = luminance * (1.0 + luminance / REINHARD_WHITE**2) / (1.0 + luminance)
+    mapped = _filmic(luminance) if curve == "filmic" else _reinhard(luminance)
     scale = np.divide(mapped, luminance, out=np.zeros_like(luminance), where=luminance > 0.0)
     c = c * scale[..., None]
     return c / np.maximum(1.0, c.max(axis=-1, keepdims=True))
 
 
-def to_srgb8(linear: np.ndarray, exposure: float = 1.0, curve: str = "reinhard") -> np.ndarray:
+def to_srgb8(linear: np.ndarray, exposure: float = 1.0, curve: str = "filmic") -> np.ndarray:
     """Linear RGB to 8-bit sRGB for saving or showing: :func:`tone_map`, then the sRGB encoding."""
     c = tone_map(linear, exposure, curve)
     srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
@@ -196,3 +279,40 @@ def write_png(path: str, image: np.ndarray) -> None:
     with open(path, "wb") as f:
         f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
                 + chunk(b"IEND", b""))
+
+
+#: The formats :func:`save_image` writes, by extension.
+IMAGE_FORMATS = {".png": "8-bit sRGB after tone_map", ".exr": "linear float32 RGB (OpenEXR, `pip install OpenEXR`)",
+                 ".npy": "linear float32 RGB (numpy)"}
+
+
+def save_image(path, linear: np.ndarray, exposure: float = 1.0, curve: str = "filmic") -> str:
+    """Write a linear RGB ``(H, W, 3)`` image in the format of ``path``'s extension
+    (:data:`IMAGE_FORMATS`): ``.png`` tone-mapped and sRGB-encoded (:func:`to_srgb8`),
+    ``.exr`` and ``.npy`` the linear values times ``exposure`` (high dynamic range kept).
+    Returns the path. Another extension is a ValueError naming it."""
+    import os
+
+    path = os.fspath(path)
+    extension = os.path.splitext(path)[1].lower()
+    if extension not in IMAGE_FORMATS:
+        raise ValueError(f"path: cannot write {extension or 'a file without an extension'!r} images; "
+                         f"supported: {', '.join(IMAGE_FORMATS)}")
+    image = np.asarray(linear, dtype=np.float64)
+    if image.ndim != 3 or image.shape[2] != 3:
+        raise ValueError(f"linear: expected an (H, W, 3) RGB image, got shape {image.shape}")
+    exposure = _non_negative("exposure", exposure)
+    if extension == ".png":
+        write_png(path, to_srgb8(image, exposure, curve))
+    elif extension == ".npy":
+        np.save(path, (image * exposure).astype(np.float32))
+    else:
+        try:
+            import OpenEXR
+        except ImportError:
+            raise ImportError("writing .exr needs the OpenEXR package: pip install OpenEXR") from None
+        pixels = np.ascontiguousarray(image * exposure, dtype=np.float32)
+        header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+        with OpenEXR.File(header, {"RGB": pixels}) as exr:
+            exr.write(path)
+    return path
