@@ -135,7 +135,26 @@ def test_brdf_slice_rgb_channel_and_existing_axes():
     rgba = image_of(left)
     assert rgba.shape == (32, 32, 4) and np.all(np.isfinite(rgba)) and rgba[..., :3].std() > 0.05
     assert pbplot.brdf_slice("gold", resolution=32, channel="r", log=False, ax=right) is right
-    assert len(fig.axes) == 3  # two panels and one colorbar
+    assert len(fig.axes) == 4  # two panels, each with a colour bar (grey for rgb: the brightness scale)
+
+
+def test_a_linear_slice_is_not_black_and_exposure_brightens():
+    # car paint's clearcoat peak is 10,000 times its body: scaled to the peak, a linear slice is black
+    ax = pbplot.brdf_slice("car_paint", resolution=64, log=False)
+    data, norm = np.ma.getdata(image_of(ax)), ax.images[-1].norm
+    assert norm.vmax == pytest.approx(np.percentile(data, 90))
+    assert np.mean(norm(data) > 0.1) > 0.25
+    rgb = image_of(pbplot.brdf_slice("car_paint", resolution=64, channel="rgb", log=False))[..., :3]
+    brighter = image_of(pbplot.brdf_slice("car_paint", resolution=64, channel="rgb", log=False, exposure=4))[..., :3]
+    assert np.mean(rgb.max(-1) > 0.2) > 0.25
+    assert np.all(brighter >= rgb - 1e-12) and brighter.mean() > rgb.mean() * 1.3
+    # the colour bar of an exposed slice is in f's units: its top is the range divided by the exposure
+    ax = pbplot.brdf_slice("car_paint", resolution=64, log=False, exposure=4)
+    assert ax.images[-1].norm.vmax == pytest.approx(norm.vmax / 4)
+    with pytest.raises(ValueError, match="percentile"):
+        pbplot.brdf_slice("car_paint", resolution=8, percentile=0)
+    with pytest.raises(ValueError, match="exposure"):
+        pbplot.brdf_slice("car_paint", resolution=8, exposure=0)
 
 
 def test_brdf_slice_bad_arguments():
@@ -184,6 +203,26 @@ def test_polar_lobes_values_and_peak():
     assert total[0] == 0.0 and total[-1] == 0.0  # on the horizon
     # no sheen or clearcoat: those lines are left out
     assert {l.get_label() for l in ax.get_lines()} == {"diffuse", "specular", "total", "wo"}
+
+
+def test_polar_lobes_log_radius_and_the_total_beside_a_single_lobe():
+    # a rough white dielectric: the total is nearly all diffuse, so it is drawn as a wider band
+    # beneath the lobes, where it stays visible
+    ax = pbplot.polar_lobes(ROUGH_WHITE, 30, resolution=181)
+    total, lobe = (next(l for l in ax.get_lines() if l.get_label() == name) for name in ("total", "diffuse"))
+    assert np.median(lobe.get_ydata() / np.maximum(total.get_ydata(), 1e-30)) > 0.9
+    assert total.get_linewidth() >= 2 * lobe.get_linewidth() and total.get_zorder() < lobe.get_zorder()
+    # log radius: log10 f over `decades` below the peak, ticks labelled in 1/sr
+    linear = pbplot.polar_lobes("car_paint", 45, resolution=181)
+    logged = pbplot.polar_lobes("car_paint", 45, resolution=181, log=True, decades=3)
+    f, r = line(linear, "total")[1], line(logged, "total")[1]
+    floor = np.log10(f.max()) - 3
+    np.testing.assert_allclose(r, np.maximum(np.log10(np.maximum(f, 1e-300)) - floor, 0.0), rtol=1e-12)
+    labels = [t.get_text() for t in logged.yaxis.get_ticklabels()]
+    assert 3 <= len(labels) <= 4 and all(float(text) > 0 for text in labels)  # one per decade
+    assert 2 <= len(linear.yaxis.get_ticklocs()) <= 6  # a few readable radius ticks
+    with pytest.raises(ValueError, match="decades"):
+        pbplot.polar_lobes("car_paint", 45, log=True, decades=0)
 
 
 def test_polar_lobes_into_existing_polar_axes_and_total_only():

@@ -185,9 +185,18 @@ def slice_directions(resolution: int, phi_d: float = 90.0):
     return theta, theta.copy(), rotate(dx, dy, cd), rotate(-dx, -dy, cd)
 
 
+def _srgb_encode(c: np.ndarray) -> np.ndarray:
+    c = np.clip(c, 0.0, 1.0)
+    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+
+
+def _srgb_decode(c: np.ndarray) -> np.ndarray:
+    return np.where(c <= 0.04045, c / 12.92, np.power((c + 0.055) / 1.055, 2.4))
+
+
 def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
-               log: bool = True, model: str = "disney2014", vmin=None, vmax=None, cmap: str = "inferno",
-               colorbar: bool = True, ax=None):
+               log: bool = True, model: str = "disney2014", vmin=None, vmax=None, percentile=None,
+               exposure: float = 1.0, cmap: str = "inferno", colorbar: bool = True, ax=None):
     """The BRDF image slice f(θh, θd) at azimuth ``phi_d`` (Burley 2012, figures 3, 4 and 17).
 
     θh (half-vector angle from the normal, degrees) runs left to right from 0
@@ -197,64 +206,74 @@ def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel:
     the bottom right. Pixels where the light or the view is at or below the
     horizon are masked (drawn in grey; NaN-free data underneath).
 
-    ``channel``: one of :data:`CHANNELS` (a colorbar in 1/sr), or ``"rgb"``:
-    the colour of f, with ``log`` mapping the luminance logarithmically and
-    keeping each pixel's chromaticity. ``log``: logarithmic colour scale over
-    ``[vmin, vmax]`` (default: the largest value and at most 6 decades below
-    it). Returns the Axes; the image is ``ax.images[-1]`` (``get_array()``
+    ``channel``: one of :data:`CHANNELS`, or ``"rgb"``: the colour of f, each
+    pixel's brightness set by its luminance on the colour scale and its
+    chromaticity kept (a grey colour bar gives the scale). The colour scale
+    runs over ``[vmin, vmax]`` in 1/sr; by default up to the ``percentile``-th
+    percentile of the slice (default 99 with ``log``, 90 without: a sharp
+    specular peak saturates instead of leaving the rest black) and, with
+    ``log``, down to 6 decades below that or the smallest positive value
+    (linear: from 0). ``exposure`` multiplies
+    f before it is mapped (above 1 brightens, the colour bar relabelled to
+    match). Returns the Axes; the image is ``ax.images[-1]`` (``get_array()``
     gives the plotted values, indexed ``[θd, θh]`` with row 0 at θd ≈ 0).
     """
     material = _uniform_material("material", material)
     n = _resolution(resolution)
     rgb_mode = channel == "rgb"
-    weights = None if rgb_mode else _channel(channel)
+    weights = np.asarray(CHANNELS["luminance"]) if rgb_mode else _channel(channel)
     _validate.model_index(model)
     for name, value in (("vmin", vmin), ("vmax", vmax)):
         if value is not None and _real(name, value, 0.0) <= 0.0 and log:
             raise ValueError(f"{name}: a logarithmic scale needs a positive value, got {value!r}")
+    percentile = (99.0 if log else 90.0) if percentile is None else _real("percentile", percentile, 0.0, 100.0,
+                                                                              open_lower=True)
+    exposure = _real("exposure", exposure, 0.0, open_lower=True)
     ax = _axes(ax)
-    from matplotlib import colors
+    from matplotlib import colors, cm
 
     theta_h, theta_d, wi, wo = slice_directions(n, phi_d)
     f = _eval(material, wi, wo, model=model).astype(np.float64)
     valid = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
-    luminance = _project(f, np.asarray(CHANNELS["luminance"]) if rgb_mode else weights)
-    shown = luminance[valid]
-    top = float(vmax) if vmax is not None else (float(shown.max()) if shown.size else 0.0)
-    if top <= 0.0:
-        top = 1.0
+    value = _project(f, weights)
+    shown = value[valid]
+    top = float(vmax) if vmax is not None else (float(np.percentile(shown, percentile)) if shown.size else 0.0)
+    if not top > 0.0:
+        top = float(shown.max()) if shown.size and shown.max() > 0.0 else 1.0
     if vmin is not None:
         bottom = float(vmin)
     elif log:
         positive = shown[shown > 0.0]
         bottom = max(float(positive.min()) if positive.size else top * 1e-6, top * 1e-6)
-        bottom = min(bottom, top * 0.5)
     else:
         bottom = 0.0
+    bottom = min(bottom, top * 0.5)
+    # exposure x f is mapped onto [bottom, top]: the scale of f itself is that divided by exposure
+    norm = (colors.LogNorm if log else colors.Normalize)(vmin=bottom / exposure, vmax=top / exposure)
     extent = (0.0, 90.0, 0.0, 90.0)
-    title = f"BRDF slice, φd = {float(phi_d):g}°"
+    title = f"BRDF slice, φd = {float(phi_d):g}°" + (f", exposure {exposure:g}" if exposure != 1.0 else "")
 
     if rgb_mode:
-        if log:
-            level = np.clip((np.log(np.maximum(luminance, bottom)) - np.log(bottom)) / np.log(top / bottom), 0.0, 1.0)
-            scale = np.divide(level, luminance, out=np.zeros_like(luminance), where=luminance > 0.0)
-            color = f * scale[..., None]
-        else:
-            color = _render.to_srgb8(f / top, curve="clip").astype(np.float64) / 255.0  # f scaled to [0, 1] already
+        # display brightness (sRGB-encoded) = the luminance's place on the scale, as on the grey colour bar
+        level = np.clip(np.ma.filled(norm(np.maximum(value, norm.vmin)), 0.0), 0.0, 1.0)
+        scale = np.divide(_srgb_decode(level), value, out=np.zeros_like(value), where=value > 0.0)
+        color = f * scale[..., None]
         color = color / np.maximum(1.0, color.max(axis=-1, keepdims=True))  # keep the hue where it clips
         image = np.empty(color.shape[:-1] + (4,))
-        image[..., :3] = np.where(valid[..., None], color, colors.to_rgb(_BACKGROUND))
+        image[..., :3] = np.where(valid[..., None], _srgb_encode(color), colors.to_rgb(_BACKGROUND))
         image[..., 3] = 1.0
         ax.imshow(image, origin="lower", extent=extent, interpolation="nearest")
-        ax.set_title(title + (" (log luminance)" if log else ""))
-    else:
-        data = np.ma.masked_array(np.where(valid, np.maximum(luminance, bottom if log else 0.0), bottom),
-                                  mask=~valid)
-        norm = colors.LogNorm(vmin=bottom, vmax=top) if log else colors.Normalize(vmin=bottom, vmax=top)
-        colormap = _pyplot().get_cmap(cmap).with_extremes(bad=_BACKGROUND)
-        image = ax.imshow(data, origin="lower", extent=extent, interpolation="nearest", norm=norm, cmap=colormap)
         if colorbar:
-            ax.figure.colorbar(image, ax=ax, label=f"f, {channel} (1/sr)")
+            ax.figure.colorbar(cm.ScalarMappable(norm=norm, cmap="gray"), ax=ax,
+                               label="f, luminance (1/sr): brightness")
+        ax.set_title(title + (" (log scale)" if log else ""))
+    else:
+        floor = norm.vmin if log else 0.0
+        data = np.ma.masked_array(np.where(valid, np.maximum(value, floor), floor), mask=~valid)
+        colormap = _pyplot().get_cmap(cmap).with_extremes(bad=_BACKGROUND)
+        ax.imshow(data, origin="lower", extent=extent, interpolation="nearest", norm=norm, cmap=colormap)
+        if colorbar:
+            ax.figure.colorbar(ax.images[-1], ax=ax, label=f"f, {channel} (1/sr)", extend="max")
         ax.set_title(title)
     ax.set_xlabel("θh (degrees)")
     ax.set_ylabel("θd (degrees)")
@@ -268,24 +287,31 @@ def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel:
 
 
 def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = False, model: str = "disney2014",
-                resolution: int = 721, channel: str = "luminance", legend: bool = True, ax=None):
+                resolution: int = 721, channel: str = "luminance", log: bool = False, decades: float = 4.0,
+                legend: bool = True, ax=None):
     """f(wi, wo) in the plane of incidence, per lobe and in total, on a polar Axes.
 
     ``wo = (sin θo, 0, cos θo)`` (``theta_o`` in degrees, in (-90, 90)), ``wi =
     (sin t, 0, cos t)`` for t from -90 to 90 degrees in ``resolution`` steps;
     the angle of the plot is t (0 at the top = the normal, positive to the
     right, the side of wo), the radius is f in 1/sr (``cosine``: f cos θl).
-    ``lobes``: also draw the four lobes (lobes that are zero everywhere are
-    left out); their sum is the ``"total"`` line. The view direction is drawn
-    as a grey dashed line labelled ``"wo"``. ``ax`` must be a polar Axes.
-    Returns the polar Axes; lines carry labels ``"total"``, ``"diffuse"``, ...
+    ``log``: the radius is log10 f over the ``decades`` below the largest
+    value (ticks labelled in 1/sr), so a diffuse lobe shows beside a sharp
+    specular peak. ``lobes``: also draw the four lobes (lobes that are zero
+    everywhere are left out) over a wide grey band of their sum, the
+    ``"total"`` line, which stays visible where one lobe is all of it. The
+    view direction is drawn as a grey dashed line labelled ``"wo"``. ``ax``
+    must be a polar Axes. Returns the polar Axes; lines carry labels
+    ``"total"``, ``"diffuse"``, ... (their data: f, or log10 f with ``log``).
     """
     material = _uniform_material("material", material)
     theta = _real("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
     n = _resolution(resolution)
     weights = _channel(channel)
+    decades = _real("decades", decades, 0.0, open_lower=True)
     _validate.model_index(model)
     ax = _axes(ax, polar=True)
+    from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
 
     t = np.radians(np.linspace(-90.0, 90.0, n))
     wi = np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
@@ -294,22 +320,40 @@ def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = 
     values = _eval_lobes(material, wi, wo, cosine=cosine, model=model)
     curves = {name: _project(v, weights) for name, v in zip(_validate.LOBE_NAMES, values)}
     total = sum(curves.values())
+    peak = float(total.max()) if total.max() > 0 else 1.0
+    if log:
+        floor = np.log10(peak) - decades
 
-    if lobes:
-        for name, curve in curves.items():
-            if np.any(curve > 0.0):
-                ax.plot(t, curve, color=_LOBE_COLORS[name], lw=1.2, label=name)
-    ax.plot(t, total, color=_LOBE_COLORS["total"], lw=1.8, label="total")
-    top = float(total.max()) if total.max() > 0 else 1.0
-    ax.plot([np.radians(theta)] * 2, [0.0, top], color="0.5", ls="--", lw=1.0, label="wo")
+        def radius(f):  # log10 f above the floor; nothing below it
+            return np.maximum(np.log10(np.maximum(f, 1e-300)) - floor, 0.0)
+    else:
+        def radius(f):
+            return f
+
+    drawn = [(name, curve) for name, curve in curves.items() if lobes and np.any(curve > 0.0)]
+    ax.plot(t, radius(total), color=_LOBE_COLORS["total"], lw=4.0 if drawn else 1.8, alpha=0.3 if drawn else 1.0,
+            label="total", zorder=2)
+    for name, curve in drawn:
+        ax.plot(t, radius(curve), color=_LOBE_COLORS[name], lw=1.3, label=name, zorder=3)
+    top = float(radius(np.array(peak)))
+    ax.plot([np.radians(theta)] * 2, [0.0, top], color="0.5", ls="--", lw=1.0, label="wo", zorder=1)
     ax.set_theta_zero_location("N")
     ax.set_theta_direction(-1)
     ax.set_thetamin(-90)
     ax.set_thetamax(90)
     ax.set_ylim(0.0, top * 1.05)
+    if log:  # a tick per decade (or per few), labelled with f itself
+        step = max(1, int(np.ceil(decades / 4)))
+        exponents = np.arange(np.ceil(floor), np.floor(np.log10(peak)) + 1, step)
+        ax.yaxis.set_major_locator(FixedLocator(exponents - floor))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda r, _: f"{10 ** (r + floor):.3g}"))
+    else:
+        ax.yaxis.set_major_locator(MaxNLocator(4))
+    ax.set_rlabel_position(-22.5)  # along a ray inside the upper-left quarter, clear of the curves' usual peaks
+    ax.tick_params(axis="y", labelsize="small")
     quantity = "f cos θl" if cosine else "f"
-    ax.set_title(f"{quantity} (1/sr, {channel}) in the plane of incidence, θo = {theta:g}°\n"
-                 "angle: θl from the normal, positive on the side of wo")
+    ax.set_title(f"{quantity} (1/sr, {channel}{', log radius' if log else ''}), θo = {theta:g}°\n"
+                 "plane of incidence; angle θl from the normal", fontsize="medium")
     if legend:  # below the half disc (its baseline is at axes y = 0.25)
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.17), ncol=3, fontsize="small", frameon=False)
     return ax
@@ -396,7 +440,7 @@ def albedo_curves(material, *, angles=np.linspace(0, 89, 46), samples: int = 1 <
     ax.set_xlabel("θo (degrees)")
     ax.set_ylabel(f"directional albedo ({channel}, unitless)")
     ax.set_title(f"directional albedo, ±2 s.e. ({samples} samples)")
-    ax.legend(fontsize="small", frameon=False)
+    ax.legend(loc="best", fontsize="small", frameon=False)  # where it covers the fewest points
     return ax
 
 
