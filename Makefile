@@ -3,7 +3,7 @@
 PYTHON ?= python3
 export PYTHON
 
-.PHONY: demo test install deps bench sanitize
+.PHONY: demo test install deps bench sanitize wheel
 
 demo: install
 	$(PYTHON) -m principled_brdf demo
@@ -16,6 +16,10 @@ install: deps
 
 deps:
 	bash scripts/install-deps.sh
+
+# A portable manylinux wheel in dist/ (scripts/build-wheel.sh says how); `pip install dist/*.whl`
+wheel: deps
+	bash scripts/build-wheel.sh
 
 # Google Benchmark executable (not part of the wheel); results in bench/results.json
 bench: deps
