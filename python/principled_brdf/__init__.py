@@ -17,4 +17,6 @@ __all__ = [
     "eval_grad", "Gradient", "GRADIENT_NAMES", "fit", "FitResult",
     "reference", "microfacet", "measured", "frames", "presets", "render", "plot",
 ]
+from .explorer import explorer  # noqa: E402 - ipywidgets and matplotlib are imported by the call
+__all__.append("explorer")
 __version__ = "0.1.0"

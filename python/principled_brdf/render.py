@@ -25,7 +25,7 @@ from ._batch import sample as _sample
 from .material import Material
 
 __all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_frames", "lattice_uniforms", "tone_map",
-           "to_srgb8", "write_png", "save_image", "IMAGE_FORMATS", "DEFAULT_LIGHT", "DEFAULT_SAMPLES", "MAX_RESOLUTION",
+           "to_srgb8", "png_bytes", "write_png", "save_image", "IMAGE_FORMATS", "DEFAULT_LIGHT", "DEFAULT_SAMPLES", "MAX_RESOLUTION",
            "TONE_CURVES", "REINHARD_WHITE", "FILMIC_WHITE"]
 
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
@@ -264,21 +264,27 @@ def to_srgb8(linear: np.ndarray, exposure: float = 1.0, curve: str = "filmic") -
     return np.round(srgb * 255.0).astype(np.uint8)
 
 
-def write_png(path: str, image: np.ndarray) -> None:
-    """Write an 8-bit RGB ``(H, W, 3)`` image as PNG (no dependency beyond zlib)."""
+def png_bytes(image: np.ndarray) -> bytes:
+    """An 8-bit ``(H, W, 3)`` RGB or ``(H, W, 4)`` RGBA image as PNG bytes (no dependency beyond zlib)."""
     pixels = np.ascontiguousarray(image, dtype=np.uint8)
-    if pixels.ndim != 3 or pixels.shape[2] != 3:
-        raise ValueError(f"image: expected an (H, W, 3) uint8 array, got shape {pixels.shape}")
-    height, width, _ = pixels.shape
-    rows = np.concatenate([np.zeros((height, 1), np.uint8), pixels.reshape(height, width * 3)], axis=1)
+    if pixels.ndim != 3 or pixels.shape[2] not in (3, 4):
+        raise ValueError(f"image: expected an (H, W, 3) or (H, W, 4) uint8 array, got shape {pixels.shape}")
+    height, width, channels = pixels.shape
+    rows = np.concatenate([np.zeros((height, 1), np.uint8), pixels.reshape(height, width * channels)], axis=1)
 
     def chunk(kind: bytes, data: bytes) -> bytes:
         return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
 
-    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)  # 8-bit RGB
+    header = struct.pack(">IIBBBBB", width, height, 8, 6 if channels == 4 else 2, 0, 0, 0)  # 8-bit RGBA or RGB
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
+            + chunk(b"IEND", b""))
+
+
+def write_png(path: str, image: np.ndarray) -> None:
+    """Write an 8-bit RGB ``(H, W, 3)`` (or RGBA) image as PNG (:func:`png_bytes`)."""
+    data = png_bytes(image)
     with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
-                + chunk(b"IEND", b""))
+        f.write(data)
 
 
 #: The formats :func:`save_image` writes, by extension.

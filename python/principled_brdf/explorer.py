@@ -1,0 +1,681 @@
+"""An interactive BRDF explorer for Jupyter, after Disney's BRDF Explorer (ipywidgets).
+
+    import principled_brdf as pb
+    explorer = pb.explorer()              # the last line of a cell shows it
+    explorer = pb.explorer("car_paint", model="disney2012", resolution=256)
+
+A slider per material parameter (``base_color`` as a colour picker, sRGB
+converted to linear by :func:`principled_brdf.srgb_to_linear`), the model,
+a preset menu that sets the sliders, the light and view directions (θ, φ in
+degrees, local frame: normal z, tangent x) and four pictures that follow
+them, each a PNG in an ``ipywidgets.Image`` (``explorer.images[name]``):
+
+``"sphere"``
+    the material on a sphere (``pb.render.render_sphere``, orthographic from
+    +z) lit from (θl, φl) in camera space (x right, y up): at the centre of
+    the sphere, whose normal faces the viewer, that is the light of the
+    sliders in the local frame. ``sky light`` adds ``pb.render``'s sky by
+    importance sampling; ``exposure`` in stops, then ``pb.render.to_srgb8``.
+``"polar"``
+    f (luminance, 1/sr) per lobe and in total in the plane of incidence of
+    the view direction (θv, φv): wi sweeps the plane through the normal and
+    wo; the light is drawn projected into that plane. ``log radius`` shows
+    four decades below the next power of ten above the peak.
+``"slice"``
+    the (θh, θd) image slice at φd = 90° (``pb.plot.slice_directions``), log
+    luminance, with the light/view pair's (θh, θd) marked.
+``"albedo"``
+    the directional albedo E(θo) per lobe and in total (``pb.albedo``, ±2
+    standard errors), with θv marked.
+
+Every number comes from the batched kernel. A picture is recomputed only when
+something it shows changes (a view angle does not re-render the sphere), and
+the figures are made once and their data replaced, which keeps an update
+within a few tenths of a second. The explorer works headless (no display,
+no kernel): tests set ``explorer.sliders["roughness"].value`` and read
+``explorer.images["sphere"].value``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import inspect
+import math
+import time
+
+import numpy as np
+
+from . import _validate
+from . import presets as _presets
+from . import render as _render
+from ._batch import eval_lobes as _eval_lobes
+from .albedo import albedo as _albedo
+from .material import PARAMETERS, Material, srgb_to_linear
+from .plot import CHANNELS, slice_directions
+
+__all__ = ["explorer", "Explorer", "OUTPUTS", "CUSTOM"]
+
+#: The pictures, in display order (keys of :attr:`Explorer.images`).
+OUTPUTS = ("sphere", "polar", "slice", "albedo")
+#: The preset menu's entry for a material that is not (or no longer) a preset.
+CUSTOM = "(custom)"
+
+_LUMINANCE = np.asarray(CHANNELS["luminance"], dtype=np.float64)
+_LOBE_COLORS = {"diffuse": "tab:orange", "sheen": "tab:purple", "specular": "tab:blue", "clearcoat": "tab:green",
+                "total": "black"}
+# What each picture shows (keys of Explorer._state): it is redrawn only when one of these changes.
+_DEPENDS = {
+    "sphere": ("material", "model", "energy_compensation", "light", "exposure", "sky"),
+    "polar": ("material", "model", "energy_compensation", "light", "view", "log"),
+    "slice": ("material", "model", "energy_compensation", "light", "view"),
+    "albedo": ("material", "model", "energy_compensation", "view"),
+}
+_KEY_STYLES = {  # the legend entries of the plots, beyond the lobes
+    "wo": dict(color="0.45", ls="--", lw=1.0, label="view"),
+    "wi": dict(color="tab:red", ls=":", lw=1.4, label="light (projected)"),
+    "θv": dict(color="0.45", ls="--", lw=1.0, label="θv"),
+}
+_UI_MAX = 1.0  # the BRDF Explorer's slider range for the unbounded parameters (their domains go on)
+_POLAR_STEPS = 360
+_POLAR_DECADES = 4
+_SLICE_RESOLUTION = 128
+_ALBEDO_ANGLES = np.concatenate([np.arange(0.0, 85.0, 5.0), [84.0, 87.0, 89.0]])  # denser where E(θo) turns
+_ALBEDO_SAMPLES = 1 << 12
+_SKY_SAMPLES = 32  # render_sphere uses 64; 32 shows little grain and keeps an update near 0.2 s
+_AMBIENT = 0.03  # times base_color, without the sky: the unlit side is not black
+_DPI = 80
+_FIGSIZE = (4.4, 3.3)
+_FONT = {"font.size": 8.0, "axes.titlesize": 8.5, "legend.fontsize": 7.5}
+
+
+def _imports():
+    try:
+        import ipywidgets
+    except ImportError as error:
+        raise ImportError("pb.explorer() needs ipywidgets: pip install ipywidgets "
+                          "(or pip install 'principled-brdf[plot]')") from error
+    try:
+        import matplotlib
+        from matplotlib.figure import Figure
+    except ImportError as error:
+        raise ImportError("pb.explorer() needs matplotlib: pip install matplotlib "
+                          "(or pip install 'principled-brdf[plot]')") from error
+    return ipywidgets, matplotlib, Figure
+
+
+def _accepts(function, keyword: str) -> bool:
+    try:
+        parameter = inspect.signature(function).parameters.get(keyword)
+    except (TypeError, ValueError):
+        return False
+    return parameter is not None and parameter.kind in (parameter.POSITIONAL_OR_KEYWORD, parameter.KEYWORD_ONLY)
+
+
+def supports_energy_compensation() -> bool:
+    """Whether ``pb.eval`` takes ``energy_compensation=`` (the explorer shows a checkbox then)."""
+    return _accepts(importlib.import_module(__package__).eval, "energy_compensation")
+
+
+def _linear_to_srgb(c: np.ndarray) -> np.ndarray:
+    c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)
+    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+
+
+def _hex(linear) -> str:
+    return "#" + "".join(f"{int(round(v * 255.0)):02x}" for v in _linear_to_srgb(linear))
+
+
+def _picked(value: str) -> tuple:
+    """The ColorPicker's value (``#rrggbb``, ``#rgb`` or a CSS colour name, sRGB) as linear RGB."""
+    from matplotlib.colors import to_rgb
+
+    srgb = np.round(np.asarray(to_rgb(value.strip())) * 255.0).astype(np.uint8)
+    return tuple(float(v) for v in srgb_to_linear(srgb))
+
+
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def _power_of_ten(value, position=None) -> str:
+    """Tick label ``10³`` for a power of ten (plain text: no mathtext to parse), else empty."""
+    if not value > 0.0:
+        return ""
+    exponent = math.log10(value)
+    if abs(exponent - round(exponent)) > 1e-6:
+        return ""
+    return "10" + str(int(round(exponent))).translate(_SUPERSCRIPT)
+
+
+def _direction(theta_degrees: float, phi_degrees: float) -> np.ndarray:
+    theta, phi = math.radians(theta_degrees), math.radians(phi_degrees)
+    cos_theta = 0.0 if theta_degrees == 90.0 else math.cos(theta)  # on the horizon, not 6e-17 above it
+    return np.array([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), cos_theta])
+
+
+def _uniform(material) -> tuple:
+    """(Material, preset name or None) from None, a Material or a preset name."""
+    if material is None:
+        return Material(), None
+    if isinstance(material, str):
+        try:
+            return _presets.get(material), material
+        except ValueError as error:
+            raise ValueError(f"material: {error}") from None
+    if not isinstance(material, Material):
+        raise TypeError(f"material: expected a principled_brdf.Material or a preset name, "
+                        f"got {type(material).__name__}")
+    if not material.is_uniform:
+        raise ValueError(f"material: expected a uniform material (one value per parameter), "
+                         f"got per-element parameters of shape {material.shape}")
+    return material, None
+
+
+class Explorer:
+    """The widget of :func:`explorer`: controls, four PNG images and the state behind them.
+
+    Attributes (all ipywidgets): ``sliders`` (``{name: FloatSlider}`` for the
+    ten scalar parameters, ranges from ``pb.PARAMETERS``' domains),
+    ``base_color`` (ColorPicker, sRGB), ``model``, ``preset`` (Dropdowns),
+    ``light_theta``, ``light_phi``, ``view_theta``, ``view_phi`` (degrees),
+    ``exposure`` (stops), ``sky``, ``log_radius`` (Checkboxes),
+    ``energy_compensation`` (a Checkbox when ``pb.eval`` takes
+    ``energy_compensation=``, else None), ``images`` (``{name: Image}`` for
+    :data:`OUTPUTS`), ``status`` (HTML: the last update's time) and
+    ``widget``, the whole layout; the Explorer displays as that widget.
+    ``timings``: seconds each picture took when last drawn;
+    ``last_update_seconds``: the last update's total. Methods:
+    :meth:`set_material`, :meth:`reset`, :meth:`hold` (several changes, one
+    update), :meth:`refresh`, :meth:`write_pngs`, :meth:`close`.
+    """
+
+    def __init__(self, material=None, *, model: str = "disney2014", resolution: int = 192):
+        widgets, self._matplotlib, Figure = _imports()
+        material, preset = _uniform(material)
+        _validate.model_index(model)
+        resolution = _validate.integer("resolution", resolution)
+        if not 2 <= resolution <= _render.MAX_RESOLUTION:
+            raise ValueError(f"resolution: expected 2 to {_render.MAX_RESOLUTION} pixels, got {resolution}")
+        self.resolution = resolution
+        self._holding = 0
+        self._quiet = False  # while the preset menu sets the sliders
+        self._rendered = {}
+        self.timings = {}
+        self.last_update_seconds = 0.0
+        self._base_color = tuple(float(c) for c in material.base_color)
+        self._inside = _render.sphere_frames(resolution)[0]
+        self._sphere_linear = (None, None)  # (what it shows but the exposure, linear image)
+
+        style = {"description_width": "104px"}
+        layout = widgets.Layout(width="330px")
+
+        def slider(description, value, lower, upper, step, fmt=".2f"):
+            return widgets.FloatSlider(value=value, min=lower, max=upper, step=step, description=description,
+                                       continuous_update=True, readout_format=fmt, style=style, layout=layout)
+
+        self.sliders = {}
+        for name, info in PARAMETERS.items():
+            if info.slots != 1:
+                continue
+            value = float(getattr(material, name))
+            upper = info.upper if math.isfinite(info.upper) else max(_UI_MAX, math.ceil(value))
+            self.sliders[name] = slider(name, value, info.lower, upper, 0.01)
+        self.base_color = widgets.ColorPicker(value=_hex(self._base_color), description="base_color", concise=False,
+                                              style=style, layout=layout)
+        self.model = widgets.Dropdown(options=list(_validate.MODELS), value=model, description="model", style=style,
+                                      layout=layout)
+        self.preset = widgets.Dropdown(options=[CUSTOM] + _presets.names(), value=preset or CUSTOM,
+                                       description="preset", style=style, layout=layout)
+        theta_l, phi_l = self._default_light()
+        self.light_theta = slider("light θ (°)", theta_l, 0.0, 90.0, 0.5, ".1f")
+        self.light_phi = slider("light φ (°)", phi_l, 0.0, 360.0, 1.0, ".0f")
+        self.view_theta = slider("view θ (°)", 45.0, 0.0, 90.0, 0.5, ".1f")
+        self.view_phi = slider("view φ (°)", 0.0, 0.0, 360.0, 1.0, ".0f")
+        self.exposure = slider("exposure (stops)", 0.0, -4.0, 4.0, 0.25, "+.2f")
+        self.sky = widgets.Checkbox(value=True, description="sky light on the sphere", indent=False)
+        self.log_radius = widgets.Checkbox(value=False, description="log radius (polar)", indent=False)
+        self.energy_compensation = (widgets.Checkbox(value=False, description="energy compensation", indent=False)
+                                    if supports_energy_compensation() else None)
+
+        self.images = {name: widgets.Image(format="png") for name in OUTPUTS}
+        self.status = widgets.HTML()
+        self._figures = {}
+        self._Figure, self._legend_cache = Figure, {}
+        self._figures_size = (round(_FIGSIZE[0] * _DPI), round(_FIGSIZE[1] * _DPI))
+        with self._matplotlib.rc_context(_FONT):
+            self._build_polar(Figure)
+            self._build_slice(Figure)
+            self._build_albedo(Figure)
+
+        for control in self._controls():
+            if control is self.preset:
+                control.observe(self._preset_chosen, names="value")
+            elif control is self.base_color:
+                control.observe(self._color_picked, names="value")
+            else:
+                control.observe(self._changed, names="value")
+
+        def header(text):
+            return widgets.HTML(f"<b>{text}</b>")
+
+        def cell(image):
+            return widgets.Box([image], layout=widgets.Layout(width=f"{self._figures_size[0] + 8}px",
+                                                             justify_content="center", align_items="center"))
+
+        checks = [self.sky, self.log_radius] + ([self.energy_compensation] if self.energy_compensation else [])
+        controls = widgets.VBox(
+            [header("Material"), self.preset, self.model, self.base_color, *self.sliders.values(),
+             header("Light and view"), self.light_theta, self.light_phi, self.view_theta, self.view_phi,
+             self.exposure, *checks, self.status],
+            layout=widgets.Layout(width="345px"))
+        pictures = widgets.GridBox([cell(self.images[name]) for name in OUTPUTS],
+                                   layout=widgets.Layout(grid_template_columns="auto auto"))
+        self.widget = widgets.HBox([controls, pictures])
+        self._initial = (material, preset, {control: (control.value, getattr(control, "max", None))
+                                            for control in self._controls()
+                                            if control not in (self.preset, self.base_color)})
+        self.refresh()
+
+    # ------------------------------------------------------------------
+    # state
+
+    @staticmethod
+    def _default_light() -> tuple:
+        light = np.asarray(_render.DEFAULT_LIGHT, dtype=np.float64)
+        light = light / np.linalg.norm(light)
+        theta = math.degrees(math.acos(float(light[2])))
+        phi = math.degrees(math.atan2(float(light[1]), float(light[0]))) % 360.0
+        return round(theta * 2.0) / 2.0, float(round(phi))
+
+    def _controls(self) -> list:
+        controls = [*self.sliders.values(), self.base_color, self.model, self.preset, self.light_theta,
+                    self.light_phi, self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius]
+        return controls + ([self.energy_compensation] if self.energy_compensation else [])
+
+    @property
+    def material(self) -> Material:
+        """The material the sliders show (``base_color`` linear)."""
+        values = {name: float(s.value) for name, s in self.sliders.items()}
+        return Material(base_color=self._base_color, **values, bright_base_color=True)
+
+    def _state(self) -> dict:
+        return {
+            "material": (self._base_color,) + tuple(float(s.value) for s in self.sliders.values()),
+            "model": self.model.value,
+            "light": (float(self.light_theta.value), float(self.light_phi.value)),
+            "view": (float(self.view_theta.value), float(self.view_phi.value)),
+            "exposure": float(self.exposure.value),
+            "sky": bool(self.sky.value),
+            "log": bool(self.log_radius.value),
+            "energy_compensation": bool(self.energy_compensation.value) if self.energy_compensation else None,
+        }
+
+    def _options(self, function, state) -> dict:
+        """Keyword options the model takes beyond ``model=``, where ``function`` accepts them."""
+        ec = state["energy_compensation"]
+        return {"energy_compensation": ec} if ec is not None and _accepts(function, "energy_compensation") else {}
+
+    @contextlib.contextmanager
+    def hold(self):
+        """Change several controls with one update at the end: ``with explorer.hold(): ...``."""
+        self._holding += 1
+        try:
+            yield self
+        finally:
+            self._holding -= 1
+            if not self._holding:
+                self.refresh()
+
+    def refresh(self) -> dict:
+        """Redraw the pictures whose inputs changed; returns ``{name: seconds}`` of those drawn."""
+        state = self._state()
+        material = self.material
+        start = time.perf_counter()
+        drawn = {}
+        for name in OUTPUTS:
+            key = tuple(state[k] for k in _DEPENDS[name])
+            if self._rendered.get(name) == key:
+                continue
+            begin = time.perf_counter()
+            with self._matplotlib.rc_context(_FONT):
+                self.images[name].value = getattr(self, f"_draw_{name}")(material, state)
+            self._rendered[name] = key
+            drawn[name] = self.timings[name] = time.perf_counter() - begin
+        if drawn:
+            self.last_update_seconds = time.perf_counter() - start
+            parts = ", ".join(f"{name} {seconds * 1e3:.0f}" for name, seconds in drawn.items())
+            self.status.value = (f"<small>updated in {self.last_update_seconds * 1e3:.0f} ms "
+                                 f"({parts})</small>")
+        return drawn
+
+    def _changed(self, change) -> None:
+        material_control = change["owner"] is self.base_color or change["owner"] in self.sliders.values()
+        if material_control and not self._quiet and self.preset.value != CUSTOM:
+            self._quietly(lambda: setattr(self.preset, "value", CUSTOM))
+        if not self._holding:
+            self.refresh()
+
+    def _quietly(self, action) -> None:
+        quiet, self._quiet = self._quiet, True
+        try:
+            action()
+        finally:
+            self._quiet = quiet
+
+    def _color_picked(self, change) -> None:
+        if self._quiet:
+            return
+        try:
+            self._base_color = _picked(change["new"])
+        except ValueError:  # not a colour (yet): keep the last one
+            return
+        self._changed(change)
+
+    def _preset_chosen(self, change) -> None:
+        if self._quiet or change["new"] == CUSTOM:
+            return
+        self.set_material(_presets.get(change["new"]), preset=change["new"])
+
+    def reset(self) -> None:
+        """Every control back to where the explorer started (one update)."""
+        material, preset, controls = self._initial
+        with self.hold():
+            self._quietly(lambda: [setattr(control, "max", upper) for control, (_, upper) in controls.items()
+                                   if upper is not None])
+            self.set_material(material, preset=preset)
+            for control, (value, _) in controls.items():
+                if control not in self.sliders.values():
+                    control.value = value
+
+    def set_material(self, material, *, preset=None) -> None:
+        """Set every material control to ``material`` (a uniform Material or a preset name), one update."""
+        material, named = _uniform(material)
+        preset = preset or named
+
+        def apply():
+            for name, s in self.sliders.items():
+                value = float(getattr(material, name))
+                if value > s.max:  # an unbounded parameter beyond the slider's range
+                    s.max = math.ceil(value)
+                s.value = value
+            self._base_color = tuple(float(c) for c in material.base_color)
+            self.base_color.value = _hex(self._base_color)
+            self.preset.value = preset if preset in self.preset.options else CUSTOM
+
+        with self.hold():
+            self._quietly(apply)
+
+    # ------------------------------------------------------------------
+    # pictures
+
+    # A legend costs as much to draw as the rest of a plot: each one is drawn once, to pixels, and
+    # shown as a figure image (cached by its entries).
+
+    def _legend(self, fig):
+        return fig.figimage(np.zeros((1, 1, 4)), 0, 0, origin="upper", zorder=10)
+
+    def _legend_pixels(self, entries: tuple, ncol: int, frame: bool) -> np.ndarray:
+        key = (entries, ncol, frame)
+        if key not in self._legend_cache:
+            from matplotlib.lines import Line2D
+
+            fig = self._Figure(figsize=(_FIGSIZE[0], 1.2), dpi=_DPI)
+            self._canvas(fig)
+            fig.patch.set_alpha(0.0)
+            styles = {**{name: dict(color=color, lw=1.8 if name == "total" else 1.2, label=name)
+                         for name, color in _LOBE_COLORS.items()}, **_KEY_STYLES}
+            legend = fig.legend(handles=[Line2D([], [], **styles[name]) for name in entries], loc="center", ncol=ncol,
+                                frameon=frame, framealpha=0.85, edgecolor="none", handlelength=1.5,
+                                columnspacing=1.0, borderpad=0.3)
+            fig.canvas.draw()
+            pixels = np.asarray(fig.canvas.buffer_rgba())
+            box = legend.get_window_extent()
+            height = pixels.shape[0]
+            rows = slice(max(0, int(height - box.y1) - 1), min(height, int(math.ceil(height - box.y0)) + 1))
+            columns = slice(max(0, int(box.x0) - 1), int(math.ceil(box.x1)) + 1)
+            self._legend_cache[key] = pixels[rows, columns].astype(np.float32) / 255.0
+        return self._legend_cache[key]
+
+    def _place_legend(self, image, entries: tuple, *, ncol: int, frame: bool, top: float, centre_x=None,
+                      left=None) -> None:
+        pixels = self._legend_pixels(entries, ncol, frame)
+        width, height = self._figures_size
+        image.set_data(pixels)
+        image.ox = round(centre_x * width - pixels.shape[1] / 2) if centre_x is not None else round(left * width)
+        image.oy = round(top * height) - pixels.shape[0]
+
+    def _canvas(self, fig) -> None:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        FigureCanvasAgg(fig)
+
+    def _savefig(self, name: str) -> bytes:
+        # the figure's own Agg canvas and renderer, kept between draws (its text metrics stay cached)
+        canvas = self._figures[name].canvas
+        canvas.draw()
+        return _render.png_bytes(np.asarray(canvas.buffer_rgba()))
+
+    def _draw_sphere(self, material, state) -> bytes:
+        key = tuple(state[k] for k in _DEPENDS["sphere"] if k != "exposure")
+        if self._sphere_linear[0] != key:  # an exposure change only tone maps again
+            self._sphere_linear = (key, self._render_sphere(material, state))
+        rgb = _render.to_srgb8(self._sphere_linear[1], 2.0 ** state["exposure"])
+        alpha = np.where(self._inside, 255, 0).astype(np.uint8)
+        return _render.png_bytes(np.concatenate([rgb, alpha[..., None]], axis=-1))
+
+    def _render_sphere(self, material, state) -> np.ndarray:
+        light = _direction(*state["light"])
+        model = state["model"]
+        n = self.resolution
+        options = self._options(_render.render_sphere, state)
+        return _render.render_sphere(material, n, light=light, ambient=0.0 if state["sky"] else _AMBIENT, model=model,
+                                     environment="sky" if state["sky"] else None, samples=_SKY_SAMPLES, **options)
+
+    def _build_polar(self, Figure) -> None:
+        fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
+        self._canvas(fig)
+        # The Axes becomes a square, the half disc (radius: half its side) centred in it: a radius of
+        # 135 px, the horizon 75 px above the bottom (room for the legend); the title is a figure text.
+        ax = fig.add_axes((0.117, 0.028, 0.767, 1.023), projection="polar")
+        ax.set_theta_zero_location("N")
+        ax.set_theta_direction(-1)
+        ax.set_thetamin(-90)
+        ax.set_thetamax(90)
+        ax.set_thetagrids([-90, -60, -30, 0, 30, 60, 90])
+        ax.set_rlabel_position(80)  # near the horizon on the side of wo
+        t = np.radians((np.arange(_POLAR_STEPS) + 0.5) * (180.0 / _POLAR_STEPS) - 90.0)  # open: no horizon segment
+        lines = {name: ax.plot(t, np.zeros_like(t), color=color, lw=1.8 if name == "total" else 1.2, label=name)[0]
+                 for name, color in _LOBE_COLORS.items()}
+        lines["wo"] = ax.plot([0, 0], [0, 1], **_KEY_STYLES["wo"])[0]
+        lines["wi"] = ax.plot([0, 0], [0, 1], **_KEY_STYLES["wi"])[0]
+        title = fig.text(0.5, 0.985, "", ha="center", va="top", fontsize=_FONT["axes.titlesize"])
+        self._polar = {"ax": ax, "t": t, "lines": lines, "legend": self._legend(fig), "title": title}
+        self._figures["polar"] = fig
+
+    def _draw_polar(self, material, state) -> bytes:
+        ax, t, lines = self._polar["ax"], self._polar["t"], self._polar["lines"]
+        theta_v, phi_v = state["view"]
+        azimuth = np.array([math.cos(math.radians(phi_v)), math.sin(math.radians(phi_v))])
+        wi = np.empty((t.size, 3))
+        wi[:, 0], wi[:, 1], wi[:, 2] = np.sin(t) * azimuth[0], np.sin(t) * azimuth[1], np.cos(t)
+        wo = _direction(theta_v, phi_v)
+        values = _eval_lobes(material, wi, wo, model=state["model"], **self._options(_eval_lobes, state))
+        curves = {name: np.asarray(v, dtype=np.float64) @ _LUMINANCE for name, v in zip(_validate.LOBE_NAMES, values)}
+        curves["total"] = sum(curves.values())
+        peak = float(curves["total"].max())
+        log = state["log"]
+        top = 10.0 ** math.ceil(math.log10(peak)) if peak > 0.0 else 1.0
+        floor = top * 10.0 ** -_POLAR_DECADES
+
+        def radius(f):
+            return np.log10(np.maximum(f, floor) / floor) if log else f
+
+        r_max = float(_POLAR_DECADES) if log else (peak * 1.05 if peak > 0.0 else 1.0)
+        shown = []
+        for name in _LOBE_COLORS:
+            visible = bool(np.any(curves[name] > 0.0)) or name == "total"
+            lines[name].set_visible(visible)
+            lines[name].set_ydata(radius(curves[name]))
+            if visible:
+                shown.append(name)
+        lines["wo"].set_data([math.radians(theta_v)] * 2, [0.0, r_max])
+        light = _direction(*state["light"])
+        in_plane = float(light[:2] @ azimuth)
+        lines["wi"].set_data([math.atan2(in_plane, float(light[2]))] * 2, [0.0, r_max])
+        ax.set_ylim(0.0, r_max)
+        if log:
+            exponent = round(math.log10(top))
+            decades = range(1, _POLAR_DECADES + 1)
+            ax.set_yticks(decades, [_power_of_ten(10.0 ** (exponent - _POLAR_DECADES + k)) for k in decades])
+        else:
+            ax.yaxis.set_major_locator(self._matplotlib.ticker.MaxNLocator(4))
+            ax.yaxis.set_major_formatter(self._matplotlib.ticker.ScalarFormatter())
+        self._polar["title"].set_text(
+            f"f (1/sr, luminance{', log radius' if log else ''}) in the plane of incidence of wo\n"
+            f"θv = {theta_v:g}°, φv = {phi_v:g}°; angle: wi from the normal")
+        self._place_legend(self._polar["legend"], tuple(shown) + ("wo", "wi"), ncol=4, frame=False,
+                           centre_x=0.5, top=0.2)
+        return self._savefig("polar")
+
+    def _build_slice(self, Figure) -> None:
+        colors = self._matplotlib.colors
+        fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
+        self._canvas(fig)
+        ax = fig.add_axes((0.13, 0.14, 0.62, 0.74))
+        cax = fig.add_axes((0.79, 0.14, 0.035, 0.74))
+        _, _, wi, wo = slice_directions(_SLICE_RESOLUTION, 90.0)
+        valid = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
+        colormap = self._matplotlib.colormaps["inferno"].with_extremes(bad="0.75")
+        blank = np.ma.masked_array(np.ones(valid.shape), mask=~valid)
+        image = ax.imshow(blank, origin="lower", extent=(0.0, 90.0, 0.0, 90.0), interpolation="nearest",
+                          norm=colors.LogNorm(1e-3, 1.0), cmap=colormap, aspect="equal")
+        colorbar = fig.colorbar(image, cax=cax)
+        colorbar.minorticks_off()
+        colorbar.formatter = self._matplotlib.ticker.FuncFormatter(_power_of_ten)
+        colorbar.set_label("f, luminance (1/sr)")
+        marker = ax.plot([45.0], [45.0], marker="+", ms=11, mew=1.8, color="cyan", ls="none",
+                         label="light/view pair")[0]
+        ax.set_xlabel("θh (degrees)")
+        ax.set_ylabel("θd (degrees)")
+        ax.set_xticks([0, 30, 60, 90])
+        ax.set_yticks([0, 30, 60, 90])
+        self._slice = {"ax": ax, "image": image, "colorbar": colorbar, "marker": marker, "wi": wi, "wo": wo,
+                       "valid": valid}
+        self._figures["slice"] = fig
+
+    def _draw_slice(self, material, state) -> bytes:
+        s = self._slice
+        f = _eval_lobes(material, s["wi"], s["wo"], model=state["model"], **self._options(_eval_lobes, state))
+        luminance = np.asarray(f.total(), dtype=np.float64) @ _LUMINANCE
+        shown = luminance[s["valid"]]
+        top = float(shown.max()) if shown.size and shown.max() > 0.0 else 1.0
+        positive = shown[shown > 0.0]
+        bottom = max(float(positive.min()) if positive.size else top * 1e-6, top * 1e-6)
+        bottom = min(bottom, top * 0.5)
+        s["image"].set_data(np.ma.masked_array(np.maximum(luminance, bottom), mask=~s["valid"]))
+        s["image"].set_clim(bottom, top)  # the same LogNorm: the colorbar keeps its ticks' style
+        wi, wo = _direction(*state["light"]), _direction(*state["view"])
+        h = wi + wo
+        length = float(np.linalg.norm(h))
+        if length > 1e-9 and wi[2] > 0.0 and wo[2] > 0.0:
+            h /= length
+            theta_h = math.degrees(math.acos(min(1.0, float(h[2]))))
+            theta_d = math.degrees(math.acos(min(1.0, float(wi @ h))))
+            s["marker"].set_data([theta_h], [theta_d])
+            s["marker"].set_visible(True)
+            where = f"pair at θh = {theta_h:.0f}°, θd = {theta_d:.0f}° (+)"
+        else:
+            s["marker"].set_visible(False)
+            where = "pair below the horizon"
+        s["ax"].set_title(f"BRDF slice at φd = 90°, log luminance\n{where}", pad=4)
+        return self._savefig("slice")
+
+    def _build_albedo(self, Figure) -> None:
+        fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
+        self._canvas(fig)
+        ax = fig.add_axes((0.13, 0.14, 0.83, 0.74))
+        lines = {name: ax.plot(_ALBEDO_ANGLES, np.zeros_like(_ALBEDO_ANGLES), color=color,
+                               lw=1.8 if name == "total" else 1.2, label=name)[0]
+                 for name, color in _LOBE_COLORS.items()}
+        lines["view"] = ax.axvline(45.0, **_KEY_STYLES["θv"])
+        ax.set_xlim(0.0, 90.0)
+        ax.set_xticks([0, 30, 60, 90])
+        ax.set_xlabel("θo (degrees)")
+        ax.set_ylabel("directional albedo (luminance)")
+        ax.grid(True, color="0.9", lw=0.6)
+        self._albedo = {"ax": ax, "lines": lines, "bands": {}, "legend": self._legend(fig)}
+        self._figures["albedo"] = fig
+
+    def _draw_albedo(self, material, state) -> bytes:
+        a = self._albedo
+        ax, lines = a["ax"], a["lines"]
+        result = _albedo(material, np.cos(np.radians(_ALBEDO_ANGLES)), samples=_ALBEDO_SAMPLES, seed=0,
+                         model=state["model"], **self._options(_albedo, state))
+        curves = {"total": (result.total, result.total_error)}
+        curves.update({name: (value, error) for name, value, error in
+                       zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)})
+        for band in a["bands"].values():
+            band.remove()
+        a["bands"] = {}
+        shown, top = [], 1.0
+        for name in _LOBE_COLORS:
+            mean = np.asarray(curves[name][0], dtype=np.float64) @ _LUMINANCE
+            band = 2.0 * (np.asarray(curves[name][1], dtype=np.float64) @ _LUMINANCE)  # an upper bound
+            visible = name == "total" or bool(np.any(mean > 0.0))
+            lines[name].set_ydata(mean)
+            lines[name].set_visible(visible)
+            if visible:
+                shown.append(name)
+                a["bands"][name] = ax.fill_between(_ALBEDO_ANGLES, mean - band, mean + band,
+                                                   color=_LOBE_COLORS[name], alpha=0.25, lw=0)
+                top = max(top, float((mean + band).max()))
+        theta_v = state["view"][0]
+        lines["view"].set_xdata([theta_v, theta_v])
+        ax.set_ylim(0.0, top * 1.05)
+        index = int(np.argmin(np.abs(_ALBEDO_ANGLES - theta_v)))
+        total_at = float(np.asarray(result.total[index]) @ _LUMINANCE)
+        ax.set_title(f"directional albedo, ±2 s.e. ({_ALBEDO_SAMPLES} samples)\n"
+                     f"E({_ALBEDO_ANGLES[index]:g}°) = {total_at:.3f}", pad=4)
+        self._place_legend(a["legend"], tuple(shown) + ("θv",), ncol=3, frame=True, left=0.135, top=0.875)
+        return self._savefig("albedo")
+
+    # ------------------------------------------------------------------
+
+    def write_pngs(self, prefix: str) -> dict:
+        """Write the four pictures to ``{prefix}{name}.png``; returns ``{name: path}``."""
+        paths = {}
+        for name in OUTPUTS:
+            paths[name] = f"{prefix}{name}.png"
+            with open(paths[name], "wb") as f:
+                f.write(self.images[name].value)
+        return paths
+
+    def close(self) -> None:
+        """Close the widgets (and drop the figures)."""
+        def close(widget):
+            for child in getattr(widget, "children", ()):
+                close(child)
+            widget.close()
+
+        close(self.widget)
+        self._figures.clear()
+
+    def _repr_mimebundle_(self, **kwargs):
+        return self.widget._repr_mimebundle_(**kwargs)
+
+    def __repr__(self) -> str:
+        return f"Explorer({self.material!r}, model={self.model.value!r}, resolution={self.resolution})"
+
+
+def explorer(material=None, *, model: str = "disney2014", resolution: int = 192) -> Explorer:
+    """An interactive BRDF explorer for Jupyter (module :mod:`principled_brdf.explorer`).
+
+    ``material``: the starting material (a uniform Material or a preset name;
+    default ``pb.Material()``, the BRDF Explorer's defaults), ``model``:
+    ``"disney2014"`` or ``"disney2012"``, ``resolution``: the sphere's size
+    in pixels. Returns an :class:`Explorer`, which displays as its widget;
+    ``explorer.sliders``, ``explorer.images`` etc. reach its parts. Needs
+    ipywidgets and matplotlib (``ImportError`` naming ``pip install
+    ipywidgets`` otherwise).
+    """
+    return Explorer(material, model=model, resolution=resolution)
