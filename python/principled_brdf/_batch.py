@@ -13,7 +13,7 @@ Input handling, once per call:
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple, overload
 
 import numpy as np
 
@@ -38,12 +38,30 @@ from . import _gradient
 from ._gradient import GRADIENT_NAMES, Gradient
 from .material import PARAMETERS, Material
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from typing import Any, Literal, SupportsIndex
+
+    from numpy.typing import NDArray
+
+    from ._typing import Float32Array, FloatArray, Layout, Model, RealArrayLike, SpecularSampler
+
 __all__ = ["eval", "eval_lobes", "eval_grad", "eval_pdf", "ValuePdf", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
 
 _INTERLEAVED, _ROWS, _SINGLE = 0, 1, 2
 
 
-class Lobes(NamedTuple("LobeArrays", [(name, np.ndarray) for name in LOBE_NAMES])):
+if TYPE_CHECKING:  # the fields of LOBE_NAMES (the C++ table), spelled out for type checkers
+    class _LobeArrays(NamedTuple):
+        diffuse: FloatArray
+        sheen: FloatArray
+        specular: FloatArray
+        clearcoat: FloatArray
+else:
+    _LobeArrays = NamedTuple("LobeArrays", [(name, np.ndarray) for name in LOBE_NAMES])
+
+
+class Lobes(_LobeArrays):
     """The lobes of f (README "The model"), in the C++ table's order: ``diffuse``
     (with subsurface, times 1 - metallic), ``sheen`` (times 1 - metallic),
     ``specular`` and ``clearcoat`` (grey), each shaped like :func:`eval`'s
@@ -51,35 +69,35 @@ class Lobes(NamedTuple("LobeArrays", [(name, np.ndarray) for name in LOBE_NAMES]
 
     __slots__ = ()
 
-    def total(self) -> np.ndarray:
+    def total(self) -> FloatArray:
         return sum(self[1:], self[0])
 
 
 class Sample(NamedTuple):
     """What :func:`sample` and ``pb.reference.sample`` return."""
 
-    wi: np.ndarray  # (..., 3) drawn direction towards the light
-    pdf: np.ndarray  # (...) mixture density in solid angle; 0 at or below the horizon
-    weight: np.ndarray  # (..., 3) f(wi, wo) cos θl / pdf; 0 where pdf is 0
-    lobe: np.ndarray  # (...) int32, an index into SAMPLED_LOBE_NAMES: 0 cosine, 1 primary specular, 2 clearcoat
+    wi: FloatArray  # (..., 3) drawn direction towards the light
+    pdf: FloatArray  # (...) mixture density in solid angle; 0 at or below the horizon
+    weight: FloatArray  # (..., 3) f(wi, wo) cos θl / pdf; 0 where pdf is 0
+    lobe: NDArray[np.int32]  # (...) int32, an index into SAMPLED_LOBE_NAMES: 0 cosine, 1 primary specular, 2 clearcoat
 
 
 _LAYOUTS = ("aos", "soa")
 
 
-def cpu_info() -> dict:
+def cpu_info() -> dict[str, Any]:
     """The instruction set in use (``PRINCIPLED_BRDF_ISA`` forces one), the
     available ones, SIMD width in floats and hardware threads."""
     return dict(_core.cpu_info())
 
 
-def _layout(layout) -> str:
+def _layout(layout: Layout) -> Layout:
     if layout not in _LAYOUTS:
         raise ValueError(f"layout: expected 'aos' for (..., 3) or 'soa' for (3, ...), got {layout!r}")
     return layout
 
 
-def _threads(threads) -> int:
+def _threads(threads: SupportsIndex | None) -> int:
     if threads is None:
         return 0
     count = integer("threads", threads)
@@ -90,7 +108,7 @@ def _threads(threads) -> int:
     return count
 
 
-def _isa(isa) -> str:
+def _isa(isa: str | None) -> str:
     if isa is None:
         return ""
     available = _core.cpu_info()["available"]
@@ -99,7 +117,7 @@ def _isa(isa) -> str:
     return isa
 
 
-def _float32_input(name: str, value) -> tuple:
+def _float32_input(name: str, value: object) -> tuple[Float32Array, FloatArray]:
     """(float32 C-contiguous aligned array, the values as given): read in place
     when ``value`` already is one, else converted once (after a check that the
     values fit in float32, so that 1e300 is not reported as infinity)."""
@@ -115,7 +133,7 @@ def _float32_input(name: str, value) -> tuple:
 class _Directions:
     """A direction argument as float32, with its leading shape and layout."""
 
-    def __init__(self, name: str, value, layout: str):
+    def __init__(self, name: str, value: object, layout: str) -> None:
         self.name = name
         self.array, self.given = _float32_input(name, value)
         array = self.array
@@ -129,7 +147,7 @@ class _Directions:
             self.leading = array.shape[1:]
         self.layout = layout
 
-    def flat(self, leading: tuple):
+    def flat(self, leading: tuple[int, ...]) -> tuple[Float32Array, int]:
         """(array, layout code) with ``leading`` elements; broadcasts if needed."""
         array = self.array
         if self.leading == ():
@@ -140,13 +158,13 @@ class _Directions:
         n = int(np.prod(leading, dtype=np.int64))
         return (array.reshape(n, 3), _INTERLEAVED) if self.layout == "aos" else (array.reshape(3, n), _ROWS)
 
-    def _own_index(self, element: int, leading: tuple) -> tuple:
+    def _own_index(self, element: int, leading: tuple[int, ...]) -> tuple[int, ...]:
         """The index into this argument's own leading shape of ``element`` of the broadcast ``leading``."""
         index = np.unravel_index(element, leading) if leading else ()
         trailing = index[len(index) - len(self.leading):]
         return tuple(int(i) if size > 1 else 0 for i, size in zip(trailing, self.leading))
 
-    def error_at(self, element: int, leading: tuple):
+    def error_at(self, element: int, leading: tuple[int, ...]) -> ValueError | None:
         """The ValueError for this argument at ``element``, or None when its vector passes."""
         own = self._own_index(element, leading)
         vector = self.array[own] if self.layout == "aos" else self.array[(slice(None),) + own]
@@ -156,7 +174,7 @@ class _Directions:
         return direction_error(self.name, flat_index, self.leading, vector)
 
 
-def _direction_error(element: int, leading: tuple, *arguments: _Directions) -> ValueError:
+def _direction_error(element: int, leading: tuple[int, ...], *arguments: _Directions) -> ValueError:
     """The error for the element the kernel rejected: the first argument whose vector fails."""
     for argument in arguments:
         error = argument.error_at(element, leading)
@@ -173,7 +191,7 @@ def _direction_error(element: int, leading: tuple, *arguments: _Directions) -> V
 FLOAT32_LIMITS = {"roughness": 1e4, "base_color": 1e20, "specular": 1e20, "sheen": 1e20, "clearcoat": 1e20}
 
 
-def _require_float32_range(name: str, value: np.ndarray) -> None:
+def _require_float32_range(name: str, value: FloatArray) -> None:
     limit = FLOAT32_LIMITS.get(name)
     if limit is not None and value.size and value.max() > limit:
         i = int(np.flatnonzero(value.ravel() > limit)[0])
@@ -181,10 +199,10 @@ def _require_float32_range(name: str, value: np.ndarray) -> None:
                          f"float32 kernels represent (<= {limit:g}); pb.reference evaluates it in float64")
 
 
-def _params(material: Material, leading: tuple) -> list:
+def _params(material: Material, leading: tuple[int, ...]) -> list[float | tuple[float, ...] | Float32Array]:
     """One entry per parameter: a number (uniform) or a float32 per-element array."""
     n = int(np.prod(leading, dtype=np.int64))
-    entries = []
+    entries: list[float | tuple[float, ...] | Float32Array] = []
     for name, info in PARAMETERS.items():
         value = getattr(material, name)
         _require_float32_range(name, value)
@@ -197,7 +215,7 @@ def _params(material: Material, leading: tuple) -> list:
     return entries
 
 
-def _output(out, shape: tuple, name: str = "out") -> np.ndarray:
+def _output(out: object, shape: tuple[int, ...], name: str = "out") -> Float32Array:
     if out is None:
         return np.empty(shape, dtype=np.float32)
     if not isinstance(out, np.ndarray):
@@ -213,7 +231,7 @@ def _output(out, shape: tuple, name: str = "out") -> np.ndarray:
     return out
 
 
-def _require_no_partial_overlap(out: np.ndarray, inputs: dict, name: str = "out") -> None:
+def _require_no_partial_overlap(out: NDArray[Any], inputs: dict[str, NDArray[Any] | None], name: str = "out") -> None:
     """An ``out=`` that is exactly an input computes in place; one that partly overlaps
     an input would read elements it has already overwritten: a ValueError."""
     for input_name, array in inputs.items():
@@ -227,26 +245,28 @@ def _require_no_partial_overlap(out: np.ndarray, inputs: dict, name: str = "out"
                              "(only an exact alias computes in place)")
 
 
-def _require_material(material) -> None:
+def _require_material(material: object) -> None:
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
 
 
-def _size(leading: tuple) -> int:
+def _size(leading: tuple[int, ...]) -> int:
     return int(np.prod(leading, dtype=np.int64))
 
 
-def _vec3_shape(leading: tuple, layout: str) -> tuple:
+def _vec3_shape(leading: tuple[int, ...], layout: str) -> tuple[int, ...]:
     return leading + (3,) if layout == "aos" else (3,) + leading
 
 
-def _flat_vec3(array: np.ndarray, layout: str) -> tuple:
+def _flat_vec3(array: Float32Array, layout: str) -> tuple[Float32Array, int]:
     n = _size(array.shape[:-1] if layout == "aos" else array.shape[1:])
     return (array.reshape(n, 3), _INTERLEAVED) if layout == "aos" else (array.reshape(3, n), _ROWS)
 
 
-def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs_for_shape, pdf_sampler=None,
-              gradient=False):
+def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine: bool, layout: Layout,
+              threads: SupportsIndex | None, check: bool, isa: str | None,
+              outputs_for_shape: Callable[[tuple[int, ...], str], list[Float32Array]], pdf_sampler: int | None = None,
+              gradient: bool = False) -> list[Float32Array]:
     """eval / eval_lobes / pdf / eval_grad: validated arguments in, outputs written."""
     _require_material(material)
     layout = _layout(layout)
@@ -267,6 +287,7 @@ def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, o
     # direction the call raises, and an out= buffer may hold partial results.
     tolerance = DIRECTION_LENGTH_TOLERANCE if check else 0.0
     out_layout = _INTERLEAVED if layout == "aos" else _ROWS
+    value: Float32Array | None  # f: the output (gradient), or eval_pdf's optional one
     if gradient:
         value, jacobian = outputs
         bad = _core.batch_eval_grad(wi_flat, wi_code, wo_flat, wo_code, params, _flat_vec3(value, layout)[0],
@@ -286,8 +307,9 @@ def _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, o
     return outputs
 
 
-def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False, layout: str = "aos",
-         threads=None, out=None, check: bool = True, isa=None) -> np.ndarray:
+def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
+         cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None,
+         out: Float32Array | None = None, check: bool = True, isa: str | None = None) -> Float32Array:
     """f(wi, wo) in 1/sr as float32, by the SIMD kernel (README "The model").
 
     ``wi``, ``wo``: unit directions, ``(..., 3)`` or with ``layout="soa"``
@@ -304,8 +326,9 @@ def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool 
     return f
 
 
-def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False, layout: str = "aos",
-               threads=None, check: bool = True, isa=None) -> Lobes:
+def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
+               cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None, check: bool = True,
+               isa: str | None = None) -> Lobes:
     """The four lobes (diffuse, sheen, specular, clearcoat) as a :class:`Lobes`
     of float32 arrays, each shaped like :func:`eval`'s result."""
     outputs = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
@@ -313,13 +336,14 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
     return Lobes(*outputs)
 
 
-def _require_pair(out, second: str) -> None:
+def _require_pair(out: object, second: str) -> None:
     """``out=`` of a call with two results, f and ``second``: None or a tuple of two arrays."""
     if out is not None and not (isinstance(out, tuple) and len(out) == 2):
         raise TypeError(f"out: expected a tuple (value, {second}) of float32 arrays")
 
 
-def _output_pair(out, value_shape: tuple, second_shape: tuple, second: str) -> tuple:
+def _output_pair(out: tuple[object, object] | None, value_shape: tuple[int, ...], second_shape: tuple[int, ...],
+                 second: str) -> tuple[Float32Array, Float32Array]:
     """The two result arrays: fresh, or ``out``'s checked (shapes, dtype, no overlap)."""
     value = _output(None if out is None else out[0], value_shape, "out[0]")
     other = _output(None if out is None else out[1], second_shape, "out[1]")
@@ -328,12 +352,15 @@ def _output_pair(out, value_shape: tuple, second_shape: tuple, second: str) -> t
     return value, other
 
 
-def _jacobian_shape(leading: tuple, layout: str, width: int) -> tuple:
+def _jacobian_shape(leading: tuple[int, ...], layout: str, width: int) -> tuple[int, ...]:
     return leading + (3, width) if layout == "aos" else (3, width) + leading
 
 
-def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014", cosine: bool = False,
-              layout: str = "aos", threads=None, out=None, check: bool = True, isa=None) -> Gradient:
+def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
+              wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014", cosine: bool = False,
+              layout: Layout = "aos", threads: SupportsIndex | None = None,
+              out: tuple[Float32Array, Float32Array] | None = None, check: bool = True,
+              isa: str | None = None) -> Gradient:
     """f and its Jacobian in the material's parameters, by the SIMD kernel in
     float32 (README "Gradients").
 
@@ -350,7 +377,7 @@ def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014"
     full = len(wanted) == len(GRADIENT_NAMES)
     _require_pair(out, "jacobian")
 
-    def outputs(leading, layout):
+    def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
         value, jacobian = _output_pair(out, _vec3_shape(leading, layout), _jacobian_shape(leading, layout, len(wanted)),
                                        "jacobian")
         return [value, jacobian if full else np.empty(_jacobian_shape(leading, layout, len(GRADIENT_NAMES)), np.float32)]
@@ -367,8 +394,9 @@ def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014"
     return Gradient(value, selected, tuple(GRADIENT_NAMES[k] for k in wanted))
 
 
-def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampler: str = "visible",
-        layout: str = "aos", threads=None, check: bool = True, isa=None) -> np.ndarray:
+def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
+        specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
+        check: bool = True, isa: str | None = None) -> Float32Array:
     """The density (solid angle) with which :func:`sample` draws ``wi`` given ``wo``:
     the lobe mixture of README "Sampling and pdf", float32 ``(...)``; 0 when
     either direction is at or below the horizon. It does not depend on the model
@@ -383,19 +411,20 @@ def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampl
 class ValuePdf(NamedTuple):
     """What :func:`eval_pdf` returns."""
 
-    value: np.ndarray  # f, as eval returns it
-    pdf: np.ndarray  # the sampling density of wi given wo, as pdf returns it
+    value: Float32Array  # f, as eval returns it
+    pdf: Float32Array  # the sampling density of wi given wo, as pdf returns it
 
 
-def eval_pdf(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False,
-             specular_sampler: str = "visible", layout: str = "aos", threads=None, out=None, check: bool = True,
-             isa=None) -> ValuePdf:
+def eval_pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
+             cosine: bool = False, specular_sampler: SpecularSampler = "visible", layout: Layout = "aos",
+             threads: SupportsIndex | None = None, out: tuple[Float32Array, Float32Array] | None = None,
+             check: bool = True, isa: str | None = None) -> ValuePdf:
     """f and the sampling pdf of (wi, wo) in one kernel pass (what multiple importance
     sampling needs): ``value`` as :func:`eval` returns it, ``pdf`` as :func:`pdf` does.
     ``out=(value, pdf)`` writes into preallocated float32 arrays of those shapes."""
     _require_pair(out, "pdf")
 
-    def outputs(leading, layout):
+    def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
         value, density = _output_pair(out, _vec3_shape(leading, layout), leading, "pdf")
         return [density, value]
 
@@ -404,7 +433,7 @@ def eval_pdf(material: Material, wi, wo, *, model: str = "disney2014", cosine: b
     return ValuePdf(value, density)
 
 
-def random_uniforms(seed: int, n: int, first: int = 0) -> np.ndarray:
+def random_uniforms(seed: SupportsIndex, n: SupportsIndex, first: SupportsIndex = 0) -> Float32Array:
     """The ``(n, 3)`` uniforms :func:`sample` draws for elements ``first .. first + n - 1``
     when given ``seed`` and no ``u`` (a counter-based generator keyed by seed and index)."""
     count, start = integer("n", n), integer("first", first)
@@ -422,9 +451,25 @@ def _fresh_seed() -> int:
     return int(np.random.SeedSequence().generate_state(1, np.uint64)[0])
 
 
-def sample(material: Material, wo, *, u=None, seed=None, n=None, model: str = "disney2014",
-           specular_sampler: str = "visible", layout: str = "aos", threads=None, check: bool = True,
-           isa=None, with_lobes: bool = False):
+@overload
+def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
+           seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
+           specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
+           check: bool = True, isa: str | None = None, with_lobes: Literal[False] = False) -> Sample: ...
+@overload
+def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
+           seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
+           specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
+           check: bool = True, isa: str | None = None, with_lobes: Literal[True]) -> tuple[Sample, Lobes]: ...
+@overload
+def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
+           seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
+           specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
+           check: bool = True, isa: str | None = None, with_lobes: bool = False) -> Sample | tuple[Sample, Lobes]: ...
+def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
+           seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
+           specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
+           check: bool = True, isa: str | None = None, with_lobes: bool = False) -> Sample | tuple[Sample, Lobes]:
     """Importance-sample ``wi`` for each ``wo`` (README "Sampling and pdf").
 
     ``u``: three uniforms in [0, 1] per element, ``(..., 3)`` (``(3, ...)`` for
@@ -480,4 +525,4 @@ def sample(material: Material, wo, *, u=None, seed=None, n=None, model: str = "d
     if bad >= 0:
         raise _direction_error(bad, leading, wo_dirs)
     drawn = Sample(wi_out, pdf_out, weight_out, lobe_out)
-    return (drawn, Lobes(*shares)) if with_lobes else drawn
+    return (drawn, Lobes(*shares)) if shares is not None else drawn  # shares is None unless with_lobes

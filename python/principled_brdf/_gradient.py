@@ -7,17 +7,20 @@ The Jacobian's columns are the 13 parameter slots of the C++ table
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from .material import PARAMETERS
 
+if TYPE_CHECKING:
+    from ._typing import FloatArray
+
 __all__ = ["Gradient", "GRADIENT_NAMES"]
 
 
-def _slot_names() -> tuple:
-    names = []
+def _slot_names() -> tuple[str, ...]:
+    names: list[str] = []
     for info in PARAMETERS.values():
         names += [f"{info.name}_{c}" for c in "rgb"] if info.slots == 3 else [info.name]
     return tuple(names)
@@ -29,12 +32,12 @@ GRADIENT_NAMES = _slot_names()
 class Gradient(NamedTuple):
     """f and its partial derivatives: ``jacobian[..., c, k] = ∂f_c / ∂names[k]``."""
 
-    value: np.ndarray  # (..., 3) as eval returns it
-    jacobian: np.ndarray  # (..., 3, P)
-    names: tuple  # the P parameters, in the table's order
+    value: FloatArray  # (..., 3) as eval returns it
+    jacobian: FloatArray  # (..., 3, P)
+    names: tuple[str, ...]  # the P parameters, in the table's order
 
 
-def columns(wrt, argument: str = "wrt") -> list:
+def columns(wrt: object, argument: str = "wrt") -> list[int]:
     """The slot indices for ``wrt``: None (all 13), a name or a sequence of names;
     ``base_color`` stands for its three channels. Kept in the table's order;
     errors name ``argument``."""
@@ -56,7 +59,7 @@ def columns(wrt, argument: str = "wrt") -> list:
     return sorted(wanted)
 
 
-def result(value: np.ndarray, jacobian: np.ndarray, wrt_columns: list) -> Gradient:
+def result(value: FloatArray, jacobian: FloatArray, wrt_columns: list[int]) -> Gradient:
     """The Gradient of full 13-column Jacobians, keeping ``wrt_columns``."""
     if len(wrt_columns) != len(GRADIENT_NAMES):
         jacobian = np.ascontiguousarray(jacobian[..., wrt_columns])

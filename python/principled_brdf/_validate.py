@@ -8,10 +8,16 @@ from __future__ import annotations
 
 import numbers
 import operator
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import _core
+
+if TYPE_CHECKING:
+    from numpy.typing import NDArray
+
+    from ._typing import Float64Array, FloatArray
 
 DIRECTION_LENGTH_TOLERANCE = 1e-3
 # A direction passes when its float64 squared length, summed as x² + y² + z²,
@@ -26,7 +32,7 @@ FLOAT32_MAX = float(np.finfo(np.float32).max)
 _REAL_KINDS = "biuf"  # bool, signed and unsigned integers, floats
 
 
-def unit_length(array: np.ndarray) -> np.ndarray:
+def unit_length(array: FloatArray) -> NDArray[np.bool_]:
     """Which vectors on the last axis pass the direction check (False for NaN)."""
     w = array.astype(np.float64, copy=False)
     with np.errstate(invalid="ignore", over="ignore"):
@@ -34,7 +40,7 @@ def unit_length(array: np.ndarray) -> np.ndarray:
         return (length2 >= DIRECTION_LENGTH2_BOUNDS[0]) & (length2 <= DIRECTION_LENGTH2_BOUNDS[1])
 
 
-def direction_error(name: str, flat_index: int, leading: tuple, vector: np.ndarray) -> ValueError:
+def direction_error(name: str, flat_index: int, leading: tuple[int, ...], vector: FloatArray) -> ValueError:
     """The error for a vector that fails the direction check."""
     where = element_name(name, flat_index, leading)
     vector = np.asarray(vector, dtype=np.float64)
@@ -47,14 +53,14 @@ def direction_error(name: str, flat_index: int, leading: tuple, vector: np.ndarr
     return ValueError(f"{where}: length {shown} is not 1 (within {DIRECTION_LENGTH_TOLERANCE:g})")
 
 
-def flag(name: str, value) -> bool:
+def flag(name: str, value: object) -> bool:
     """A yes/no option: True, False (or numpy's bool); TypeError otherwise."""
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
     raise TypeError(f"{name}: expected True or False, got {type(value).__name__}")
 
 
-def element_name(name: str, flat_index: int, shape: tuple) -> str:
+def element_name(name: str, flat_index: int, shape: tuple[int, ...]) -> str:
     """``name[i, j]`` for the element at ``flat_index`` of an array of ``shape``."""
     if not shape:
         return name
@@ -62,11 +68,11 @@ def element_name(name: str, flat_index: int, shape: tuple) -> str:
     return f"{name}[{', '.join(str(int(i)) for i in index)}]"
 
 
-def first_true(mask: np.ndarray) -> int:
+def first_true(mask: NDArray[np.bool_]) -> int:
     return int(np.flatnonzero(mask.ravel())[0])
 
 
-def as_real_array(name: str, value) -> np.ndarray:
+def as_real_array(name: str, value: object) -> Float64Array:
     """A float64 array from a number or array of real numbers; TypeError otherwise."""
     if isinstance(value, (str, bytes)) or value is None:
         raise TypeError(f"{name}: expected a real number or an array of them, got {type(value).__name__}")
@@ -84,12 +90,12 @@ def as_real_array(name: str, value) -> np.ndarray:
     return array if array.flags.aligned else array.copy()
 
 
-def _not_finite_message(name: str, flat_index: int, array: np.ndarray) -> str:
+def _not_finite_message(name: str, flat_index: int, array: FloatArray) -> str:
     # float() so the message reads "nan", not numpy 2's "np.float64(nan)"
     return f"{element_name(name, flat_index, array.shape)}: {float(array.ravel()[flat_index])!r} is not a finite number"
 
 
-def require_float32(name: str, array: np.ndarray) -> None:
+def require_float32(name: str, array: FloatArray) -> None:
     """Every value finite and within float32's range (for the float32 kernels)."""
     with np.errstate(invalid="ignore"):
         bad = ~(np.abs(array) <= FLOAT32_MAX)
@@ -102,13 +108,13 @@ def require_float32(name: str, array: np.ndarray) -> None:
         raise ValueError(_not_finite_message(name, i, array))
 
 
-def require_finite(name: str, array: np.ndarray) -> None:
+def require_finite(name: str, array: FloatArray) -> None:
     bad = ~np.isfinite(array)
     if bad.any():
         raise ValueError(_not_finite_message(name, first_true(bad), array))
 
 
-def require_in_domain(name: str, array: np.ndarray, lower: float, upper: float) -> None:
+def require_in_domain(name: str, array: FloatArray, lower: float, upper: float) -> None:
     not_finite = ~np.isfinite(array)
     with np.errstate(invalid="ignore"):
         bad = not_finite | (array < lower) | (array > upper)
@@ -122,7 +128,7 @@ def require_in_domain(name: str, array: np.ndarray, lower: float, upper: float) 
         )
 
 
-def directions(name: str, value) -> np.ndarray:
+def directions(name: str, value: object) -> Float64Array:
     """A float64 ``(..., 3)`` array of unit vectors, checked."""
     array = as_real_array(name, value)
     if array.ndim == 0 or array.shape[-1] != 3:
@@ -138,36 +144,36 @@ def directions(name: str, value) -> np.ndarray:
     return array
 
 
-def integer(name: str, value) -> int:
+def integer(name: str, value: object) -> int:
     """An integer (not a bool); TypeError otherwise."""
     if isinstance(value, (bool, np.bool_)):
         raise TypeError(f"{name}: expected an integer, got {type(value).__name__}")
     try:
-        return operator.index(value)
+        return operator.index(value)  # type: ignore[arg-type]  # a TypeError here is the check
     except TypeError:
         raise TypeError(f"{name}: expected an integer, got {type(value).__name__}") from None
 
 
-def seed_value(seed) -> int:
+def seed_value(seed: object) -> int:
     value = integer("seed", seed)
     if not 0 <= value < 2**64:
         raise ValueError(f"seed: expected 0 <= seed < 2**64, got {value}")
     return value
 
 
-def model_index(model) -> int:
+def model_index(model: object) -> int:
     if not isinstance(model, str) or model not in MODELS:
         raise ValueError(f"model: expected one of {sorted(MODELS)}, got {model!r}")
     return MODELS[model]
 
 
-def sampler_index(specular_sampler) -> int:
+def sampler_index(specular_sampler: object) -> int:
     if not isinstance(specular_sampler, str) or specular_sampler not in SAMPLERS:
         raise ValueError(f"specular_sampler: expected one of {sorted(SAMPLERS)}, got {specular_sampler!r}")
     return SAMPLERS[specular_sampler]
 
 
-def broadcast_leading(**shapes: tuple) -> tuple:
+def broadcast_leading(**shapes: tuple[int, ...]) -> tuple[int, ...]:
     """The common leading shape of several arguments, or a ValueError naming them."""
     try:
         return np.broadcast_shapes(*shapes.values())

@@ -4,13 +4,18 @@ in total, with its Monte Carlo standard error."""
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from ._batch import Lobes, random_uniforms, sample
 from ._validate import LOBE_NAMES, as_real_array, broadcast_leading, integer, require_in_domain, seed_value
 from .material import PARAMETERS, Material
+
+if TYPE_CHECKING:
+    from typing import Any, SupportsIndex
+
+    from ._typing import Float64Array, Model, RealArrayLike, SpecularSampler
 
 __all__ = ["Albedo", "albedo"]
 
@@ -23,15 +28,15 @@ _CHUNK_ELEMENTS = 1 << 22
 class Albedo(NamedTuple):
     """Directional albedo at each cos θo, RGB ``(..., 3)``, with standard errors."""
 
-    total: np.ndarray
+    total: Float64Array
     lobes: Lobes  # diffuse, sheen, specular, clearcoat
-    total_error: np.ndarray  # standard error of the mean
+    total_error: Float64Array  # standard error of the mean
     lobe_errors: Lobes
 
 
-def _with_sample_axis(material: Material, leading: tuple) -> Material:
+def _with_sample_axis(material: Material, leading: tuple[int, ...]) -> Material:
     """The material broadcast to ``leading`` with a trailing axis of length 1 for the samples."""
-    params = {}
+    params: dict[str, Any] = {}  # Material's keywords
     for name, info in PARAMETERS.items():
         value = getattr(material, name)
         if info.slots == 3:
@@ -41,8 +46,9 @@ def _with_sample_axis(material: Material, leading: tuple) -> Material:
     return Material(**params)
 
 
-def albedo(material: Material, cos_theta_o, *, samples: int = 1 << 16, seed: int = 0, model: str = "disney2014",
-           specular_sampler: str = "visible", threads=None) -> Albedo:
+def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsIndex = 1 << 16,
+           seed: SupportsIndex = 0, model: Model = "disney2014", specular_sampler: SpecularSampler = "visible",
+           threads: SupportsIndex | None = None) -> Albedo:
     """Directional albedo ``E(wo) = ∫ f(wi, wo) cos θl dωi`` for ``wo = (sin θo, 0, cos θo)``.
 
     ``cos_theta_o`` in (0, 1], any shape, broadcast with the material's
@@ -96,9 +102,9 @@ def albedo(material: Material, cos_theta_o, *, samples: int = 1 << 16, seed: int
     )
 
 
-def _flatten(material: Material, leading: tuple) -> dict:
+def _flatten(material: Material, leading: tuple[int, ...]) -> dict[str, Float64Array]:
     """Per-element parameters of a sample-axis material as flat (M, 1[, 3]) arrays; uniform ones as they are."""
-    flat = {}
+    flat: dict[str, Float64Array] = {}
     for name, info in PARAMETERS.items():
         value = getattr(material, name)
         uniform = value.shape == ((3,) if info.slots == 3 else ())
@@ -106,6 +112,7 @@ def _flatten(material: Material, leading: tuple) -> dict:
     return flat
 
 
-def _slice(flat: dict, start: int, stop: int) -> Material:
-    return Material(**{name: (v if v.ndim <= 1 and (v.shape in ((), (3,))) else v[start:stop])
-                       for name, v in flat.items()})
+def _slice(flat: dict[str, Float64Array], start: int, stop: int) -> Material:
+    values: dict[str, Any] = {name: (v if v.ndim <= 1 and (v.shape in ((), (3,))) else v[start:stop])
+                              for name, v in flat.items()}
+    return Material(**values)

@@ -5,17 +5,24 @@ of the model (README "The model") on the same pairs, both timed in this process 
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ._batch import cpu_info, eval as _eval
 from .material import Material
 
-MATERIAL = dict(base_color=(0.82, 0.67, 0.16), metallic=0.2, subsurface=0.3, specular=0.5, specular_tint=0.1,
+if TYPE_CHECKING:
+    from collections.abc import Callable, Mapping
+    from typing import Any
+
+    from ._typing import Float32Array
+
+MATERIAL: dict[str, Any] = dict(base_color=(0.82, 0.67, 0.16), metallic=0.2, subsurface=0.3, specular=0.5, specular_tint=0.1,
                 roughness=0.4, anisotropic=0.3, sheen=0.2, sheen_tint=0.5, clearcoat=0.5, clearcoat_gloss=0.7)
 
 
-def numpy_eval(m: dict, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+def numpy_eval(m: Mapping[str, Any], wi: Float32Array, wo: Float32Array) -> Float32Array:
     """The model (disney2014) written the obvious way with float32 numpy arrays."""
     f32 = np.float32
     base = np.asarray(m["base_color"], f32)
@@ -25,7 +32,7 @@ def numpy_eval(m: dict, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     h /= np.linalg.norm(h, axis=1, keepdims=True)
     cos_h, cos_d = h[:, 2], np.einsum("ij,ij->i", wi, h)
 
-    def schlick(u):
+    def schlick(u: Any) -> Any:
         return np.clip(f32(1) - u, 0, 1) ** 5
 
     fl, fv, fh = schlick(lz), schlick(vz), schlick(cos_d)
@@ -55,11 +62,11 @@ def numpy_eval(m: dict, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     return f.astype(f32, copy=False)
 
 
-def random_pairs(n: int, seed: int = 1):
+def random_pairs(n: int, seed: int = 1) -> tuple[Float32Array, Float32Array]:
     """``n`` random (wi, wo) pairs in the upper hemisphere, float32 (n, 3) each."""
     rng = np.random.default_rng(seed)
 
-    def hemisphere():
+    def hemisphere() -> Float32Array:
         v = rng.normal(size=(n, 3)).astype(np.float32)
         v[:, 2] = np.abs(v[:, 2]) + 1e-3
         return v / np.linalg.norm(v, axis=1, keepdims=True)
@@ -67,7 +74,7 @@ def random_pairs(n: int, seed: int = 1):
     return hemisphere(), hemisphere()
 
 
-def best_seconds(fn, repeats: int) -> float:
+def best_seconds(fn: Callable[[], object], repeats: int) -> float:
     """The fastest of ``repeats`` runs of ``fn()``."""
     times = []
     for _ in range(repeats):
@@ -77,7 +84,8 @@ def best_seconds(fn, repeats: int) -> float:
     return min(times)
 
 
-def compare_with_numpy(pairs: int = 1 << 22, repeats: int = 5, report=print) -> dict:
+def compare_with_numpy(pairs: int = 1 << 22, repeats: int = 5,
+                       report: Callable[[str], object] = print) -> dict[str, Any]:
     """Times pb.eval (the default call with a fresh output; out= checked and unchecked) and
     numpy_eval on ``pairs`` pairs."""
     material = Material(**MATERIAL)

@@ -10,6 +10,7 @@ rounding, and stop at the start point.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,6 +19,14 @@ from ._batch import eval_grad
 from ._gradient import GRADIENT_NAMES
 from .material import PARAMETERS, Material
 from . import reference
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Mapping
+    from typing import Any, Literal, SupportsFloat, SupportsIndex
+
+    from numpy.typing import NDArray
+
+    from ._typing import Float64Array, Model, RealArrayLike
 
 __all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES"]
 
@@ -31,14 +40,15 @@ LOSSES = ("log", "relative", "linear")
 class FitResult:
     """What :func:`fit` returns; for a batch of problems every field has a leading batch axis."""
 
+    # (a single problem: cost, iterations and success are numpy scalars, message a str)
     material: Material  # the fitted material (per element along the batch axis for a batch)
-    slots: np.ndarray  # (..., 13) its values in the parameter slots (GRADIENT_NAMES' order)
-    cost: np.ndarray  # 0.5 * sum of squared (weighted) residuals, per problem
-    residuals: np.ndarray  # (..., N, 3) unweighted, at the fitted material; NaN where measured is NaN
-    iterations: np.ndarray  # Jacobian evaluations, per problem
-    success: np.ndarray  # scipy's convergence flag, per problem
-    message: tuple  # scipy's message, per problem
-    names: tuple  # the fitted parameters (slot names, base_color as three)
+    slots: Float64Array  # (..., 13) its values in the parameter slots (GRADIENT_NAMES' order)
+    cost: np.float64 | Float64Array  # 0.5 * sum of squared (weighted) residuals, per problem
+    residuals: Float64Array  # (..., N, 3) unweighted, at the fitted material; NaN where measured is NaN
+    iterations: np.int64 | NDArray[np.int64]  # Jacobian evaluations, per problem
+    success: np.bool_ | NDArray[np.bool_]  # scipy's convergence flag, per problem
+    message: str | tuple[str, ...]  # scipy's message, per problem
+    names: tuple[str, ...]  # the fitted parameters (slot names, base_color as three)
 
     def summary(self) -> str:
         rows = np.atleast_2d(self.slots)
@@ -61,17 +71,19 @@ class FitResult:
         return self.summary()
 
 
-def _slot_bounds(bounds) -> tuple:
+def _slot_bounds(
+    bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None,
+) -> tuple[Float64Array, Float64Array]:
     merged = dict(FIT_BOUNDS)
     for name, pair in (bounds or {}).items():
         if name not in PARAMETERS:
             raise ValueError(f"bounds: unknown parameter {name!r}")
-        lower, upper = (float(v) for v in pair)
+        low, high = (float(v) for v in pair)
         info = PARAMETERS[name]
-        if not (info.lower <= lower <= upper <= info.upper):
-            raise ValueError(f"bounds[{name!r}]: ({lower}, {upper}) is not an interval inside its domain "
+        if not (info.lower <= low <= high <= info.upper):
+            raise ValueError(f"bounds[{name!r}]: ({low}, {high}) is not an interval inside its domain "
                              f"[{info.lower}, {info.upper}]")
-        merged[name] = (lower, upper)
+        merged[name] = (low, high)
     lower = np.empty(len(GRADIENT_NAMES))
     upper = np.empty(len(GRADIENT_NAMES))
     for name, info in PARAMETERS.items():
@@ -80,7 +92,7 @@ def _slot_bounds(bounds) -> tuple:
     return lower, upper
 
 
-def _initial_slots(init) -> np.ndarray:
+def _initial_slots(init: Material | dict[str, Any] | None) -> Float64Array:
     if init is None:
         init = Material()
     if isinstance(init, dict):
@@ -90,16 +102,18 @@ def _initial_slots(init) -> np.ndarray:
     return np.asarray(init.packed(()), dtype=np.float64).reshape(-1)
 
 
-def _material_of(slot_values: np.ndarray) -> Material:
+def _material_of(slot_values: Float64Array) -> Material:
     """A material from slot values ``(..., 13)``, uniform when one row."""
-    values = {}
+    values: dict[str, Any] = {}  # Material's keywords
     for name, info in PARAMETERS.items():
         block = slot_values[..., info.first_slot:info.first_slot + info.slots]
         values[name] = block if info.slots == 3 else block[..., 0]
     return Material(**values)
 
 
-def _residual_and_jacobian(value, jacobian, measured, cos_theta, loss, scale):
+def _residual_and_jacobian(value: Float64Array, jacobian: Float64Array, measured: Float64Array,
+                           cos_theta: Float64Array, loss: str,
+                           scale: Float64Array) -> tuple[Float64Array, Float64Array]:
     """Residuals r (n, 3) and dr/dslot (n, 3, 13) for one problem."""
     if loss == "log":
         model = value * cos_theta[:, None]
@@ -114,9 +128,12 @@ def _residual_and_jacobian(value, jacobian, measured, cos_theta, loss, scale):
     return residual, derivative
 
 
-def fit(wi, wo, measured, *, init=None, fit=None, loss: str = "log", weights=None, bounds=None,
-        model: str = "disney2014", cosine: bool = True, precision: str = "float32",
-        max_iterations: int = 200) -> FitResult:
+def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
+        init: Material | dict[str, Any] | None = None, fit: str | list[str] | tuple[str, ...] | None = None,
+        loss: Literal["log", "relative", "linear"] = "log", weights: RealArrayLike | None = None,
+        bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None = None, model: Model = "disney2014",
+        cosine: bool = True, precision: Literal["float32", "float64"] = "float32",
+        max_iterations: SupportsIndex = 200) -> FitResult:
     """The material that best matches ``measured`` values of f (1/sr) at the pairs (wi, wo).
 
     ``wi``, ``wo``: unit directions ``(N, 3)``; ``measured``: ``(N, 3)``, or
@@ -183,9 +200,9 @@ def fit(wi, wo, measured, *, init=None, fit=None, loss: str = "log", weights=Non
         scale = np.maximum(m, 1e-3 * max(float(m.max(initial=0.0)), 1e-300))
         root_weight = np.sqrt(weights[row][present])[:, None] if weights is not None else np.ones((len(m), 1))
         values = start.copy()
-        last = {}
+        last: dict[str, Float64Array] = {}
 
-        def evaluate(x):
+        def evaluate(x: Float64Array) -> tuple[Float64Array, Float64Array]:
             """Unweighted residuals (n, 3) and their Jacobian (n, 3, len(slots)) at x, kept for the next call."""
             if last.get("x") is None or not np.array_equal(last["x"], x):
                 values[slots] = x
@@ -211,7 +228,7 @@ def fit(wi, wo, measured, *, init=None, fit=None, loss: str = "log", weights=Non
         messages.append(solution.message)
         residuals_out[row][present] = evaluate(solution.x)[0]
 
-    take = (lambda a: a) if batched else (lambda a: a[0])
+    take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
     return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
                      residuals=take(residuals_out), iterations=take(iterations), success=take(success),
                      message=tuple(messages) if batched else messages[0], names=tuple(GRADIENT_NAMES[k] for k in slots))

@@ -8,16 +8,21 @@ coordinates; angles are in radians.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from . import _validate
 from .measured import half_diff_to_wiwo, wiwo_to_half_diff
 
+if TYPE_CHECKING:
+    from ._typing import Float64Array, RealArrayLike
+
 __all__ = ["spherical_to_direction", "direction_to_spherical", "frame_from_normal", "to_local", "to_world",
            "wiwo_to_half_diff", "half_diff_to_wiwo"]
 
 
-def spherical_to_direction(theta, phi=0.0) -> np.ndarray:
+def spherical_to_direction(theta: RealArrayLike, phi: RealArrayLike = 0.0) -> Float64Array:
     """(sin θ cos φ, sin θ sin φ, cos θ) ``(..., 3)``: θ from the normal, φ from the tangent."""
     theta, phi = np.broadcast_arrays(np.asarray(_validate.as_real_array("theta", theta), dtype=np.float64),
                                      np.asarray(_validate.as_real_array("phi", phi), dtype=np.float64))
@@ -25,14 +30,14 @@ def spherical_to_direction(theta, phi=0.0) -> np.ndarray:
     return np.stack([sin_theta * np.cos(phi), sin_theta * np.sin(phi), np.cos(theta)], axis=-1)
 
 
-def direction_to_spherical(w) -> tuple:
+def direction_to_spherical(w: RealArrayLike) -> tuple[Float64Array, Float64Array]:
     """(θ, φ) of unit directions ``(..., 3)``: θ in [0, π] (by atan2, accurate near the
     normal), φ in (-π, π]."""
     w = _validate.directions("w", w)
     return np.arctan2(np.hypot(w[..., 0], w[..., 1]), w[..., 2]), np.arctan2(w[..., 1], w[..., 0])
 
 
-def frame_from_normal(normal, tangent=None) -> np.ndarray:
+def frame_from_normal(normal: RealArrayLike, tangent: RealArrayLike | None = None) -> Float64Array:
     """Orthonormal frames ``(..., 3, 3)`` whose rows are (tangent, bitangent, normal).
 
     Without ``tangent``, the tangent is the branchless construction of Duff et
@@ -58,13 +63,13 @@ def frame_from_normal(normal, tangent=None) -> np.ndarray:
     return np.stack(np.broadcast_arrays(t, bitangent, n), axis=-2)
 
 
-def to_local(w, frame) -> np.ndarray:
+def to_local(w: RealArrayLike, frame: RealArrayLike) -> Float64Array:
     """World directions ``(..., 3)`` in the frames ``(..., 3, 3)`` of :func:`frame_from_normal`."""
     w = np.asarray(_validate.as_real_array("w", w), dtype=np.float64)
     return np.einsum("...ij,...j->...i", np.asarray(frame, dtype=np.float64), w)
 
 
-def to_world(w, frame) -> np.ndarray:
+def to_world(w: RealArrayLike, frame: RealArrayLike) -> Float64Array:
     """Local directions ``(..., 3)`` back to world coordinates (the frames' transpose)."""
     w = np.asarray(_validate.as_real_array("w", w), dtype=np.float64)
     return np.einsum("...ji,...j->...i", np.asarray(frame, dtype=np.float64), w)

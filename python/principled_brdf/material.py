@@ -3,17 +3,32 @@
 from __future__ import annotations
 
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import _core
 from ._validate import as_real_array, broadcast_leading, flag, require_in_domain
 
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+    from typing import NoReturn, SupportsIndex
+
+    from ._typing import Float32Array, Float64Array, Index, RealArrayLike
+
 
 class _ParamInfo:
     __slots__ = ("name", "first_slot", "slots", "default", "lower", "upper")
 
-    def __init__(self, name, first_slot, slots, default, lower, upper):
+    name: str
+    first_slot: int
+    slots: int
+    default: float | tuple[float, ...]  # a number, or base_color's three
+    lower: float
+    upper: float
+
+    def __init__(self, name: str, first_slot: int, slots: int, default: tuple[float, ...], lower: float,
+                 upper: float) -> None:
         self.name, self.first_slot, self.slots = name, first_slot, slots
         self.default = default[0] if slots == 1 else tuple(default)
         self.lower, self.upper = lower, upper
@@ -34,22 +49,36 @@ class Material:
 
     __slots__ = tuple(PARAMETERS) + ("_float32_cache",)
 
+    # The parameters as given, float64 and read-only: base_color (3,) or (..., 3), the others () or (...).
+    base_color: Float64Array
+    metallic: Float64Array
+    subsurface: Float64Array
+    specular: Float64Array
+    specular_tint: Float64Array
+    roughness: Float64Array
+    anisotropic: Float64Array
+    sheen: Float64Array
+    sheen_tint: Float64Array
+    clearcoat: Float64Array
+    clearcoat_gloss: Float64Array
+    _float32_cache: dict[tuple[str, tuple[int, ...]], Float32Array]
+
     def __init__(
         self,
-        base_color=PARAMETERS["base_color"].default,
-        metallic=PARAMETERS["metallic"].default,
-        subsurface=PARAMETERS["subsurface"].default,
-        specular=PARAMETERS["specular"].default,
-        specular_tint=PARAMETERS["specular_tint"].default,
-        roughness=PARAMETERS["roughness"].default,
-        anisotropic=PARAMETERS["anisotropic"].default,
-        sheen=PARAMETERS["sheen"].default,
-        sheen_tint=PARAMETERS["sheen_tint"].default,
-        clearcoat=PARAMETERS["clearcoat"].default,
-        clearcoat_gloss=PARAMETERS["clearcoat_gloss"].default,
+        base_color: RealArrayLike = PARAMETERS["base_color"].default,
+        metallic: RealArrayLike = PARAMETERS["metallic"].default,
+        subsurface: RealArrayLike = PARAMETERS["subsurface"].default,
+        specular: RealArrayLike = PARAMETERS["specular"].default,
+        specular_tint: RealArrayLike = PARAMETERS["specular_tint"].default,
+        roughness: RealArrayLike = PARAMETERS["roughness"].default,
+        anisotropic: RealArrayLike = PARAMETERS["anisotropic"].default,
+        sheen: RealArrayLike = PARAMETERS["sheen"].default,
+        sheen_tint: RealArrayLike = PARAMETERS["sheen_tint"].default,
+        clearcoat: RealArrayLike = PARAMETERS["clearcoat"].default,
+        clearcoat_gloss: RealArrayLike = PARAMETERS["clearcoat_gloss"].default,
         *,
         bright_base_color: bool = False,
-    ):
+    ) -> None:
         values = dict(locals())
         for name, info in PARAMETERS.items():
             if name == "base_color" and isinstance(values[name], np.ndarray) and values[name].dtype == np.uint8:
@@ -69,14 +98,14 @@ class Material:
                           "display-encoded colour?); pass bright_base_color=True if it is meant", BrightColorWarning,
                           stacklevel=2)
 
-    def __setattr__(self, name, value):
+    def __setattr__(self, name: str, value: object) -> NoReturn:
         raise AttributeError("Material is immutable; build a new one (or use Material.replace)")
 
-    def __delattr__(self, name):
+    def __delattr__(self, name: str) -> NoReturn:
         raise AttributeError("Material is immutable; build a new one (or use Material.replace)")
 
     @property
-    def shape(self) -> tuple:
+    def shape(self) -> tuple[int, ...]:
         """Leading shape the per-element parameters broadcast to (``()`` if all uniform)."""
         return broadcast_leading(**{name: self._leading_shape(name) for name in PARAMETERS})
 
@@ -84,11 +113,11 @@ class Material:
     def is_uniform(self) -> bool:
         return self.shape == ()
 
-    def _leading_shape(self, name: str) -> tuple:
-        array = getattr(self, name)
+    def _leading_shape(self, name: str) -> tuple[int, ...]:
+        array: Float64Array = getattr(self, name)
         return array.shape[:-1] if PARAMETERS[name].slots == 3 else array.shape
 
-    def replace(self, **changes) -> "Material":
+    def replace(self, **changes: RealArrayLike) -> Material:
         """A copy with some parameters changed."""
         unknown = set(changes) - set(PARAMETERS)
         if unknown:
@@ -96,37 +125,38 @@ class Material:
         # a bright base_color kept from self was reported when self was made
         return Material(**{**self.as_dict(), **changes}, bright_base_color="base_color" not in changes)
 
-    def _per_element(self, transform) -> "Material":
+    def _per_element(self, transform: Callable[[Float64Array], Float64Array]) -> Material:
         """A material whose per-element parameters are ``transform(array broadcast to the
         leading shape + its trailing shape, trailing ndim)``; uniform ones stay uniform."""
         shape = self.shape
-        values = {}
+        values: dict[str, RealArrayLike] = {}
         for name, info in PARAMETERS.items():
             array = getattr(self, name)
-            trailing = () if info.slots == 1 else (3,)
+            trailing: tuple[int, ...] = () if info.slots == 1 else (3,)
             values[name] = array if array.shape == trailing else transform(np.broadcast_to(array, shape + trailing))
         return Material(**values, bright_base_color=True)
 
-    def __getitem__(self, key) -> "Material":
+    def __getitem__(self, key: Index) -> Material:
         """The material of some elements: ``m[i]``, ``m[2:5, ::2]``, ``m[mask]`` index the
         leading shape, as numpy indexes an array of that shape."""
         if self.shape == ():
             raise IndexError("material: a uniform material has no elements to index")
-        if key is Ellipsis or (isinstance(key, tuple) and any(k is Ellipsis for k in key)):
+        # (Index has no Ellipsis; this is for untyped callers)
+        if key is Ellipsis or (isinstance(key, tuple) and any(k is Ellipsis for k in key)):  # type: ignore[comparison-overlap]
             raise IndexError("material: index the leading shape without Ellipsis")
         np.empty(self.shape, dtype=np.int8)[key]  # numpy's IndexError for a bad key, before any copy
         return self._per_element(lambda array: array[key])
 
-    def reshape(self, *shape) -> "Material":
+    def reshape(self, *shape: SupportsIndex | Sequence[SupportsIndex]) -> Material:
         """The same elements in a new leading shape (``m.reshape(-1)`` for flattened directions)."""
-        new_shape = np.empty(self.shape, dtype=np.int8).reshape(*shape).shape
+        new_shape = np.empty(self.shape, dtype=np.int8).reshape(*shape).shape  # type: ignore[arg-type]  # as numpy's
         return self._per_element(lambda array: array.reshape(new_shape + array.shape[len(self.shape):]))
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Float64Array]:
         return {name: getattr(self, name) for name in PARAMETERS}
 
     @staticmethod
-    def mix(a: "Material", b: "Material", t) -> "Material":
+    def mix(a: Material, b: Material, t: RealArrayLike) -> Material:
         """Every parameter linearly interpolated, ``a + (b - a) t`` (Burley 2012 §5.7).
 
         ``t`` is a number or a per-element mask in [0, 1], broadcast against the
@@ -138,14 +168,14 @@ class Material:
         weight = as_real_array("t", t)
         require_in_domain("t", weight, 0.0, 1.0)
         broadcast_leading(a=a.shape, b=b.shape, t=weight.shape)  # else numpy's message names no argument
-        mixed = {}
+        mixed: dict[str, RealArrayLike] = {}
         for name, info in PARAMETERS.items():
             start, end = getattr(a, name), getattr(b, name)
             w = weight[..., None] if info.slots == 3 else weight
             mixed[name] = start + (end - start) * w
         return Material(**mixed, bright_base_color=True)  # no brighter than a or b
 
-    def packed(self, leading_shape: tuple) -> np.ndarray:
+    def packed(self, leading_shape: tuple[int, ...]) -> Float64Array:
         """All parameters broadcast to ``leading_shape`` as contiguous ``(N, 13)`` float64 rows."""
         n = int(np.prod(leading_shape, dtype=np.int64))
         rows = np.empty((n, _core.PARAM_SLOTS), dtype=np.float64)
@@ -157,7 +187,7 @@ class Material:
                 rows[:, info.first_slot] = np.broadcast_to(array, leading_shape).reshape(n)
         return rows
 
-    def _float32(self, name: str, leading_shape: tuple) -> np.ndarray:
+    def _float32(self, name: str, leading_shape: tuple[int, ...]) -> Float32Array:
         """A per-element parameter broadcast to ``leading_shape`` as contiguous float32 (cached)."""
         key = (name, leading_shape)
         cached = self._float32_cache.get(key)
@@ -171,16 +201,16 @@ class Material:
             self._float32_cache[key] = cached
         return cached
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Callable[..., Material], tuple[Float64Array, ...]]:
         # pickling (multiprocessing, dask): rebuild through __init__, which re-checks
         return (_rebuilt, tuple(getattr(self, name) for name in PARAMETERS))
 
-    def __eq__(self, other):
+    def __eq__(self, other: object) -> bool:
         if not isinstance(other, Material):
             return NotImplemented
         return all(np.array_equal(getattr(self, n), getattr(other, n)) for n in PARAMETERS)
 
-    __hash__ = None
+    __hash__ = None  # type: ignore[assignment]  # mutable-looking arrays: unhashable, as numpy's
 
     def __repr__(self) -> str:
         parts = []
@@ -195,7 +225,7 @@ class Material:
         return "Material(" + ", ".join(parts) + ")"
 
 
-def _rebuilt(*values) -> Material:
+def _rebuilt(*values: RealArrayLike) -> Material:
     return Material(*values, bright_base_color=True)
 
 
@@ -203,7 +233,7 @@ class BrightColorWarning(UserWarning):
     """A base_color above 1 without bright_base_color=True."""
 
 
-def srgb_to_linear(color):
+def srgb_to_linear(color: RealArrayLike) -> Float64Array:
     """sRGB-encoded colour to linear RGB by the exact piecewise curve (IEC 61966-2-1):
     ``c / 12.92`` for ``c <= 0.04045``, else ``((c + 0.055) / 1.055) ** 2.4``. A uint8
     array is taken as 0-255 and scaled by 1/255 first; other values must lie in [0, 1]."""
@@ -214,7 +244,7 @@ def srgb_to_linear(color):
     return np.where(array <= 0.04045, array / 12.92, ((array + 0.055) / 1.055) ** 2.4)
 
 
-def gamma22_to_linear(color):
+def gamma22_to_linear(color: RealArrayLike) -> Float64Array:
     """Display (gamma 2.2) colour to linear RGB, the BRDF Explorer's ``mon2lin``: ``c ** 2.2``."""
     array = as_real_array("color", color)
     require_in_domain("color", array, 0.0, np.inf)

@@ -17,10 +17,19 @@ difference angles (``wiwo_to_half_diff``). All arrays here are float64.
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import _validate
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from typing import Any, Literal
+
+    from numpy.typing import NDArray
+
+    from ._typing import Float64Array, RealArrayLike
 
 __all__ = ["MerlBRDF", "load_merl", "save_merl", "merl_pairs", "wiwo_to_half_diff", "half_diff_to_wiwo",
            "MERL_SHAPE", "MERL_SCALE"]
@@ -33,17 +42,18 @@ _FILE_BYTES = _HEADER_BYTES + 3 * _CELLS * 8
 _HALF_PI = 0.5 * np.pi
 
 
-def _rotate_z(v: np.ndarray, angle: np.ndarray) -> np.ndarray:
+def _rotate_z(v: Float64Array, angle: Float64Array) -> Float64Array:
     c, s = np.cos(angle), np.sin(angle)
     return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1], v[..., 2]], axis=-1)
 
 
-def _rotate_y(v: np.ndarray, angle: np.ndarray) -> np.ndarray:
+def _rotate_y(v: Float64Array, angle: Float64Array) -> Float64Array:
     c, s = np.cos(angle), np.sin(angle)
     return np.stack([c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]], axis=-1)
 
 
-def wiwo_to_half_diff(wi, wo) -> tuple:
+def wiwo_to_half_diff(wi: RealArrayLike,
+                      wo: RealArrayLike) -> tuple[Float64Array, Float64Array, Float64Array, Float64Array]:
     """Rusinkiewicz's angles (θh, φh, θd, φd) of unit directions ``(..., 3)``:
     h = normalize(wi + wo) at (θh, φh), and wi in the frame of h (rotated by
     -φh about n, then by -θh about the bitangent) at (θd, φd); φ in (-π, π]."""
@@ -61,7 +71,8 @@ def wiwo_to_half_diff(wi, wo) -> tuple:
     return theta_h, phi_h, theta_d, phi_d
 
 
-def half_diff_to_wiwo(theta_h, phi_h, theta_d, phi_d) -> tuple:
+def half_diff_to_wiwo(theta_h: RealArrayLike, phi_h: RealArrayLike, theta_d: RealArrayLike,
+                      phi_d: RealArrayLike) -> tuple[Float64Array, Float64Array]:
     """(wi, wo) ``(..., 3)`` from Rusinkiewicz's angles, the inverse of :func:`wiwo_to_half_diff`."""
     theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64)
                                                             for a in (theta_h, phi_h, theta_d, phi_d)))
@@ -72,7 +83,8 @@ def half_diff_to_wiwo(theta_h, phi_h, theta_d, phi_d) -> tuple:
     return wi, wo
 
 
-def _cell_coordinates(theta_h, theta_d, phi_d) -> tuple:
+def _cell_coordinates(theta_h: Float64Array, theta_d: Float64Array,
+                      phi_d: Float64Array) -> tuple[Float64Array, Float64Array, Float64Array]:
     """Continuous cell coordinates (cell i spans [i, i + 1)), φd folded into [0, π)."""
     phi_d = np.where(phi_d < 0.0, phi_d + 2.0 * np.pi, phi_d)
     phi_d = np.where(phi_d >= np.pi, phi_d - np.pi, phi_d)
@@ -82,19 +94,19 @@ def _cell_coordinates(theta_h, theta_d, phi_d) -> tuple:
     return x_h, x_d, x_p
 
 
-def _indices(theta_h, theta_d, phi_d) -> tuple:
+def _indices(theta_h: Float64Array, theta_d: Float64Array, phi_d: Float64Array) -> tuple[NDArray[np.int64], ...]:
     coordinates = _cell_coordinates(theta_h, theta_d, phi_d)
     return tuple(np.clip(np.floor(x).astype(np.int64), 0, size - 1) for x, size in zip(coordinates, MERL_SHAPE))
 
 
-def _centres() -> tuple:
+def _centres() -> tuple[Float64Array, Float64Array, Float64Array]:
     """(θh, θd, φd) at the centre of every cell, each ``MERL_SHAPE``."""
     i_h, i_d, i_p = np.meshgrid(*(np.arange(size) + 0.5 for size in MERL_SHAPE), indexing="ij")
     theta_h = (i_h / MERL_SHAPE[0]) ** 2 * _HALF_PI
     return theta_h, i_d / MERL_SHAPE[1] * _HALF_PI, i_p / MERL_SHAPE[2] * np.pi
 
 
-def merl_pairs() -> tuple:
+def merl_pairs() -> tuple[Float64Array, Float64Array]:
     """(wi, wo), each ``(90 · 90 · 180, 3)``, at the cells' centres in the file's
     order (φh = 0): the pairs to evaluate a model at, or to fit one to a
     table's :meth:`MerlBRDF.values`. Some lie below the horizon (θh + θd > 90°)."""
@@ -106,17 +118,20 @@ def merl_pairs() -> tuple:
 class MerlBRDF:
     """A MERL table: ``table`` ``(3, 90, 90, 180)`` of f in 1/sr, NaN where there is no data."""
 
-    def __init__(self, table):
-        table = np.array(table, dtype=np.float64)
-        if table.shape != (3,) + MERL_SHAPE:
-            raise ValueError(f"table: expected shape {(3,) + MERL_SHAPE} (channel, θh, θd, φd), got {table.shape}")
-        self.table = table
+    table: Float64Array
 
-    def values(self) -> np.ndarray:
+    def __init__(self, table: RealArrayLike) -> None:
+        array = np.array(table, dtype=np.float64)
+        if array.shape != (3,) + MERL_SHAPE:
+            raise ValueError(f"table: expected shape {(3,) + MERL_SHAPE} (channel, θh, θd, φd), got {array.shape}")
+        self.table = array
+
+    def values(self) -> Float64Array:
         """f ``(90 · 90 · 180, 3)`` in :func:`merl_pairs`' order, NaN where missing."""
         return self.table.reshape(3, -1).T.copy()
 
-    def eval(self, wi, wo, interpolation: str = "nearest") -> np.ndarray:
+    def eval(self, wi: RealArrayLike, wo: RealArrayLike,
+             interpolation: Literal["nearest", "linear"] = "nearest") -> Float64Array:
         """f(wi, wo) ``(..., 3)`` in 1/sr from the table: the cell the format's indices name
         (``"nearest"``), or trilinear between cell centres (``"linear"``, φd periodic with
         period π, the other axes clamped). NaN where a cell used has no data; 0 where wi or
@@ -134,8 +149,8 @@ class MerlBRDF:
             f = self._trilinear(*_cell_coordinates(theta_h, theta_d, phi_d))
         return np.where(above[..., None], f, 0.0)
 
-    def _trilinear(self, x_h, x_d, x_p) -> np.ndarray:
-        result = 0.0
+    def _trilinear(self, x_h: Float64Array, x_d: Float64Array, x_p: Float64Array) -> Float64Array:
+        result: Any = 0.0  # then the weighted sum of the corners' arrays
         corners = []
         for x, size, periodic in ((x_h, MERL_SHAPE[0], False), (x_d, MERL_SHAPE[1], False), (x_p, MERL_SHAPE[2], True)):
             position = x - 0.5  # centres sit at i + 0.5
@@ -156,7 +171,7 @@ class MerlBRDF:
         return result
 
 
-def load_merl(path) -> MerlBRDF:
+def load_merl(path: str | os.PathLike[str]) -> MerlBRDF:
     """Reads a MERL ``.binary`` file. A file of the wrong size or header is a ValueError saying what was expected."""
     size = os.path.getsize(path)
     with open(path, "rb") as f:
@@ -173,7 +188,8 @@ def load_merl(path) -> MerlBRDF:
     return MerlBRDF(table)
 
 
-def save_merl(path, brdf) -> None:
+def save_merl(path: str | os.PathLike[str],
+              brdf: MerlBRDF | Callable[[Float64Array, Float64Array], RealArrayLike]) -> None:
     """Writes a MERL ``.binary`` file: ``brdf`` a :class:`MerlBRDF`, or any callable
     ``f(wi, wo) -> (..., 3)`` in 1/sr (e.g. ``lambda wi, wo: pb.reference.eval(m, wi, wo)``),
     evaluated at the cells' centres. NaN (missing) is written as -1."""

@@ -25,10 +25,17 @@ function draws from.
 
 from __future__ import annotations
 
+import typing
+
 import numpy as np
 
 from . import _core
 from . import _validate
+
+if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
+    from collections.abc import Callable
+
+    from ._typing import Float64Array, RealArrayLike
 
 __all__ = [
     "MIN_ALPHA",
@@ -63,7 +70,7 @@ _core_mf = _core.microfacet
 # validation and packing
 
 
-def _positive(name: str, value, upper: float = np.inf) -> np.ndarray:
+def _positive(name: str, value: RealArrayLike, upper: float = np.inf) -> Float64Array:
     """Finite values in (0, upper]."""
     array = _validate.as_real_array(name, value)
     _validate.require_in_domain(name, array, 0.0, upper)
@@ -76,17 +83,17 @@ def _positive(name: str, value, upper: float = np.inf) -> np.ndarray:
     return array
 
 
-def _in_range(name: str, value, lower: float, upper: float) -> np.ndarray:
+def _in_range(name: str, value: RealArrayLike, lower: float, upper: float) -> Float64Array:
     array = _validate.as_real_array(name, value)
     _validate.require_in_domain(name, array, lower, upper)
     return array
 
 
-def _uniform(name: str, value) -> np.ndarray:
+def _uniform(name: str, value: RealArrayLike) -> Float64Array:
     return _in_range(name, value, 0.0, 1.0)
 
 
-def _alphas(alpha_x, alpha_y) -> tuple:
+def _alphas(alpha_x: RealArrayLike, alpha_y: RealArrayLike | None) -> tuple[Float64Array, Float64Array]:
     ax = _positive("alpha_x", alpha_x)
     ay = ax if alpha_y is None else _positive("alpha_y", alpha_y)
     return ax, ay
@@ -95,11 +102,12 @@ def _alphas(alpha_x, alpha_y) -> tuple:
 class _Vector:
     """Marks a ``(..., 3)`` argument for :func:`_run`."""
 
-    def __init__(self, array: np.ndarray):
+    def __init__(self, array: Float64Array) -> None:
         self.array = array
 
 
-def _run(core_function, *args, returns_vector: bool = False, **arguments):
+def _run(core_function: Callable[..., Float64Array], *args: bool, returns_vector: bool = False,
+         **arguments: Float64Array | _Vector) -> Float64Array:
     """Broadcasts ``arguments`` (numpy arrays or :class:`_Vector`), packs them as rows
     (one shared row when an argument has a single element) and calls the binding."""
     leading = {
@@ -130,7 +138,8 @@ def _run(core_function, *args, returns_vector: bool = False, **arguments):
 # GTR (Burley 2012 appendix B)
 
 
-def gtr_d(cos_theta_h, alpha, gamma, *, closed_forms: bool = True) -> np.ndarray:
+def gtr_d(cos_theta_h: RealArrayLike, alpha: RealArrayLike, gamma: RealArrayLike, *,
+          closed_forms: bool = True) -> Float64Array:
     """Generalized-Trowbridge-Reitz distribution D(θh), appendix B eq. (1)::
 
         D = (γ-1)(α²-1) / (π (1 - (α²)^(1-γ))) / (1 + (α²-1) cos²θh)^γ
@@ -147,7 +156,8 @@ def gtr_d(cos_theta_h, alpha, gamma, *, closed_forms: bool = True) -> np.ndarray
     return _run(_core_mf.gtr_d, bool(closed_forms), cos_theta_h=c, alpha=a, gamma=g)
 
 
-def gtr_pdf(h, alpha, gamma, *, closed_forms: bool = True) -> np.ndarray:
+def gtr_pdf(h: RealArrayLike, alpha: RealArrayLike, gamma: RealArrayLike, *,
+            closed_forms: bool = True) -> Float64Array:
     """Density in solid angle of the half vectors drawn by :func:`gtr_sample`: ``D(h) (h·n)``.
 
     ``cos²θh`` and ``sin²θh`` are taken from the components of ``h``, so narrow
@@ -159,7 +169,8 @@ def gtr_pdf(h, alpha, gamma, *, closed_forms: bool = True) -> np.ndarray:
     return _run(_core_mf.gtr_pdf, bool(closed_forms), h=_Vector(hv), alpha=a, gamma=g)
 
 
-def gtr_sample(u1, u2, alpha, gamma, *, closed_forms: bool = True) -> np.ndarray:
+def gtr_sample(u1: RealArrayLike, u2: RealArrayLike, alpha: RealArrayLike, gamma: RealArrayLike, *,
+               closed_forms: bool = True) -> Float64Array:
     """Half vectors ``(..., 3)`` with density :func:`gtr_pdf`, appendix B eq. (2)-(3)::
 
         φ = 2π u1,  cos θh = sqrt((1 - [(α²)^(1-γ)(1-u2) + u2]^(1/(1-γ))) / (1 - α²))
@@ -178,7 +189,7 @@ def gtr_sample(u1, u2, alpha, gamma, *, closed_forms: bool = True) -> np.ndarray
 # anisotropic GGX and Smith masking
 
 
-def ggx_d(h, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_d(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Anisotropic GGX (GTR2), appendix B eq. (13)::
 
         D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²),  0 for h·n <= 0.
@@ -188,14 +199,15 @@ def ggx_d(h, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.ggx_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
 
 
-def ggx_pdf(h, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_pdf(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Density in solid angle of :func:`ggx_sample`: ``D(h) (h·n)``."""
     hv = _validate.directions("h", h)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
 
 
-def ggx_sample(u1, u2, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
+               alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Half vectors ``(..., 3)`` by the projected half vector, eq. (14)-(15)::
 
         h' = sqrt(u2/(1-u2)) (αx cos 2πu1 x + αy sin 2πu1 y) + n,   h = h'/|h'|
@@ -208,7 +220,8 @@ def ggx_sample(u1, u2, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.ggx_sample, returns_vector=True, u1=v1, u2=v2, alpha_x=ax, alpha_y=ay)
 
 
-def ggx_sample_visible(wo, u1, u2, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_sample_visible(wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
+                       alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Visible normals seen from ``wo`` (Heitz 2018), ``(..., 3)``, density :func:`ggx_pdf_visible`.
 
     ``wo`` is stretched to the α = 1 configuration, a point is drawn on the
@@ -223,7 +236,8 @@ def ggx_sample_visible(wo, u1, u2, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.ggx_sample_visible, returns_vector=True, wo=_Vector(w), u1=v1, u2=v2, alpha_x=ax, alpha_y=ay)
 
 
-def ggx_pdf_visible(h, wo, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
+                    alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Density of visible normals in solid angle::
 
         D_wo(h) = G1(wo) max(0, wo·h) D(h) / |wo·n|
@@ -237,7 +251,7 @@ def ggx_pdf_visible(h, wo, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.ggx_pdf_visible, h=_Vector(hv), wo=_Vector(w), alpha_x=ax, alpha_y=ay)
 
 
-def ggx_lambda(w, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Smith Λ for anisotropic GGX::
 
         Λ(w) = (-1 + sqrt(1 + (αx² wx² + αy² wy²) / wz²)) / 2
@@ -250,14 +264,15 @@ def ggx_lambda(w, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.ggx_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
 
 
-def ggx_g1(w, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_g1(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Smith masking ``G1 = 1 / (1 + Λ(w)) = 2|wz| / (|wz| + sqrt(wz² + αx² wx² + αy² wy²))``."""
     wv = _validate.directions("w", w)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.ggx_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
 
 
-def ggx_g2_separable(wi, wo, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_g2_separable(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
+                     alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Separable masking-shadowing ``G2 = G1(wi) G1(wo)`` (what the model uses)."""
     a = _validate.directions("wi", wi)
     b = _validate.directions("wo", wo)
@@ -265,7 +280,8 @@ def ggx_g2_separable(wi, wo, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.ggx_g2_separable, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay)
 
 
-def ggx_g2_height_correlated(wi, wo, alpha_x, alpha_y=None) -> np.ndarray:
+def ggx_g2_height_correlated(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
+                             alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Height-correlated masking-shadowing ``G2 = 1 / (1 + Λ(wi) + Λ(wo))``.
 
     Evaluated as ``2|zi||zo| / (|zi| ro + |zo| ri)``, ``r = sqrt(z² + αx² x² + αy² y²)``;
@@ -281,7 +297,7 @@ def ggx_g2_height_correlated(wi, wo, alpha_x, alpha_y=None) -> np.ndarray:
 # anisotropic Beckmann (Walter et al. 2007)
 
 
-def beckmann_d(h, alpha_x, alpha_y=None) -> np.ndarray:
+def beckmann_d(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Anisotropic Beckmann (Walter et al. 2007), stretched as in Heitz 2014::
 
         D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴),  0 for h·n <= 0.
@@ -291,14 +307,15 @@ def beckmann_d(h, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.beckmann_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
 
 
-def beckmann_pdf(h, alpha_x, alpha_y=None) -> np.ndarray:
+def beckmann_pdf(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Density in solid angle of :func:`beckmann_sample`: ``D(h) (h·n)``."""
     hv = _validate.directions("h", h)
     ax, ay = _alphas(alpha_x, alpha_y)
     return _run(_core_mf.beckmann_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
 
 
-def beckmann_sample(u1, u2, alpha_x, alpha_y=None) -> np.ndarray:
+def beckmann_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
+                    alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Half vectors ``(..., 3)`` with density :func:`beckmann_pdf`::
 
         h ∝ sqrt(-ln(1 - u2)) (αx cos 2πu1 x + αy sin 2πu1 y) + n
@@ -311,7 +328,7 @@ def beckmann_sample(u1, u2, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.beckmann_sample, returns_vector=True, u1=v1, u2=v2, alpha_x=ax, alpha_y=ay)
 
 
-def beckmann_lambda(w, alpha_x, alpha_y=None) -> np.ndarray:
+def beckmann_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Smith Λ for Beckmann (Heitz 2014), exact (not Walter's rational fit)::
 
         Λ = (erf(a) - 1) / 2 + exp(-a²) / (2 a sqrt(π)),   a = |wz| / sqrt(αx² wx² + αy² wy²)
@@ -323,7 +340,7 @@ def beckmann_lambda(w, alpha_x, alpha_y=None) -> np.ndarray:
     return _run(_core_mf.beckmann_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
 
 
-def beckmann_g1(w, alpha_x, alpha_y=None) -> np.ndarray:
+def beckmann_g1(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Smith masking for Beckmann, ``G1 = 1 / (1 + Λ(w))``."""
     wv = _validate.directions("w", w)
     ax, ay = _alphas(alpha_x, alpha_y)

@@ -7,11 +7,16 @@
 
 from __future__ import annotations
 
+import typing
+
 from .material import Material
+
+if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
+    from typing import Any
 
 __all__ = ["get", "names", "parameters"]
 
-_PRESETS = {
+_PRESETS: dict[str, dict[str, float | tuple[float, float, float]]] = {
     # Metals: base_color is the specular colour at normal incidence.
     "gold": dict(base_color=(1.0, 0.766, 0.336), metallic=1.0, roughness=0.3),
     "copper": dict(base_color=(0.955, 0.638, 0.538), metallic=1.0, roughness=0.35),
@@ -28,13 +33,14 @@ _PRESETS = {
 }
 
 
-def names() -> list:
+def names() -> list[str]:
     """The preset names, sorted."""
     return sorted(_PRESETS)
 
 
-def parameters(name: str) -> dict:
-    """The parameters of preset ``name`` (the rest take their defaults)."""
+def parameters(name: str) -> dict[str, Any]:
+    """The parameters of preset ``name`` (the rest take their defaults): numbers, and
+    ``base_color`` a triple (typed ``Any`` so that ``pb.Material(**parameters(name))`` checks)."""
     if name not in _PRESETS:
         raise ValueError(f"name: unknown preset {name!r}; choose one of {', '.join(names())}")
     return dict(_PRESETS[name])

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import typing
+
 import numpy as np
 
 from . import _core
@@ -11,20 +13,29 @@ from ._gradient import Gradient
 from ._batch import Lobes, Sample
 from .material import Material
 
+if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
+    from collections.abc import Callable
+
+    from numpy.typing import NDArray
+
+    from ._typing import Float64Array, Layout, Model, RealArrayLike, SpecularSampler
+
+    _Scalar = typing.TypeVar("_Scalar", bound=np.generic)
+
 __all__ = ["eval", "eval_lobes", "eval_grad", "Lobes", "Gradient", "sample", "pdf", "lobe_probabilities", "Sample"]
 
 
 _LAYOUTS = ("aos", "soa")
 
 
-def _layout(layout) -> bool:
+def _layout(layout: Layout) -> bool:
     """True for "soa" ((3, ...) arrays, as the SIMD calls take them), False for "aos"."""
     if layout not in _LAYOUTS:
         raise ValueError(f"layout: expected 'aos' or 'soa', got {layout!r}")
     return layout == "soa"
 
 
-def _as_aos(name: str, value, soa: bool):
+def _as_aos(name: str, value: RealArrayLike, soa: bool) -> RealArrayLike:
     """A 3-vector argument with its components last: ``(3, ...)`` moved for layout="soa"."""
     if not soa:
         return value
@@ -34,21 +45,23 @@ def _as_aos(name: str, value, soa: bool):
     return np.moveaxis(array, 0, -1)
 
 
-def _as_layout(array: np.ndarray, soa: bool, trailing: int = 1) -> np.ndarray:
+def _as_layout(array: NDArray[_Scalar], soa: bool, trailing: int = 1) -> NDArray[_Scalar]:
     """A result with its ``trailing`` last axes moved to the front for layout="soa"."""
     if not soa:
         return array
     return np.ascontiguousarray(np.moveaxis(array, tuple(range(-trailing, 0)), tuple(range(trailing))))
 
 
-def _prepare(material, wi, wo, model):
+def _prepare(material: Material, wi: RealArrayLike, wo: RealArrayLike,
+             model: Model) -> tuple[tuple[int, ...], Float64Array, Float64Array, Float64Array, int]:
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
     model_id = _validate.model_index(model)
     wi = _validate.directions("wi", wi)
     wo = _validate.directions("wo", wo)
     shape = _validate.broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
-    rows = lambda w: np.ascontiguousarray(np.broadcast_to(w, shape + (3,)).reshape(-1, 3))  # noqa: E731
+    rows: Callable[[Float64Array], Float64Array] = (  # noqa: E731
+        lambda w: np.ascontiguousarray(np.broadcast_to(w, shape + (3,)).reshape(-1, 3)))
     return shape, rows(wi), rows(wo), _material_rows(material, shape), model_id
 
 
@@ -56,8 +69,8 @@ def _prepare(material, wi, wo, model):
 # cosine, layout, specular_sampler); threads, out, check and isa do not: the
 # reference is one float64 loop, and always checks its directions.
 
-def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False,
-         layout: str = "aos") -> np.ndarray:
+def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
+         cosine: bool = False, layout: Layout = "aos") -> Float64Array:
     """f(wi, wo) in 1/sr as float64 ``(..., 3)`` (``(3, ...)`` for ``layout="soa"``); times cos θl if ``cosine``."""
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
@@ -68,8 +81,9 @@ def eval(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool 
     return _as_layout(f.reshape(shape + (3,)), soa)
 
 
-def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014", cosine: bool = False,
-              layout: str = "aos") -> Gradient:
+def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
+              wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014",
+              cosine: bool = False, layout: Layout = "aos") -> Gradient:
     """f in float64 and its Jacobian in the material's parameters (README "Gradients"):
     ``value`` ``(..., 3)`` as :func:`eval`, ``jacobian`` ``(..., 3, P)`` with
     ``jacobian[..., c, k] = ∂f_c/∂names[k]``, ``names`` the P parameters ``wrt``
@@ -89,8 +103,8 @@ def eval_grad(material: Material, wi, wo, *, wrt=None, model: str = "disney2014"
     return Gradient(_as_layout(result.value, soa), _as_layout(result.jacobian, soa, trailing=2), result.names)
 
 
-def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine: bool = False,
-               layout: str = "aos") -> Lobes:
+def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
+               cosine: bool = False, layout: Layout = "aos") -> Lobes:
     """The four lobes as a :class:`Lobes` of float64 ``(..., 3)`` (``(3, ...)``) arrays."""
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
@@ -105,7 +119,7 @@ def eval_lobes(material: Material, wi, wo, *, model: str = "disney2014", cosine:
 # sampling (README "Sampling and pdf")
 
 
-def _uniforms(name: str, value) -> np.ndarray:
+def _uniforms(name: str, value: RealArrayLike) -> Float64Array:
     """A float64 ``(..., 3)`` array of numbers in [0, 1], checked (README "Bad input")."""
     array = _validate.as_real_array(name, value)
     if array.ndim == 0 or array.shape[-1] != 3:
@@ -114,18 +128,18 @@ def _uniforms(name: str, value) -> np.ndarray:
     return array
 
 
-def _shared_or_rows(array: np.ndarray, shape: tuple, columns: int) -> np.ndarray:
+def _shared_or_rows(array: Float64Array, shape: tuple[int, ...], columns: int) -> Float64Array:
     """``(1, columns)`` when the argument is one row for every element, else ``(N, columns)`` rows."""
     if array.size == columns:
         return np.ascontiguousarray(array.reshape(1, columns))
     return np.ascontiguousarray(np.broadcast_to(array, shape + (columns,)).reshape(-1, columns))
 
 
-def _material_rows(material: Material, shape: tuple) -> np.ndarray:
+def _material_rows(material: Material, shape: tuple[int, ...]) -> Float64Array:
     return material.packed(()) if material.is_uniform else material.packed(shape)
 
 
-def _to_shape(rows: np.ndarray, shape: tuple, trailing: tuple = ()) -> np.ndarray:
+def _to_shape(rows: NDArray[_Scalar], shape: tuple[int, ...], trailing: tuple[int, ...] = ()) -> NDArray[_Scalar]:
     """The binding's output rows as ``shape + trailing``; a single row (every input was
     one shared row) is repeated."""
     n = int(np.prod(shape, dtype=np.int64))
@@ -134,13 +148,13 @@ def _to_shape(rows: np.ndarray, shape: tuple, trailing: tuple = ()) -> np.ndarra
     return rows.reshape(shape + trailing)
 
 
-def _check_material(material) -> None:
+def _check_material(material: object) -> None:
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
 
 
-def sample(material: Material, wo, u, *, model: str = "disney2014", specular_sampler: str = "visible",
-           layout: str = "aos") -> Sample:
+def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Model = "disney2014",
+           specular_sampler: SpecularSampler = "visible", layout: Layout = "aos") -> Sample:
     """Draws ``wi`` for each ``wo`` from the three-lobe mixture of README "Sampling and pdf".
 
     ``u`` holds three uniforms in [0, 1] per element, ``(u0, u1, u2)`` on the last
@@ -168,8 +182,8 @@ def sample(material: Material, wo, u, *, model: str = "disney2014", specular_sam
                   _as_layout(_to_shape(weight, shape, (3,)), soa), _to_shape(lobe, shape))
 
 
-def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampler: str = "visible",
-        layout: str = "aos") -> np.ndarray:
+def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
+        specular_sampler: SpecularSampler = "visible", layout: Layout = "aos") -> Float64Array:
     """The mixture density ``P0 pdf0 + P1 pdf1 + P2 pdf2`` of ``wi`` given ``wo``, float64 ``(...)``.
 
     0 unless both directions lie strictly above the horizon. It does not depend on
@@ -189,7 +203,7 @@ def pdf(material: Material, wi, wo, *, model: str = "disney2014", specular_sampl
     return _to_shape(density, shape)
 
 
-def lobe_probabilities(material: Material, wo) -> np.ndarray:
+def lobe_probabilities(material: Material, wo: RealArrayLike) -> Float64Array:
     """``(P0, P1, P2)`` on the last axis, ``(..., 3)``: the chances of the cosine, primary
     specular and clearcoat lobes at ``wo`` (README "Lobe probabilities")."""
     _check_material(material)
