@@ -1,0 +1,206 @@
+"""principled_brdf native core (use the principled_brdf package, not this module).
+
+Stubs for the pybind11 extension (cpp/bindings/*.cpp). The functions take
+packed arguments the Python side has already checked: directions as float32
+(N, 3), (3, N) or (3,) arrays with a layout code (0 (N, 3), 1 (3, N), 2 one
+(3,) vector for every element), ``model`` an index into MODEL_NAMES,
+``sampler`` one into SAMPLER_NAMES, ``isa`` "" (the CPU's choice) or one of
+``cpu_info()["available"]``. The batch functions write into the float32
+arrays they are given and return -1, or the index of an element whose
+direction failed the check. tests/test_typing.py keeps these in step with the
+module's own signatures.
+"""
+
+from collections.abc import Sequence
+from types import ModuleType
+from typing import Annotated, Final, SupportsFloat, SupportsIndex, SupportsInt, TypedDict, type_check_only
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from typing_extensions import TypeAlias
+
+_Int: TypeAlias = SupportsInt | SupportsIndex
+_Float: TypeAlias = SupportsFloat | SupportsIndex
+# An input the binding converts to a C-contiguous array of that dtype (a copy if needed).
+_Float32In: TypeAlias = Annotated[ArrayLike, np.float32]
+_Float64In: TypeAlias = Annotated[ArrayLike, np.float64]
+# An output: written in place, so it must already be a C-contiguous array of that dtype.
+_Float32Out: TypeAlias = NDArray[np.float32]
+# One entry per parameter of PARAMETER_TABLE, in its order: a number (base_color:
+# three numbers) when uniform, else a float32 array of N values ((N, 3) for base_color).
+_Params: TypeAlias = Sequence[float | Sequence[float] | NDArray[np.float32]]
+
+# (name, first slot, slots, defaults, lower bound, upper bound) per parameter
+PARAMETER_TABLE: Final[list[tuple[str, int, int, tuple[float, ...], float, float]]]
+PARAM_SLOTS: Final[int]
+MODEL_NAMES: Final[tuple[str, ...]]
+LOBE_NAMES: Final[tuple[str, ...]]
+SAMPLED_LOBE_NAMES: Final[tuple[str, ...]]
+SAMPLER_NAMES: Final[tuple[str, ...]]
+
+@type_check_only
+class _CpuInfo(TypedDict):
+    isa: str
+    float_lanes: int
+    available: list[str]
+    threads: int
+
+def reference_eval(wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, lobes: bool) -> NDArray[np.float64]:
+    """Float64 reference f (N,3) or lobes (N,4,3) for packed, already validated rows."""
+
+def reference_eval_grad(
+    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Float64 reference f (N,3) and its Jacobian (N,3,13) over the parameter slots, for packed validated rows."""
+
+def reference_sample(
+    wo: _Float64In, u: _Float64In, params: _Float64In, model: _Int, sampler: _Int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32]]:
+    """Float64 reference samples (wi (N,3), pdf (N,), weight (N,3), lobe (N,) int32) for validated rows;
+    each input is N rows or one shared row."""
+
+def reference_pdf(wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, sampler: _Int) -> NDArray[np.float64]:
+    """Float64 reference mixture pdf (N,) for validated rows (N or one shared row each)."""
+
+def reference_lobe_probabilities(wo: _Float64In, params: _Float64In) -> NDArray[np.float64]:
+    """Lobe probabilities (N,3) at wo for validated rows (N or one shared row each)."""
+
+def batch_eval(
+    wi: _Float32In,
+    wi_layout: _Int,
+    wo: _Float32In,
+    wo_layout: _Int,
+    params: _Params,
+    outputs: Sequence[_Float32Out],
+    out_layout: _Int,
+    n: _Int,
+    model: _Int,
+    lobes: bool,
+    cosine: bool,
+    check_tolerance: _Float,
+    threads: _Int,
+    isa: str,
+) -> int:
+    """SIMD evaluation into preallocated float32 outputs (validated by the caller)."""
+
+def batch_eval_grad(
+    wi: _Float32In,
+    wi_layout: _Int,
+    wo: _Float32In,
+    wo_layout: _Int,
+    params: _Params,
+    out: _Float32Out,
+    jacobian: _Float32Out,
+    out_layout: _Int,
+    n: _Int,
+    model: _Int,
+    cosine: bool,
+    check_tolerance: _Float,
+    threads: _Int,
+    isa: str,
+) -> int:
+    """SIMD f and its Jacobian over the parameter slots into preallocated float32 outputs."""
+
+def batch_pdf(
+    wi: _Float32In,
+    wi_layout: _Int,
+    wo: _Float32In,
+    wo_layout: _Int,
+    params: _Params,
+    pdf: _Float32Out,
+    n: _Int,
+    sampler: _Int,
+    check_tolerance: _Float,
+    threads: _Int,
+    isa: str,
+    out: _Float32Out | None = None,
+    out_layout: _Int = 0,
+    model: _Int = 0,
+    cosine: bool = False,
+) -> int:
+    """SIMD sampling pdf into a preallocated float32 array (and f into out, in the same pass, if given)."""
+
+def batch_sample(
+    wo: _Float32In,
+    wo_layout: _Int,
+    u: _Float32In | None,
+    u_layout: _Int,
+    seed: _Int,
+    params: _Params,
+    wi: _Float32Out,
+    weight: _Float32Out,
+    out_layout: _Int,
+    pdf: _Float32Out,
+    lobe: NDArray[np.int32],
+    n: _Int,
+    model: _Int,
+    sampler: _Int,
+    check_tolerance: _Float,
+    threads: _Int,
+    isa: str,
+    lobe_weights: Sequence[_Float32Out] | None = None,
+) -> int:
+    """SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given)."""
+
+def counter_uniforms(seed: _Int, first: _Int, n: _Int) -> NDArray[np.float32]:
+    """The counter-based uniforms (n, 3) that sampling uses for elements first .. first + n - 1."""
+
+def direction_length2_bounds(tolerance: _Float) -> tuple[float, float]:
+    """(lowest, highest): a direction passes the check when its float64 squared length lies within."""
+
+def memory_roofline(wi: _Float32In, wo: _Float32In, out: _Float32Out, threads: _Int) -> None:
+    """out = wi + wo over (N, 3) float32 arrays: the bytes eval moves, at memory speed."""
+
+def cpu_info() -> _CpuInfo:
+    """Instruction set in use, the available ones, SIMD width, hardware threads."""
+
+def float_lanes(isa: str) -> int: ...
+
+# The submodule principled_brdf._core.microfacet (an attribute of _core, not an
+# importable module): float64 rows, each argument N rows or one shared row.
+@type_check_only
+class _MicrofacetModule(ModuleType):
+    """Microfacet toolkit (README "Microfacet toolkit") over packed float64 rows."""
+
+    @staticmethod
+    def gtr_d(cos_theta_h: _Float64In, alpha: _Float64In, gamma: _Float64In, closed_forms: bool) -> NDArray[np.float64]: ...
+    @staticmethod
+    def gtr_pdf(h: _Float64In, alpha: _Float64In, gamma: _Float64In, closed_forms: bool) -> NDArray[np.float64]: ...
+    @staticmethod
+    def gtr_sample(
+        u1: _Float64In, u2: _Float64In, alpha: _Float64In, gamma: _Float64In, closed_forms: bool
+    ) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_d(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_pdf(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_lambda(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_g1(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_g2_separable(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_g2_height_correlated(
+        wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In
+    ) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_pdf_visible(h: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_sample(u1: _Float64In, u2: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_sample_visible(
+        wo: _Float64In, u1: _Float64In, u2: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In
+    ) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_d(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_pdf(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_lambda(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_g1(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_sample(u1: _Float64In, u2: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+
+microfacet: Final[_MicrofacetModule]
