@@ -10,11 +10,15 @@ import argparse
 import platform
 import sys
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .material import PARAMETERS, Material
 from .render import MAX_RESOLUTION
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
 
 # Each pair holds about 100 bytes across the benchmarks' arrays: 2**27 pairs is 13 GB.
 MAX_PAIRS = 1 << 27
@@ -23,7 +27,7 @@ MAX_PAIRS = 1 << 27
 class _Progress:
     """Prints what is being done, with the time since the command started."""
 
-    def __init__(self, quiet: bool = False):
+    def __init__(self, quiet: bool = False) -> None:
         self.start = time.perf_counter()
         self.quiet = quiet
 
@@ -43,7 +47,7 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def _at_most(upper: int, what: str):
+def _at_most(upper: int, what: str) -> Callable[[str], int]:
     """A positive integer option of at most ``upper`` (beyond it the job cannot fit in memory)."""
     def parse(text: str) -> int:
         value = _positive_int(text)
@@ -63,7 +67,7 @@ def _exposure(text: str) -> float:
     return value
 
 
-def _vector(text: str) -> tuple:
+def _vector(text: str) -> tuple[float, ...]:
     try:
         values = tuple(float(v) for v in text.split(","))
     except ValueError:
@@ -73,7 +77,7 @@ def _vector(text: str) -> tuple:
     return values
 
 
-def _parameter(text: str) -> tuple:
+def _parameter(text: str) -> tuple[str, float | tuple[float, ...]]:
     name, sep, value = text.partition("=")
     if not sep or name not in PARAMETERS:
         raise argparse.ArgumentTypeError(
@@ -91,7 +95,7 @@ def _parameter(text: str) -> tuple:
     return name, parsed if info.slots == 3 else parsed[0]
 
 
-def _image_path(formats):
+def _image_path(formats: Sequence[str]) -> Callable[[str], str]:
     """An output path whose extension is one of ``formats`` (the error names the extension)."""
     def parse(text: str) -> str:
         import os
@@ -104,13 +108,13 @@ def _image_path(formats):
     return parse
 
 
-def _demo(args, report) -> None:
+def _demo(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     from .demo import run
 
     run(pairs=args.pairs, output=args.output, repeats=args.repeats, report=report)
 
 
-def _render(args, report) -> None:
+def _render(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     from . import presets
     from .render import render_sphere, save_image
 
@@ -125,13 +129,13 @@ def _render(args, report) -> None:
     report(f"wrote {args.output}")
 
 
-def _bench(args, report) -> None:
+def _bench(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     from .benchmark import compare_with_numpy
 
     compare_with_numpy(pairs=args.pairs, repeats=args.repeats, report=report)
 
 
-def _info(args, report) -> None:
+def _info(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     from . import __version__
     from ._batch import cpu_info
 
@@ -194,7 +198,7 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     report = _Progress()

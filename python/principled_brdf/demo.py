@@ -5,6 +5,8 @@ sample against the reference, and write a picture."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from . import _core, presets, reference
@@ -13,12 +15,19 @@ from .benchmark import best_seconds, random_pairs
 from .material import Material
 from .render import render_sphere, to_srgb8, write_png
 
-DEMO_MATERIAL = dict(base_color=(0.9, 0.55, 0.25), metallic=0.3, roughness=0.35, anisotropic=0.4, sheen=0.3,
-                     clearcoat=0.6, clearcoat_gloss=0.8)
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+    from typing import Any
+
+    from ._typing import Float32Array, FloatArray
+
+DEMO_MATERIAL: dict[str, Any] = dict(base_color=(0.9, 0.55, 0.25), metallic=0.3, roughness=0.35, anisotropic=0.4,
+                                     sheen=0.3, clearcoat=0.6, clearcoat_gloss=0.8)
 PICTURE_PRESETS = ("gold", "chrome", "brushed_metal", "car_paint", "blue_rubber", "satin_cloth")
 
 
-def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats: int = 5, report=print) -> dict:
+def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats: int = 5,
+        report: Callable[[str], object] = print) -> dict[str, Any]:
     from . import __version__
 
     info = cpu_info()
@@ -72,13 +81,13 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
     return {"rates": rates, "max_relative_error": error, "output": output}
 
 
-def lit_sphere(material: Material, resolution: int = 160) -> np.ndarray:
+def lit_sphere(material: Material, resolution: int = 160) -> Float32Array:
     """A sphere under render_sphere's key light and default sky (linear RGB), with 256
     sky samples per pixel: no grain where a rough metal reflects the dark ground."""
     return render_sphere(material, resolution, samples=256)
 
 
-def write_picture(output: str, images: list, labels: list, columns: int) -> None:
+def write_picture(output: str, images: Sequence[FloatArray], labels: Sequence[str], columns: int) -> None:
     """The tone-mapped images in a grid, each labelled (with matplotlib; without it, unlabelled)."""
     rows = [np.concatenate(images[k:k + columns], axis=1) for k in range(0, len(images), columns)]
     grid = to_srgb8(np.concatenate(rows, axis=0))
@@ -93,7 +102,9 @@ def write_picture(output: str, images: list, labels: list, columns: int) -> None
     figure = plt.figure(figsize=(grid.shape[1] / 100, (grid.shape[0] + 22 * len(rows)) / 100), dpi=100)
     for index, label in enumerate(labels):
         row, column = divmod(index, columns)
-        axes = figure.add_axes([column / columns, 1 - (row + 1) / len(rows), 1 / columns, 1 / len(rows)])
+        # matplotlib's stub types rect as a tuple only; add_axes takes any sequence of four numbers
+        axes = figure.add_axes(  # type: ignore[call-overload]
+            [column / columns, 1 - (row + 1) / len(rows), 1 / columns, 1 / len(rows)])
         axes.imshow(grid[row * size:(row + 1) * size, column * size:(column + 1) * size], extent=(0, 1, 0, 1))
         axes.set_xlim(0, 1)
         axes.set_ylim(0, 1.14)
