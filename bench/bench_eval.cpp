@@ -87,12 +87,13 @@ int threads_of(const benchmark::State& state) {
     return state.range(1) == 0 ? pb::hardware_threads() : static_cast<int>(state.range(1));
 }
 
-void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_element, bool checked,
-               pb::Output output) {
+void simd_eval_with(benchmark::State& state, const std::string& isa, bool soa, bool per_element, bool checked,
+                    pb::Output output, bool energy_compensation) {
     Data& d = data_for(state.range(0));
     pb::EvalJob job = make_job(d, soa, per_element);
     if (checked) job.check = pb::direction_check(1e-3);  // what pb.eval does by default
     job.output = output;  // f; with the pdf (pb.eval_pdf); with the Jacobian (pb.eval_grad)
+    job.energy_compensation = energy_compensation;  // the multiple-scattering lobe (pb.eval(..., energy_compensation=True))
     std::vector<float> pdf(output == pb::Output::kValuePdf ? d.n : 0);
     job.pdf = pdf.data();
     job.jacobian = d.jacobian.data();
@@ -103,6 +104,15 @@ void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_elem
         benchmark::ClobberMemory();
     }
     state.SetItemsProcessed(state.iterations() * d.n);
+}
+
+void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_element, bool checked, pb::Output output) {
+    simd_eval_with(state, isa, soa, per_element, checked, output, false);
+}
+
+// f with the multiple-scattering energy compensation (pb.eval(..., energy_compensation=True))
+void simd_eval_compensated(benchmark::State& state, std::string isa, bool soa, bool per_element) {
+    simd_eval_with(state, isa, soa, per_element, false, pb::Output::kTotal, true);
 }
 
 // Importance sampling with the counter-based generator: wi, pdf, weight, lobe per element.
@@ -213,6 +223,14 @@ void register_all() {
                                     ->Args({size, threads})
                                     ->UseRealTime()
                                     ->Unit(benchmark::kMicrosecond);
+                        }
+                        if (n == kSizes[0] && threads == 1 && !soa) {  // f with the energy compensation, beside eval
+                            const std::string compensated_name = "eval_compensated/" + isa + "/aos" +
+                                                                 (per_element ? "/per_element" : "/uniform");
+                            benchmark::RegisterBenchmark(compensated_name.c_str(), simd_eval_compensated, isa, soa, per_element)
+                                ->Args({n, threads})
+                                ->UseRealTime()
+                                ->Unit(benchmark::kMicrosecond);
                         }
                         if (n == kSizes[0] && threads == 1 && !soa) {  // f and the pdf in one pass
                             const std::string value_pdf_name = "eval_pdf/" + isa + "/aos" +

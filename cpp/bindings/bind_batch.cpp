@@ -105,10 +105,12 @@ EvalJob eval_job(const Float32Array& wi, int wi_layout, const Float32Array& wo, 
 // wo is not a unit vector (the outputs then hold the results of some elements only).
 std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                         const py::sequence& params, const py::sequence& outputs, int out_layout, std::int64_t n, int model,
-                        bool lobes, bool cosine, double check_tolerance, int threads, const std::string& isa) {
+                        bool lobes, bool cosine, double check_tolerance, int threads, const std::string& isa,
+                        bool energy_compensation) {
     py::list keep_alive;
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, model, lobes ? Output::kLobes : Output::kTotal, cosine,
                            check_tolerance, keep_alive);
+    job.energy_compensation = energy_compensation;
     std::vector<Float32Array> keep_outputs;
     output_views(outputs, lobes ? kLobeCount : 1, out_layout, n, "out", job.out, keep_outputs);
     if (n == 0) return -1;
@@ -152,11 +154,12 @@ T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const ch
 std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                        const py::sequence& params, Float32Array pdf, std::int64_t n, int sampler,
                        double check_tolerance, int threads, const std::string& isa, const py::object& out,
-                       int out_layout, int model, bool cosine) {
+                       int out_layout, int model, bool cosine, bool energy_compensation) {
     py::list keep_alive;
     const bool with_value = !out.is_none();
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, model, with_value ? Output::kValuePdf : Output::kPdf,
                            cosine, check_tolerance, keep_alive);
+    job.energy_compensation = energy_compensation;
     job.sampler = sampler_from(sampler);
     job.pdf = scalar_output(pdf, n, "pdf");
     Float32Array value;
@@ -174,8 +177,9 @@ std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::objec
                           std::uint64_t seed, const py::sequence& params, Float32Array wi, Float32Array weight,
                           int out_layout, Float32Array pdf, py::array_t<std::int32_t, py::array::c_style> lobe,
                           std::int64_t n, int model, int sampler, double check_tolerance, int threads,
-                          const std::string& isa, const py::object& lobe_weights) {
+                          const std::string& isa, const py::object& lobe_weights, bool energy_compensation) {
     SampleJob job;
+    job.energy_compensation = energy_compensation;
     job.wo = vec3_view(wo, wo_layout, n, "wo");
     Float32Array u_array;
     if (!u.is_none()) {
@@ -243,6 +247,7 @@ void bind_batch(py::module_& m) {
     m.def("batch_eval", &batch_eval, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
           py::arg("params"), py::arg("outputs"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
           py::arg("lobes"), py::arg("cosine"), py::arg("check_tolerance"), py::arg("threads"), py::arg("isa"),
+          py::arg("energy_compensation") = false,
           "SIMD evaluation into preallocated float32 outputs (validated by the caller).");
     m.def("batch_eval_grad", &batch_eval_grad, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
           py::arg("params"), py::arg("out"), py::arg("jacobian"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
@@ -251,12 +256,13 @@ void bind_batch(py::module_& m) {
     m.def("batch_pdf", &batch_pdf, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
           py::arg("params"), py::arg("pdf"), py::arg("n"), py::arg("sampler"), py::arg("check_tolerance"),
           py::arg("threads"), py::arg("isa"), py::arg("out") = py::none(), py::arg("out_layout") = 0,
-          py::arg("model") = 0, py::arg("cosine") = false,
+          py::arg("model") = 0, py::arg("cosine") = false, py::arg("energy_compensation") = false,
           "SIMD sampling pdf into a preallocated float32 array (and f into out, in the same pass, if given).");
     m.def("batch_sample", &batch_sample, py::arg("wo"), py::arg("wo_layout"), py::arg("u"), py::arg("u_layout"),
           py::arg("seed"), py::arg("params"), py::arg("wi"), py::arg("weight"), py::arg("out_layout"), py::arg("pdf"),
           py::arg("lobe"), py::arg("n"), py::arg("model"), py::arg("sampler"), py::arg("check_tolerance"),
           py::arg("threads"), py::arg("isa"), py::arg("lobe_weights") = py::none(),
+          py::arg("energy_compensation") = false,
           "SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given).");
     m.def("counter_uniforms", &uniforms, py::arg("seed"), py::arg("first"), py::arg("n"),
           "The counter-based uniforms (n, 3) that sampling uses for elements first .. first + n - 1.");

@@ -15,6 +15,7 @@
 
 #include "bindings.hpp"
 #include "principled_brdf/microfacet.hpp"
+#include "principled_brdf/microfacet_family.hpp"
 
 namespace py = pybind11;
 
@@ -161,6 +162,90 @@ py::array_t<double> ggx_sample_visible(const Float64Array& wo, const Float64Arra
     });
 }
 
+// ---- the microfacet family (microfacet_family.hpp): each function also takes the shape parameter
+// (Student-t γ, exponential-power p; ignored by Blinn-Phong and Walter's Beckmann)
+
+template <double (*Formula)(const mf::Vec3&, double, double, double)>
+py::array_t<double> direction_alphas_shape(const Float64Array& w, const Float64Array& alpha_x,
+                                           const Float64Array& alpha_y, const Float64Array& shape) {
+    Column wc(w, 3, "w"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y"), sc(shape, 1, "shape");
+    const py::ssize_t n = common_rows({&wc, &ax, &ay, &sc});
+    return scalar_rows(
+        n, [&](py::ssize_t i) { return Formula(wc.unit_vector(i), ax.scalar(i), ay.scalar(i), sc.scalar(i)); });
+}
+
+template <double (*Formula)(const mf::Vec3&, const mf::Vec3&, double, double, double)>
+py::array_t<double> two_directions_alphas_shape(const Float64Array& a, const Float64Array& b,
+                                                const Float64Array& alpha_x, const Float64Array& alpha_y,
+                                                const Float64Array& shape) {
+    Column ac(a, 3, "a"), bc(b, 3, "b"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y"), sc(shape, 1, "shape");
+    const py::ssize_t n = common_rows({&ac, &bc, &ax, &ay, &sc});
+    return scalar_rows(n, [&](py::ssize_t i) {
+        return Formula(ac.unit_vector(i), bc.unit_vector(i), ax.scalar(i), ay.scalar(i), sc.scalar(i));
+    });
+}
+
+template <mf::Vec3 (*Sampler)(double, double, double, double, double)>
+py::array_t<double> sample_alphas_shape(const Float64Array& u1, const Float64Array& u2, const Float64Array& alpha_x,
+                                        const Float64Array& alpha_y, const Float64Array& shape) {
+    Column c1(u1, 1, "u1"), c2(u2, 1, "u2"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y"),
+        sc(shape, 1, "shape");
+    const py::ssize_t n = common_rows({&c1, &c2, &ax, &ay, &sc});
+    return vector_rows(n, [&](py::ssize_t i) {
+        return Sampler(c1.scalar(i), c2.scalar(i), ax.scalar(i), ay.scalar(i), sc.scalar(i));
+    });
+}
+
+py::array_t<double> ggx_g2_over_4cos(const Float64Array& wi, const Float64Array& wo, const Float64Array& alpha_x,
+                                     const Float64Array& alpha_y, int form) {
+    if (form < 0 || form > 2) throw std::invalid_argument("form: expected 0 (exact), 1 (karis) or 2 (hammon)");
+    Column ic(wi, 3, "wi"), oc(wo, 3, "wo"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y");
+    const py::ssize_t n = common_rows({&ic, &oc, &ax, &ay});
+    return scalar_rows(n, [&](py::ssize_t i) {
+        return mf::ggx_g2_over_4cos(ic.unit_vector(i), oc.unit_vector(i), ax.scalar(i), ay.scalar(i),
+                                    static_cast<mf::GgxVisibility>(form));
+    });
+}
+
+py::array_t<double> beckmann_sample_visible(const Float64Array& wo, const Float64Array& u1, const Float64Array& u2,
+                                            const Float64Array& alpha_x, const Float64Array& alpha_y) {
+    Column w(wo, 3, "wo"), c1(u1, 1, "u1"), c2(u2, 1, "u2"), ax(alpha_x, 1, "alpha_x"), ay(alpha_y, 1, "alpha_y");
+    const py::ssize_t n = common_rows({&w, &c1, &c2, &ax, &ay});
+    return vector_rows(n, [&](py::ssize_t i) {
+        return mf::beckmann_sample_visible_h(w.unit_vector(i), c1.scalar(i), c2.scalar(i), ax.scalar(i), ay.scalar(i));
+    });
+}
+
+py::array_t<double> hyp2f1(const Float64Array& a, const Float64Array& b, const Float64Array& c,
+                           const Float64Array& z) {
+    Column ac(a, 1, "a"), bc(b, 1, "b"), cc(c, 1, "c"), zc(z, 1, "z");
+    const py::ssize_t n = common_rows({&ac, &bc, &cc, &zc});
+    return scalar_rows(n, [&](py::ssize_t i) {
+        return principled_brdf::special::hypergeometric_2f1(ac.scalar(i), bc.scalar(i), cc.scalar(i), zc.scalar(i));
+    });
+}
+
+// the eight functions of one family member, as <prefix>_d, _pdf, _lambda, _g1, _g2_separable,
+// _g2_height_correlated, _pdf_visible, _sample (all with the trailing shape argument)
+template <class Distribution>
+void def_family(py::module_& sub, const std::string& prefix, bool with_sampler = true) {
+    const auto h = py::arg("h"), w = py::arg("w"), wi = py::arg("wi"), wo = py::arg("wo"), ax = py::arg("alpha_x"),
+               ay = py::arg("alpha_y"), shape = py::arg("shape");
+    sub.def((prefix + "_d").c_str(), &direction_alphas_shape<mf::family_d<Distribution>>, h, ax, ay, shape);
+    sub.def((prefix + "_pdf").c_str(), &direction_alphas_shape<mf::family_pdf<Distribution>>, h, ax, ay, shape);
+    sub.def((prefix + "_lambda").c_str(), &direction_alphas_shape<mf::family_lambda<Distribution>>, w, ax, ay, shape);
+    sub.def((prefix + "_g1").c_str(), &direction_alphas_shape<mf::family_g1<Distribution>>, w, ax, ay, shape);
+    sub.def((prefix + "_g2_separable").c_str(), &two_directions_alphas_shape<mf::family_g2_separable<Distribution>>,
+            wi, wo, ax, ay, shape);
+    sub.def((prefix + "_g2_height_correlated").c_str(),
+            &two_directions_alphas_shape<mf::family_g2_height_correlated<Distribution>>, wi, wo, ax, ay, shape);
+    sub.def((prefix + "_pdf_visible").c_str(), &two_directions_alphas_shape<mf::family_pdf_visible<Distribution>>, h,
+            wo, ax, ay, shape);
+    if (with_sampler)
+        sub.def((prefix + "_sample").c_str(), &sample_alphas_shape<mf::family_sample<Distribution>>, py::arg("u1"),
+                py::arg("u2"), ax, ay, shape);
+}
+
 }  // namespace
 
 void bind_microfacet(py::module_& m) {
@@ -194,6 +279,21 @@ void bind_microfacet(py::module_& m) {
     sub.def("beckmann_g1", &direction_alphas<mf::beckmann_g1>, py::arg("w"), py::arg("alpha_x"), py::arg("alpha_y"));
     sub.def("beckmann_sample", &sample_alphas<mf::beckmann_sample_h>, py::arg("u1"), py::arg("u2"), py::arg("alpha_x"),
             py::arg("alpha_y"));
+    def_family<principled_brdf::f64::StudentT<double>>(sub, "student_t");
+    def_family<principled_brdf::f64::ExponentialPower<double>>(sub, "exponential_power");
+    def_family<principled_brdf::f64::BlinnPhong<double>>(sub, "blinn_phong");
+    def_family<mf::BeckmannWalter>(sub, "beckmann_walter", false);
+    sub.def("beckmann_g2_separable", &two_directions_alphas<mf::beckmann_g2_separable>, py::arg("wi"), py::arg("wo"),
+            py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("beckmann_g2_height_correlated", &two_directions_alphas<mf::beckmann_g2_height_correlated>, py::arg("wi"),
+            py::arg("wo"), py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("beckmann_pdf_visible", &two_directions_alphas<mf::beckmann_pdf_visible_h>, py::arg("h"), py::arg("wo"),
+            py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("ggx_g2_over_4cos", &ggx_g2_over_4cos, py::arg("wi"), py::arg("wo"), py::arg("alpha_x"),
+            py::arg("alpha_y"), py::arg("form"));
+    sub.def("beckmann_sample_visible", &beckmann_sample_visible, py::arg("wo"), py::arg("u1"), py::arg("u2"),
+            py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("hyp2f1", &hyp2f1, py::arg("a"), py::arg("b"), py::arg("c"), py::arg("z"));
 }
 
 }  // namespace principled_brdf::bindings

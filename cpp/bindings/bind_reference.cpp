@@ -73,9 +73,21 @@ Rows shared_or_rows(const Float64Array& a, py::ssize_t n, py::ssize_t columns, c
     return {a.data(), a.shape(0) == 1 ? 0 : columns};
 }
 
-// f or the four lobes for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
+// Calls f with a row cache of Compensated materials for the model's tables.
+template <class Function>
+void each_compensated(Model model, Function&& f) {
+    if (model == Model::kDisney2012) {
+        reference::CompensatedCache<Model::kDisney2012> cache;
+        f(cache);
+    } else {
+        reference::CompensatedCache<Model::kDisney2014> cache;
+        f(cache);
+    }
+}
+
+// f or the lobes for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
 py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
-                                   int model, bool lobes) {
+                                   int model, bool lobes, bool energy_compensation) {
     const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
     require_rows(wi, n, 3, "wi");
     require_rows(wo, n, 3, "wo");
@@ -91,19 +103,36 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
     double* out_data = out.mutable_data();
     {
         py::gil_scoped_release release;
-        reference::ShadingCache shading;
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const auto& material = shading.of(material_rows.row(i));
-            const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
-            if (lobes) {
-                const auto result = reference::eval_lobes(material, in, view, which_model);
-                double* row = out_data + 3 * kLobeCount * i;
-                Eigen::Map<Eigen::Vector3d>(row + 0) = result.diffuse;
-                Eigen::Map<Eigen::Vector3d>(row + 3) = result.sheen;
-                Eigen::Map<Eigen::Vector3d>(row + 6) = result.specular;
-                Eigen::Map<Eigen::Vector3d>(row + 9) = result.clearcoat;
-            } else {
-                Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, which_model);
+        auto store = [&](py::ssize_t i, const reference::Lobes& result) {
+            double* row = out_data + 3 * kLobeCount * i;
+            Eigen::Map<Eigen::Vector3d>(row + 0) = result.diffuse;
+            Eigen::Map<Eigen::Vector3d>(row + 3) = result.sheen;
+            Eigen::Map<Eigen::Vector3d>(row + 6) = result.specular;
+            Eigen::Map<Eigen::Vector3d>(row + 9) = result.clearcoat;
+            Eigen::Map<Eigen::Vector3d>(row + 12) = result.multiple_scattering;
+        };
+        if (energy_compensation) {
+            each_compensated(which_model, [&](auto& cache) {
+                for (py::ssize_t i = 0; i < n; ++i) {
+                    const auto& material = cache.of(material_rows.row(i));
+                    const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+                    if (lobes) {
+                        store(i, reference::eval_lobes(material, in, view, which_model));
+                    } else {
+                        Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, which_model);
+                    }
+                }
+            });
+        } else {
+            reference::ShadingCache shading;
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const auto& material = shading.of(material_rows.row(i));
+                const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+                if (lobes) {
+                    store(i, reference::eval_lobes(material, in, view, which_model));
+                } else {
+                    Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, which_model);
+                }
             }
         }
     }
@@ -137,7 +166,7 @@ py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, co
 
 // README "Sampling and pdf": wo (N,3), u (N,3) = (u0, u1, u2), params (N,13); each may be one shared row.
 py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const Float64Array& params, int model,
-                           int sampler) {
+                           int sampler, bool energy_compensation) {
     const py::ssize_t n = common_row_count({&wo, &u, &params});
     const Rows view = shared_or_rows(wo, n, 3, "wo");
     const Rows uniforms = shared_or_rows(u, n, 3, "u");
@@ -153,16 +182,23 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
     std::int32_t* lobe_data = lobe_out.mutable_data();
     {
         py::gil_scoped_release release;
-        reference::ShadingCache shading;
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const auto& material = shading.of(material_rows.row(i));
-            const double* ui = uniforms.row(i);
-            const auto s =
-                reference::sample(material, Eigen::Vector3d(view.row(i)), ui[0], ui[1], ui[2], which_model, which_sampler);
-            Eigen::Map<Eigen::Vector3d>(wi_data + 3 * i) = s.wi;
-            pdf_data[i] = s.pdf;
-            Eigen::Map<Eigen::Vector3d>(weight_data + 3 * i) = s.weight;
-            lobe_data[i] = s.lobe;
+        auto run = [&](auto& cache) {
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const auto& material = cache.of(material_rows.row(i));
+                const double* ui = uniforms.row(i);
+                const auto s = reference::sample(material, Eigen::Vector3d(view.row(i)), ui[0], ui[1], ui[2], which_model,
+                                                 which_sampler);
+                Eigen::Map<Eigen::Vector3d>(wi_data + 3 * i) = s.wi;
+                pdf_data[i] = s.pdf;
+                Eigen::Map<Eigen::Vector3d>(weight_data + 3 * i) = s.weight;
+                lobe_data[i] = s.lobe;
+            }
+        };
+        if (energy_compensation) {
+            each_compensated(which_model, run);
+        } else {
+            reference::ShadingCache shading;
+            run(shading);
         }
     }
     return py::make_tuple(wi_out, pdf_out, weight_out, lobe_out);
@@ -170,30 +206,38 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
 
 // The mixture pdf (N,) of wi (N,3) given wo (N,3); model is checked but does not change it.
 py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
-                                  int model, int sampler) {
+                                  int model, int sampler, bool energy_compensation) {
     const py::ssize_t n = common_row_count({&wi, &wo, &params});
     const Rows in = shared_or_rows(wi, n, 3, "wi");
     const Rows view = shared_or_rows(wo, n, 3, "wo");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
-    model_from(model);
+    const Model which_model = model_from(model);  // the pdf depends on it through the compensation's tables only
     const SpecularSampler which_sampler = sampler_from(sampler);
 
     py::array_t<double> out(n);
     double* out_data = out.mutable_data();
     {
         py::gil_scoped_release release;
-        reference::ShadingCache shading;
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const auto& material = shading.of(material_rows.row(i));
-            out_data[i] = reference::pdf(material, Eigen::Vector3d(in.row(i)), Eigen::Vector3d(view.row(i)),
-                                         which_sampler);
+        auto run = [&](auto& cache) {
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const auto& material = cache.of(material_rows.row(i));
+                out_data[i] = reference::pdf(material, Eigen::Vector3d(in.row(i)), Eigen::Vector3d(view.row(i)),
+                                             which_sampler);
+            }
+        };
+        if (energy_compensation) {
+            each_compensated(which_model, run);
+        } else {
+            reference::ShadingCache shading;
+            run(shading);
         }
     }
     return out;
 }
 
 // (P0, P1, P2) (N,3) at wo (N,3).
-py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const Float64Array& params) {
+py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const Float64Array& params, int model,
+                                                 bool energy_compensation) {
     const py::ssize_t n = common_row_count({&wo, &params});
     const Rows view = shared_or_rows(wo, n, 3, "wo");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
@@ -201,11 +245,18 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
     double* out_data = out.mutable_data();
     {
         py::gil_scoped_release release;
-        reference::ShadingCache shading;
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const auto& material = shading.of(material_rows.row(i));
-            const auto p = reference::lobe_probabilities(material, Eigen::Vector3d(view.row(i)));
-            std::copy(p.begin(), p.end(), out_data + 3 * i);
+        auto run = [&](auto& cache) {
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const auto& material = cache.of(material_rows.row(i));
+                const auto p = reference::lobe_probabilities(material, Eigen::Vector3d(view.row(i)));
+                std::copy(p.begin(), p.end(), out_data + 3 * i);
+            }
+        };
+        if (energy_compensation) {
+            each_compensated(model_from(model), run);
+        } else {
+            reference::ShadingCache shading;
+            run(shading);
         }
     }
     return out;
@@ -215,18 +266,18 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
 
 void bind_reference(py::module_& m) {
     m.def("reference_eval", &reference_eval, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
-          py::arg("lobes"),
-          "Float64 reference f (N,3) or lobes (N,4,3) for packed, already validated rows.");
+          py::arg("lobes"), py::arg("energy_compensation") = false,
+          "Float64 reference f (N,3) or lobes (N,5,3) for packed, already validated rows.");
     m.def("reference_eval_grad", &reference_eval_grad, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
           "Float64 reference f (N,3) and its Jacobian (N,3,13) over the parameter slots, for packed validated rows.");
     m.def("reference_sample", &reference_sample, py::arg("wo"), py::arg("u"), py::arg("params"), py::arg("model"),
-          py::arg("sampler"),
+          py::arg("sampler"), py::arg("energy_compensation") = false,
           "Float64 reference samples (wi (N,3), pdf (N,), weight (N,3), lobe (N,) int32) for validated rows;\n"
           "each input is N rows or one shared row.");
     m.def("reference_pdf", &reference_pdf, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
-          py::arg("sampler"), "Float64 reference mixture pdf (N,) for validated rows (N or one shared row each).");
+          py::arg("sampler"), py::arg("energy_compensation") = false, "Float64 reference mixture pdf (N,) for validated rows (N or one shared row each).");
     m.def("reference_lobe_probabilities", &reference_lobe_probabilities, py::arg("wo"), py::arg("params"),
-          "Lobe probabilities (N,3) at wo for validated rows (N or one shared row each).");
+          py::arg("model") = 0, py::arg("energy_compensation") = false, "Lobe probabilities (N,3) at wo for validated rows (N or one shared row each).");
 }
 
 }  // namespace principled_brdf::bindings

@@ -22,6 +22,43 @@ PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
     }
 }
 
+// With the energy compensation (model/energy.hpp): the multiple-scattering
+// lobe's constants as well (its own type, so that the loops without it are
+// the same code as before the option existed).
+template <Output output>
+struct CompensatedPrepared : Prepared<output> {
+    MultipleScatteringLobe<Floats> ms;
+    alignas(64) float row[energy::kCosines];
+
+    // For a uniform material, once per call: the two table rows about r_eff
+    // blended into `row`, so that a lookup fetches two values instead of four.
+    void blend_rows() {
+        alignas(64) std::int32_t offset[kLanes];
+        alignas(64) float fraction[kLanes];
+        ms.row.offset.store_aligned(offset);
+        ms.row.fraction.store_aligned(fraction);
+        const float* below = ms.missing + offset[0];
+        const float* above = below + energy::kCosines;
+        const float t = fraction[0];
+        for (int k = 0; k < energy::kCosines; ++k) row[k] = below[k] * (1.0f - t) + above[k] * t;
+        ms.missing = row;
+        ms.single_row = true;
+    }
+};
+
+template <Output output, bool compensated>
+using PreparedOf = std::conditional_t<compensated, CompensatedPrepared<output>, Prepared<output>>;
+
+template <Model model, Output output, bool compensated>
+PB_KERNEL_INLINE PreparedOf<output, compensated> prepare_for(const RawMaterial& m) {
+    if constexpr (compensated) {
+        const Shading<Floats> s = shading_of(m);
+        return {{s, NoPartials{}}, multiple_scattering_of(m.slot, s, model)};
+    } else {
+        return prepare<output>(m);
+    }
+}
+
 // Where a batch's Jacobian goes, row r = kParamSlots c + p holding ∂f_c/∂p of
 // every lane: straight to memory by rows (the (3, N) layout), or through the
 // stack, transposed to element-major order when the batch is done (finish).
@@ -54,9 +91,46 @@ struct JacobianStore {
     }
 };
 
+// eval_batch with the energy compensation: f_ms joins f (and is its own lobe),
+// its weight w3 the cosine lobe's in the pdf (model/energy.hpp).
 template <Model model, Output output, Layouts layouts>
+PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi,
+                                             const Vec3<Floats>& wo, const CompensatedPrepared<output>& material) {
+    static_assert(output != Output::kGradient, "the energy compensation has no gradient");
+    const Shading<Floats>& s = material.shading;
+    const MultipleScatteringLobe<Floats>& ms = material.ms;
+    const Geometry<Floats> g = geometry_of(wi, wo);
+    const Mask above = above_surface(g);
+    const View<Floats> view = view_of<model>(wo, s);
+    const Floats missing_wo = ms.missing_energy(wo.z);
+    const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+    auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };
+    if constexpr (output == Output::kPdf || output == Output::kValuePdf) {
+        const Shading<Floats> mixture = with_multiple_scattering_weight(s, ms.weight(missing_wo));
+        const Floats pdf = mixture_pdf(g, mixture, view, lobe_weights(view.fv, mixture), job.sampler);
+        select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
+    }
+    if constexpr (output == Output::kPdf) return;
+    const LobeValues<Floats> lobes = eval_lobes<model>(g, s, view);
+    const Rgb<Floats> multiple_scattering = ms.rgb(ms.value(g, missing_wo));
+    if constexpr (output == Output::kLobes) {
+        store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse_rgb(s)));
+        store_rgb<layouts>(job.out[1], i, masked(lobes.sheen_rgb(s)));
+        store_rgb<layouts>(job.out[2], i, masked(lobes.specular_rgb(s)));
+        store_rgb<layouts>(job.out[3], i, masked(lobes.clearcoat_rgb()));
+        store_rgb<layouts>(job.out[4], i, masked(multiple_scattering));
+    } else if constexpr (output != Output::kPdf) {
+        store_rgb<layouts>(job.out[0], i, masked(lobes.total(s) + multiple_scattering));
+    }
+}
+
+template <Model model, Output output, Layouts layouts, bool compensated>
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
-                                 const Prepared<output>& material) {
+                                 const PreparedOf<output, compensated>& material) {
+    if constexpr (compensated) {
+        eval_compensated_batch<model, output, layouts>(job, i, wi, wo, material);
+        return;
+    }
     const Shading<Floats>& s = material.shading;
     const Geometry<Floats> g = geometry_of(wi, wo);
     // select discards whatever the formulas gave below the surface (H may be 0)
@@ -89,6 +163,7 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
             store_rgb<layouts>(job.out[1], i, masked(lobes.sheen_rgb(s)));
             store_rgb<layouts>(job.out[2], i, masked(lobes.specular_rgb(s)));
             store_rgb<layouts>(job.out[3], i, masked(lobes.clearcoat_rgb()));
+            store_rgb<layouts>(job.out[4], i, zero);
         } else {
             store_rgb<layouts>(job.out[0], i, masked(lobes.total(s)));
         }
@@ -97,22 +172,23 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
 
 // One batch at i; false, with nothing stored, when the fast direction test
 // does not accept it.
-template <Model model, Output output, bool per_element, Layouts layouts>
-PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const Prepared<output>& uniform) {
+template <Model model, Output output, bool per_element, Layouts layouts, bool compensated>
+PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const PreparedOf<output, compensated>& uniform) {
     const Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
     const Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled && !all(surely_unit_length(wi, job.check) & surely_unit_length(wo, job.check))) return false;
     if constexpr (per_element) {
-        eval_batch<model, output, layouts>(job, i, wi, wo, prepare<output>(load_material(job.params, i)));
+        eval_batch<model, output, layouts, compensated>(job, i, wi, wo,
+                                                        prepare_for<model, output, compensated>(load_material(job.params, i)));
     } else {
-        eval_batch<model, output, layouts>(job, i, wi, wo, uniform);
+        eval_batch<model, output, layouts, compensated>(job, i, wi, wo, uniform);
     }
     return true;
 }
 
 // The last pad.count < kLanes elements, as one batch.
-template <Model model, Output output, bool per_element>
-bool eval_tail(const EvalJob& job, const Padding& pad, const Prepared<output>& uniform) {
+template <Model model, Output output, bool per_element, bool compensated>
+bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, compensated>& uniform) {
     alignas(64) PadBuffer wi, wo, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
     alignas(64) float jacobian[output == Output::kGradient ? kJacobianWidth * kLanes : 1];
@@ -126,7 +202,7 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const Prepared<output>& u
     padded.jacobian = jacobian;
     padded.jacobian_row_stride = 0;
 
-    if (!eval_one_batch<model, output, per_element, Layouts::kMixed>(padded, 0, uniform)) return false;
+    if (!eval_one_batch<model, output, per_element, Layouts::kMixed, compensated>(padded, 0, uniform)) return false;
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf || output == Output::kValuePdf) unpad_scalars(job.pdf, pad, pdf);
@@ -143,14 +219,17 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const Prepared<output>& u
 
 // -1 with every element of [begin, end) written, or the start of the first
 // batch the fast direction test did not accept (see run_checked).
-template <Model model, Output output, bool per_element, Layouts layouts>
+template <Model model, Output output, bool per_element, Layouts layouts, bool compensated>
 std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    Prepared<output> uniform{};
-    if constexpr (!per_element) uniform = prepare<output>(load_material(job.params, 0));
+    PreparedOf<output, compensated> uniform{};
+    if constexpr (!per_element) {
+        uniform = prepare_for<model, output, compensated>(load_material(job.params, 0));
+        if constexpr (compensated) uniform.blend_rows();
+    }
     std::int64_t i = begin;
     for (; i + kLanes <= end; i += kLanes)
-        if (!eval_one_batch<model, output, per_element, layouts>(job, i, uniform)) return i;
-    if (i < end && !eval_tail<model, output, per_element>(job, Padding{i, end - i}, uniform)) return i;
+        if (!eval_one_batch<model, output, per_element, layouts, compensated>(job, i, uniform)) return i;
+    if (i < end && !eval_tail<model, output, per_element, compensated>(job, Padding{i, end - i}, uniform)) return i;
     return -1;
 }
 
@@ -165,32 +244,52 @@ inline Layouts layouts_of(const EvalJob& job) {
     return Layouts::kMixed;
 }
 
-template <Model model, Output output, bool per_element, Layouts layouts>
+template <Model model, Output output, bool per_element, Layouts layouts, bool compensated>
 std::int64_t eval_checked(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     auto rejected = [&](std::int64_t i) { return !unit_length_at(job.wi, i, job.check) || !unit_length_at(job.wo, i, job.check); };
-    return run_checked(job, begin, end, eval_loop<model, output, per_element, layouts>, rejected);
+    return run_checked(job, begin, end, eval_loop<model, output, per_element, layouts, compensated>, rejected);
 }
 
 // -1 with every element written, or the first element whose wi or wo fails the direction check.
-template <Model model, Output output, bool per_element>
+template <Model model, Output output, bool per_element, bool compensated>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    if constexpr (compensated) {  // (N, 3) arrays, or any layout through the mixed loads and stores
+        return layouts_of(job) == Layouts::kInterleaved
+                       ? eval_checked<model, output, per_element, Layouts::kInterleaved, true>(job, begin, end)
+                       : eval_checked<model, output, per_element, Layouts::kMixed, true>(job, begin, end);
+    }
     switch (layouts_of(job)) {
         case Layouts::kInterleaved:
-            return eval_checked<model, output, per_element, Layouts::kInterleaved>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kInterleaved, compensated>(job, begin, end);
         case Layouts::kRows:
-            return eval_checked<model, output, per_element, Layouts::kRows>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kRows, compensated>(job, begin, end);
         default:
-            return eval_checked<model, output, per_element, Layouts::kMixed>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kMixed, compensated>(job, begin, end);
     }
 }
 
-template <Model model, Output output>
+template <Model model, Output output, bool compensated = false>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    return job.uniform_material() ? eval_range_for<model, output, false>(job, begin, end)
-                                  : eval_range_for<model, output, true>(job, begin, end);
+    return job.uniform_material() ? eval_range_for<model, output, false, compensated>(job, begin, end)
+                                  : eval_range_for<model, output, true, compensated>(job, begin, end);
+}
+
+// The energy compensation's loops: every output but the Jacobian (the bindings refuse it).
+template <Output output>
+std::int64_t eval_compensated_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, output, true>(job, begin, end)
+                                           : eval_range_for<Model::kDisney2014, output, true>(job, begin, end);
 }
 
 inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    if (job.energy_compensation && job.output != Output::kGradient) {
+        switch (job.output) {
+            case Output::kPdf: return eval_compensated_range<Output::kPdf>(job, begin, end);
+            case Output::kValuePdf: return eval_compensated_range<Output::kValuePdf>(job, begin, end);
+            case Output::kLobes: return eval_compensated_range<Output::kLobes>(job, begin, end);
+            default: return eval_compensated_range<Output::kTotal>(job, begin, end);
+        }
+    }
     switch (job.output) {
         case Output::kPdf:  // the pdf does not depend on the model
             return eval_range_for<Model::kDisney2014, Output::kPdf>(job, begin, end);

@@ -52,6 +52,8 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& 
         store_rgb<layouts>(job.lobe_weight[1], i, w.share(w.lobes.sheen_rgb(s)));
         store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
         store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
+        const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+        store_rgb<layouts>(job.lobe_weight[4], i, zero);
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
@@ -59,8 +61,58 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& 
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
+// The energy compensation's batch (model/energy.hpp): the multiple-scattering
+// lobe's weight w3 at wo joins the cosine lobe's, f_ms the weight (and the
+// lobe shares, as the fifth). Batch after batch, not pipelined.
 template <Model model, bool per_element, Layouts layouts, bool with_lobes>
-PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform, const CounterSeed& seed) {
+PB_KERNEL_INLINE bool sample_compensated_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform,
+                                               const MultipleScatteringLobe<Floats>& uniform_ms, const CounterSeed& seed) {
+    Shading<Floats> per_batch;
+    MultipleScatteringLobe<Floats> per_batch_ms;
+    if constexpr (per_element) {
+        const RawMaterial m = load_material(job.params, i);
+        per_batch = shading_of(m);
+        per_batch_ms = multiple_scattering_of(m.slot, per_batch, model);
+    }
+    const Shading<Floats>& material = per_element ? per_batch : uniform;
+    const MultipleScatteringLobe<Floats>& ms = per_element ? per_batch_ms : uniform_ms;
+    Chosen c;
+    c.wo = load_vec3<layouts>(job.wo, i);
+    if (job.check.enabled && !all(surely_unit_length(c.wo, job.check))) return false;
+    if (job.u.data != nullptr) {
+        const Vec3<Floats> given = load_vec3<layouts>(job.u, i);
+        c.u = {given.x, given.y, given.z};
+    } else {
+        c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index) + static_cast<std::uint64_t>(i), seed);
+    }
+    const Floats missing_wo = ms.missing_energy(c.wo.z);
+    const Shading<Floats> s = with_multiple_scattering_weight(material, ms.weight(missing_wo));
+    c.fv = schlick_weight(c.wo.z);
+    c.weights = lobe_weights(c.fv, s);
+    c.lobe = choose_lobe(c.u.u0, s, c.weights);
+    const CompensatedWeighed<Floats> cw =
+            weigh_compensated<model>(c.wo, c.fv, c.weights, draw(job, c, s), s, ms, missing_wo, job.sampler);
+    const Weighed<Floats>& w = cw.weighed;
+    store_rgb<layouts>(job.wi, i, Rgb<Floats>{w.wi.x, w.wi.y, w.wi.z});
+    w.pdf.store_unaligned(job.pdf + i);
+    store_rgb<layouts>(job.weight, i, w.weight);
+    if constexpr (with_lobes) {
+        store_rgb<layouts>(job.lobe_weight[0], i, w.share(w.lobes.diffuse_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[1], i, w.share(w.lobes.sheen_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
+        store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
+        store_rgb<layouts>(job.lobe_weight[4], i, w.share(cw.multiple_scattering));
+    }
+    auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
+    const Floats lobe_index = select(c.lobe.cosine, index_bits(0), select(c.lobe.specular, index_bits(1), index_bits(2)));
+    xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
+    return true;
+}
+
+template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool compensated = false>
+PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform,
+                                       const MultipleScatteringLobe<Floats>& uniform_ms, const CounterSeed& seed) {
+    if constexpr (compensated) return sample_compensated_batch<model, per_element, layouts, with_lobes>(job, i, uniform, uniform_ms, seed);
     Shading<Floats> per_batch;
     if constexpr (per_element) per_batch = shading_of(load_material(job.params, i));
     const Shading<Floats>& s = per_element ? per_batch : uniform;
@@ -70,8 +122,9 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
     return true;
 }
 
-template <Model model, bool per_element, bool with_lobes>
-bool sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>& uniform, const CounterSeed& seed) {
+template <Model model, bool per_element, bool with_lobes, bool compensated>
+bool sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>& uniform,
+                 const MultipleScatteringLobe<Floats>& uniform_ms, const CounterSeed& seed) {
     alignas(64) PadBuffer wo, u, params[kParamSlots], wi, weight, lobe_weight[kLobeCount];
     alignas(64) float pdf[kLanes];
     alignas(64) std::int32_t lobe[kLanes];
@@ -87,7 +140,8 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>
     padded.lobe = lobe;
     padded.first_index = job.first_index + pad.begin;  // the generator sees the true element indices
 
-    if (!sample_one_batch<model, per_element, Layouts::kMixed, with_lobes>(padded, 0, uniform, seed)) return false;
+    if (!sample_one_batch<model, per_element, Layouts::kMixed, with_lobes, compensated>(padded, 0, uniform, uniform_ms, seed))
+        return false;
 
     unpad_vec3(job.wi, pad, wi);
     unpad_vec3(job.weight, pad, weight);
@@ -132,15 +186,20 @@ PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const 
 // every element of [begin, end) written, or the start of the first batch the
 // fast direction test did not accept, every element before it written (see
 // run_checked).
-template <Model model, bool per_element, Layouts layouts, bool with_lobes>
+template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool compensated>
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     Shading<Floats> uniform{};
-    if constexpr (!per_element) uniform = shading_of(load_material(job.params, 0));
+    MultipleScatteringLobe<Floats> uniform_ms{};
+    if constexpr (!per_element) {
+        const RawMaterial m = load_material(job.params, 0);
+        uniform = shading_of(m);
+        if constexpr (compensated) uniform_ms = multiple_scattering_of(m.slot, uniform, model);
+    }
     const CounterSeed seed = counter_seed(job.seed);
     const std::int64_t batches = (end - begin) / kLanes;
     auto at = [&](std::int64_t b) { return begin + b * kLanes; };
     std::int64_t b = 0;
-    if constexpr (!per_element && !with_lobes) {
+    if constexpr (!per_element && !with_lobes && !compensated) {
         if (batches >= 5) {
             InFlight slot0, slot1, slot2;
             // a stop at a batch first weighs the one drawn before it, so that
@@ -166,21 +225,28 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
         }
     }
     for (; b < batches; ++b)
-        if (!sample_one_batch<model, per_element, layouts, with_lobes>(job, at(b), uniform, seed)) return at(b);
+        if (!sample_one_batch<model, per_element, layouts, with_lobes, compensated>(job, at(b), uniform, uniform_ms, seed))
+            return at(b);
     const std::int64_t i = begin + batches * kLanes;
-    if (i < end && !sample_tail<model, per_element, with_lobes>(job, Padding{i, end - i}, uniform, seed)) return i;
+    if (i < end && !sample_tail<model, per_element, with_lobes, compensated>(job, Padding{i, end - i}, uniform, uniform_ms, seed))
+        return i;
     return -1;
 }
 
-template <Model model, bool per_element, Layouts layouts, bool with_lobes = false>
+template <Model model, bool per_element, Layouts layouts, bool with_lobes = false, bool compensated = false>
 std::int64_t sample_checked(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     auto rejected = [&](std::int64_t i) { return !unit_length_at(job.wo, i, job.check); };
-    return run_checked(job, begin, end, sample_loop<model, per_element, layouts, with_lobes>, rejected);
+    return run_checked(job, begin, end, sample_loop<model, per_element, layouts, with_lobes, compensated>, rejected);
 }
 
 // -1 with every element written, or the first element whose wo fails the direction check.
 template <Model model, bool per_element>
 std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+    // the energy compensation: batch after batch, any layout (model/energy.hpp)
+    if (job.energy_compensation)
+        return job.lobe_weight[0].data != nullptr
+                       ? sample_checked<model, per_element, Layouts::kMixed, true, true>(job, begin, end)
+                       : sample_checked<model, per_element, Layouts::kMixed, false, true>(job, begin, end);
     // each lobe's share as well (the albedo's split): batch after batch, any layout
     if (job.lobe_weight[0].data != nullptr) return sample_checked<model, per_element, Layouts::kMixed, true>(job, begin, end);
     const Vec3Layout layout = job.wo.layout;

@@ -368,6 +368,25 @@ PB_KERNEL_INLINE bool all(const Mask& m) { return xsimd::all(m); }
 PB_KERNEL_INLINE Floats log(Floats x) { return xsimd::log(x); }
 PB_KERNEL_INLINE Floats exp(Floats x) { return xsimd::exp(x); }
 PB_KERNEL_INLINE Floats largest_finite(Floats) { return Floats(std::numeric_limits<float>::max()); }
+// table lookups (model/energy.hpp): the integer part of x >= 0 (truncation), back to
+// floats, table[i] per lane (one gather instruction on AVX2 and AVX-512)
+PB_KERNEL_INLINE Ints truncate_to_index(Floats x) { return xsimd::to_int(x); }
+PB_KERNEL_INLINE Floats index_to_real(Ints i) { return xsimd::to_float(i); }
+PB_KERNEL_INLINE Ints min(Ints a, Ints b) { return xsimd::min(a, b); }
+// (the intrinsics: xsimd 8.1's batch::gather for fma3<avx2> falls back to an out-of-line element loop)
+#if defined(__AVX512F__)
+PB_KERNEL_INLINE Floats gather(const float* table, Ints i) { return _mm512_i32gather_ps(i, table, 4); }
+#elif defined(__AVX2__)
+PB_KERNEL_INLINE Floats gather(const float* table, Ints i) { return _mm256_i32gather_ps(table, i, 4); }
+#else
+PB_KERNEL_INLINE Floats gather(const float* table, Ints i) {
+    alignas(64) std::int32_t index[kLanes];
+    alignas(64) float value[kLanes];
+    i.store_aligned(index);
+    for (std::int64_t j = 0; j < kLanes; ++j) value[j] = table[index[j]];
+    return Floats::load_aligned(value);
+}
+#endif
 
 // (sin 2πu, cos 2πu) for u in [0, 1] by the double angle, without quadrant
 // selects: with t = u - 1/2 and θ = πt in [-π/2, π/2], 2πu = 2θ + π, so

@@ -57,6 +57,7 @@ if TYPE_CHECKING:  # the fields of LOBE_NAMES (the C++ table), spelled out for t
         sheen: FloatArray
         specular: FloatArray
         clearcoat: FloatArray
+        multiple_scattering: FloatArray
 else:
     _LobeArrays = NamedTuple("LobeArrays", [(name, np.ndarray) for name in LOBE_NAMES])
 
@@ -64,7 +65,8 @@ else:
 class Lobes(_LobeArrays):
     """The lobes of f (README "The model"), in the C++ table's order: ``diffuse``
     (with subsurface, times 1 - metallic), ``sheen`` (times 1 - metallic),
-    ``specular`` and ``clearcoat`` (grey), each shaped like :func:`eval`'s
+    ``specular``, ``clearcoat`` (grey) and ``multiple_scattering`` (the energy
+    compensation's, 0 unless it is on), each shaped like :func:`eval`'s
     result, already weighted as they enter the sum."""
 
     __slots__ = ()
@@ -266,9 +268,13 @@ def _flat_vec3(array: Float32Array, layout: str) -> tuple[Float32Array, int]:
 def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine: bool, layout: Layout,
               threads: SupportsIndex | None, check: bool, isa: str | None,
               outputs_for_shape: Callable[[tuple[int, ...], str], list[Float32Array]], pdf_sampler: int | None = None,
-              gradient: bool = False) -> list[Float32Array]:
+              gradient: bool = False, energy_compensation: bool = False) -> list[Float32Array]:
     """eval / eval_lobes / pdf / eval_grad: validated arguments in, outputs written."""
     _require_material(material)
+    energy_compensation = flag("energy_compensation", energy_compensation)
+    if gradient and energy_compensation:
+        raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
+                                  "multiple-scattering lobe is not implemented); evaluate f with pb.eval")
     layout = _layout(layout)
     thread_count = _threads(threads)
     isa_name = _isa(isa)
@@ -296,12 +302,13 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     elif pdf_sampler is not None:
         value = _flat_vec3(outputs[1], layout)[0] if len(outputs) == 2 else None  # eval_pdf: f in the same pass
         bad = _core.batch_pdf(wi_flat, wi_code, wo_flat, wo_code, params, outputs[0].reshape(n), n, pdf_sampler,
-                              tolerance, thread_count, isa_name, value, out_layout, model_id, cosine)
+                              tolerance, thread_count, isa_name, value, out_layout, model_id, cosine,
+                              energy_compensation)
     else:
         flat_outputs = [_flat_vec3(o, layout)[0] for o in outputs]
         bad = _core.batch_eval(wi_flat, wi_code, wo_flat, wo_code, params, flat_outputs,
                                out_layout, n, model_id, len(outputs) == len(LOBE_NAMES),
-                               cosine, tolerance, thread_count, isa_name)
+                               cosine, tolerance, thread_count, isa_name, energy_compensation)
     if bad >= 0:
         raise _direction_error(bad, leading, wi_dirs, wo_dirs)
     return outputs
@@ -309,7 +316,8 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
 
 def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
          cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None,
-         out: Float32Array | None = None, check: bool = True, isa: str | None = None) -> Float32Array:
+         out: Float32Array | None = None, check: bool = True, isa: str | None = None,
+         energy_compensation: bool = False) -> Float32Array:
     """f(wi, wo) in 1/sr as float32, by the SIMD kernel (README "The model").
 
     ``wi``, ``wo``: unit directions, ``(..., 3)`` or with ``layout="soa"``
@@ -320,19 +328,24 @@ def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mod
     every thread count. ``check=False`` skips the direction checks for speed:
     a non-unit direction is then used as given and a non-finite one gives 0. ``isa``
     picks one of ``cpu_info()["available"]`` (for tests and benchmarks).
+    ``energy_compensation=True`` adds the primary specular lobe's multiple
+    scattering (Kulla & Conty 2017; README "Energy compensation").
     """
     (f,) = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
-                     lambda leading, layout: [_output(out, _vec3_shape(leading, layout))])
+                     lambda leading, layout: [_output(out, _vec3_shape(leading, layout))],
+                     energy_compensation=energy_compensation)
     return f
 
 
 def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
                cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None, check: bool = True,
-               isa: str | None = None) -> Lobes:
-    """The four lobes (diffuse, sheen, specular, clearcoat) as a :class:`Lobes`
-    of float32 arrays, each shaped like :func:`eval`'s result."""
+               isa: str | None = None, energy_compensation: bool = False) -> Lobes:
+    """The lobes (diffuse, sheen, specular, clearcoat, multiple_scattering) as a
+    :class:`Lobes` of float32 arrays, each shaped like :func:`eval`'s result;
+    multiple_scattering is 0 unless ``energy_compensation``."""
     outputs = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
-                        lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in LOBE_NAMES])
+                        lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in LOBE_NAMES],
+                        energy_compensation=energy_compensation)
     return Lobes(*outputs)
 
 
@@ -360,7 +373,7 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
               wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014", cosine: bool = False,
               layout: Layout = "aos", threads: SupportsIndex | None = None,
               out: tuple[Float32Array, Float32Array] | None = None, check: bool = True,
-              isa: str | None = None) -> Gradient:
+              isa: str | None = None, energy_compensation: bool = False) -> Gradient:
     """f and its Jacobian in the material's parameters, by the SIMD kernel in
     float32 (README "Gradients").
 
@@ -371,7 +384,8 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     ``base_color`` as ``base_color_r/g/b``), in the table's order. A uniform
     parameter still gets a per-element derivative. ``out=(value, jacobian)``
     writes into preallocated float32 arrays of exactly those shapes. The other
-    arguments are :func:`eval`'s.
+    arguments are :func:`eval`'s; ``energy_compensation=True`` raises
+    NotImplementedError.
     """
     wanted = _gradient.columns(wrt)
     full = len(wanted) == len(GRADIENT_NAMES)
@@ -383,7 +397,7 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
         return [value, jacobian if full else np.empty(_jacobian_shape(leading, layout, len(GRADIENT_NAMES)), np.float32)]
 
     value, jacobian_all = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
-                                    gradient=True)
+                                    gradient=True, energy_compensation=energy_compensation)
     if full:
         return Gradient(value, jacobian_all, GRADIENT_NAMES)
     axis = -1 if _layout(layout) == "aos" else 1
@@ -396,15 +410,16 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
 
 def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
         specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
-        check: bool = True, isa: str | None = None) -> Float32Array:
+        check: bool = True, isa: str | None = None, energy_compensation: bool = False) -> Float32Array:
     """The density (solid angle) with which :func:`sample` draws ``wi`` given ``wo``:
     the lobe mixture of README "Sampling and pdf", float32 ``(...)``; 0 when
     either direction is at or below the horizon. It does not depend on the model
-    (``model`` is checked and accepted, as every call takes it)."""
-    model_index(model)
-    (density,) = _evaluate(material, wi, wo, 0, False, layout, threads, check, isa,
+    (``model`` is checked and accepted, as every call takes it) unless
+    ``energy_compensation``, whose lobe's mixture weight reads the model's tables."""
+    model_id = model_index(model)
+    (density,) = _evaluate(material, wi, wo, model_id if energy_compensation else 0, False, layout, threads, check, isa,
                            lambda leading, layout: [np.empty(leading, np.float32)],
-                           pdf_sampler=sampler_index(specular_sampler))
+                           pdf_sampler=sampler_index(specular_sampler), energy_compensation=energy_compensation)
     return density
 
 
@@ -418,7 +433,7 @@ class ValuePdf(NamedTuple):
 def eval_pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
              cosine: bool = False, specular_sampler: SpecularSampler = "visible", layout: Layout = "aos",
              threads: SupportsIndex | None = None, out: tuple[Float32Array, Float32Array] | None = None,
-             check: bool = True, isa: str | None = None) -> ValuePdf:
+             check: bool = True, isa: str | None = None, energy_compensation: bool = False) -> ValuePdf:
     """f and the sampling pdf of (wi, wo) in one kernel pass (what multiple importance
     sampling needs): ``value`` as :func:`eval` returns it, ``pdf`` as :func:`pdf` does.
     ``out=(value, pdf)`` writes into preallocated float32 arrays of those shapes."""
@@ -429,7 +444,7 @@ def eval_pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model:
         return [density, value]
 
     density, value = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
-                               pdf_sampler=sampler_index(specular_sampler))
+                               pdf_sampler=sampler_index(specular_sampler), energy_compensation=energy_compensation)
     return ValuePdf(value, density)
 
 
@@ -455,21 +470,25 @@ def _fresh_seed() -> int:
 def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
            seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
-           check: bool = True, isa: str | None = None, with_lobes: Literal[False] = False) -> Sample: ...
+           check: bool = True, isa: str | None = None, with_lobes: Literal[False] = False,
+           energy_compensation: bool = False) -> Sample: ...
 @overload
 def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
            seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
-           check: bool = True, isa: str | None = None, with_lobes: Literal[True]) -> tuple[Sample, Lobes]: ...
+           check: bool = True, isa: str | None = None, with_lobes: Literal[True],
+           energy_compensation: bool = False) -> tuple[Sample, Lobes]: ...
 @overload
 def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
            seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
-           check: bool = True, isa: str | None = None, with_lobes: bool = False) -> Sample | tuple[Sample, Lobes]: ...
+           check: bool = True, isa: str | None = None, with_lobes: bool = False,
+           energy_compensation: bool = False) -> Sample | tuple[Sample, Lobes]: ...
 def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
            seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
-           check: bool = True, isa: str | None = None, with_lobes: bool = False) -> Sample | tuple[Sample, Lobes]:
+           check: bool = True, isa: str | None = None, with_lobes: bool = False,
+           energy_compensation: bool = False) -> Sample | tuple[Sample, Lobes]:
     """Importance-sample ``wi`` for each ``wo`` (README "Sampling and pdf").
 
     ``u``: three uniforms in [0, 1] per element, ``(..., 3)`` (``(3, ...)`` for
@@ -484,6 +503,8 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     Returns a :class:`Sample` of float32 ``wi``, ``pdf``, ``weight`` and int32 ``lobe``;
     with ``with_lobes=True``, ``(Sample, Lobes)``: each lobe's share of the weight,
     ``f_k(wi, wo) cos θl / pdf``, from the same pass (they sum to ``weight``).
+    ``energy_compensation=True``: f includes the multiple-scattering lobe, drawn
+    by the cosine lobe (its weight joins that lobe's chance, ``lobe`` 0).
     """
     _require_material(material)
     model_id = model_index(model)
@@ -493,6 +514,7 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     isa_name = _isa(isa)
     seed = _fresh_seed() if seed is None else seed_value(seed)
     check, with_lobes = flag("check", check), flag("with_lobes", with_lobes)
+    energy_compensation = flag("energy_compensation", energy_compensation)
     wo_dirs = _Directions("wo", wo, layout)
     shapes = dict(wo=wo_dirs.leading, material=material.shape)
     uniforms = None
@@ -520,7 +542,7 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
         wo_flat, wo_code, u_flat, u_code, seed, _params(material, leading), _flat_vec3(wi_out, layout)[0],
         _flat_vec3(weight_out, layout)[0], _INTERLEAVED if layout == "aos" else _ROWS, pdf_out.reshape(n),
         lobe_out.reshape(n), n, model_id, sampler, DIRECTION_LENGTH_TOLERANCE if check else 0.0, thread_count,
-        isa_name, None if shares is None else [_flat_vec3(share, layout)[0] for share in shares],
+        isa_name, None if shares is None else [_flat_vec3(share, layout)[0] for share in shares], energy_compensation,
     )
     if bad >= 0:
         raise _direction_error(bad, leading, wo_dirs)

@@ -45,8 +45,10 @@ class _CpuInfo(TypedDict):
     available: list[str]
     threads: int
 
-def reference_eval(wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, lobes: bool) -> NDArray[np.float64]:
-    """Float64 reference f (N,3) or lobes (N,4,3) for packed, already validated rows."""
+def reference_eval(
+    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, lobes: bool, energy_compensation: bool = False
+) -> NDArray[np.float64]:
+    """Float64 reference f (N,3) or lobes (N,5,3) for packed, already validated rows."""
 
 def reference_eval_grad(
     wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int
@@ -54,15 +56,19 @@ def reference_eval_grad(
     """Float64 reference f (N,3) and its Jacobian (N,3,13) over the parameter slots, for packed validated rows."""
 
 def reference_sample(
-    wo: _Float64In, u: _Float64In, params: _Float64In, model: _Int, sampler: _Int
+    wo: _Float64In, u: _Float64In, params: _Float64In, model: _Int, sampler: _Int, energy_compensation: bool = False
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32]]:
     """Float64 reference samples (wi (N,3), pdf (N,), weight (N,3), lobe (N,) int32) for validated rows;
     each input is N rows or one shared row."""
 
-def reference_pdf(wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, sampler: _Int) -> NDArray[np.float64]:
+def reference_pdf(
+    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, sampler: _Int, energy_compensation: bool = False
+) -> NDArray[np.float64]:
     """Float64 reference mixture pdf (N,) for validated rows (N or one shared row each)."""
 
-def reference_lobe_probabilities(wo: _Float64In, params: _Float64In) -> NDArray[np.float64]:
+def reference_lobe_probabilities(
+    wo: _Float64In, params: _Float64In, model: _Int = 0, energy_compensation: bool = False
+) -> NDArray[np.float64]:
     """Lobe probabilities (N,3) at wo for validated rows (N or one shared row each)."""
 
 def batch_eval(
@@ -80,6 +86,7 @@ def batch_eval(
     check_tolerance: _Float,
     threads: _Int,
     isa: str,
+    energy_compensation: bool = False,
 ) -> int:
     """SIMD evaluation into preallocated float32 outputs (validated by the caller)."""
 
@@ -117,6 +124,7 @@ def batch_pdf(
     out_layout: _Int = 0,
     model: _Int = 0,
     cosine: bool = False,
+    energy_compensation: bool = False,
 ) -> int:
     """SIMD sampling pdf into a preallocated float32 array (and f into out, in the same pass, if given)."""
 
@@ -139,6 +147,7 @@ def batch_sample(
     threads: _Int,
     isa: str,
     lobe_weights: Sequence[_Float32Out] | None = None,
+    energy_compensation: bool = False,
 ) -> int:
     """SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given)."""
 
@@ -200,6 +209,82 @@ class _MicrofacetModule(ModuleType):
     def beckmann_lambda(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
     @staticmethod
     def beckmann_g1(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def student_t_d(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def student_t_pdf(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def student_t_lambda(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def student_t_g1(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def student_t_g2_separable(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def student_t_g2_height_correlated(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def student_t_pdf_visible(h: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def student_t_sample(u1: _Float64In, u2: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def exponential_power_d(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def exponential_power_pdf(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def exponential_power_lambda(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def exponential_power_g1(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def exponential_power_g2_separable(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def exponential_power_g2_height_correlated(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def exponential_power_pdf_visible(h: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def exponential_power_sample(u1: _Float64In, u2: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def blinn_phong_d(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def blinn_phong_pdf(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def blinn_phong_lambda(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def blinn_phong_g1(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def blinn_phong_g2_separable(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def blinn_phong_g2_height_correlated(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def blinn_phong_pdf_visible(h: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def blinn_phong_sample(u1: _Float64In, u2: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_walter_d(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_walter_pdf(h: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_walter_lambda(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_walter_g1(w: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_walter_g2_separable(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_walter_g2_height_correlated(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_walter_pdf_visible(h: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, shape: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_g2_separable(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_g2_height_correlated(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_pdf_visible(h: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def ggx_g2_over_4cos(wi: _Float64In, wo: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In, form: int) -> NDArray[np.float64]: ...
+    @staticmethod
+    def hyp2f1(a: _Float64In, b: _Float64In, c: _Float64In, z: _Float64In) -> NDArray[np.float64]: ...
+    @staticmethod
+    def beckmann_sample_visible(
+        wo: _Float64In, u1: _Float64In, u2: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In
+    ) -> NDArray[np.float64]: ...
     @staticmethod
     def beckmann_sample(u1: _Float64In, u2: _Float64In, alpha_x: _Float64In, alpha_y: _Float64In) -> NDArray[np.float64]: ...
 

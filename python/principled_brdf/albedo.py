@@ -29,7 +29,7 @@ class Albedo(NamedTuple):
     """Directional albedo at each cos θo, RGB ``(..., 3)``, with standard errors."""
 
     total: Float64Array
-    lobes: Lobes  # diffuse, sheen, specular, clearcoat
+    lobes: Lobes  # diffuse, sheen, specular, clearcoat, multiple_scattering
     total_error: Float64Array  # standard error of the mean
     lobe_errors: Lobes
 
@@ -48,13 +48,13 @@ def _with_sample_axis(material: Material, leading: tuple[int, ...]) -> Material:
 
 def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsIndex = 1 << 16,
            seed: SupportsIndex = 0, model: Model = "disney2014", specular_sampler: SpecularSampler = "visible",
-           threads: SupportsIndex | None = None) -> Albedo:
+           threads: SupportsIndex | None = None, energy_compensation: bool = False) -> Albedo:
     """Directional albedo ``E(wo) = ∫ f(wi, wo) cos θl dωi`` for ``wo = (sin θo, 0, cos θo)``.
 
     ``cos_theta_o`` in (0, 1], any shape, broadcast with the material's
     leading shape. Each albedo is the mean of ``samples`` importance-sampled
     weights (``pb.sample``, seeded, so the call is reproducible); errors are
-    the standard errors of those means.
+    the standard errors of those means. ``energy_compensation`` as in ``pb.sample``.
     """
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
@@ -84,7 +84,8 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
         u = random_uniforms(seed, (stop - start) * count, first=start * count).reshape(stop - start, count, 3)
         # one kernel pass: the weight and each lobe's share of it
         drawn, shares = sample(chunk_material, wo, u=u, model=model, specular_sampler=specular_sampler,
-                               threads=threads, check=False, with_lobes=True)
+                               threads=threads, check=False, with_lobes=True,
+                               energy_compensation=energy_compensation)
         for k, weight in enumerate((drawn.weight, *shares)):
             weight = weight.astype(np.float64)
             sums[k, start:stop] = weight.sum(axis=1)

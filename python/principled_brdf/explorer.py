@@ -43,6 +43,7 @@ import importlib
 import inspect
 import math
 import time
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -53,6 +54,22 @@ from ._batch import eval_lobes as _eval_lobes
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material, srgb_to_linear
 from .plot import CHANNELS, slice_directions
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterator, Mapping
+    from types import ModuleType
+    from typing import Any, Protocol
+
+    from matplotlib.figure import Figure
+    from matplotlib.image import FigureImage
+    from matplotlib.projections.polar import PolarAxes
+    from numpy.typing import NDArray
+
+    from ._typing import Float32Array, Float64Array, FloatArray, Model, RealArrayLike
+
+    class _AggCanvas(Protocol):  # what is used of FigureCanvasAgg (its methods are not annotated)
+        def draw(self) -> None: ...
+        def buffer_rgba(self) -> memoryview: ...
 
 __all__ = ["explorer", "Explorer", "OUTPUTS", "CUSTOM"]
 
@@ -71,7 +88,7 @@ _DEPENDS = {
     "slice": ("material", "model", "energy_compensation", "light", "view"),
     "albedo": ("material", "model", "energy_compensation", "view"),
 }
-_KEY_STYLES = {  # the legend entries of the plots, beyond the lobes
+_KEY_STYLES: dict[str, dict[str, Any]] = {  # the legend entries of the plots, beyond the lobes
     "wo": dict(color="0.45", ls="--", lw=1.0, label="view"),
     "wi": dict(color="tab:red", ls=":", lw=1.4, label="light (projected)"),
     "θv": dict(color="0.45", ls="--", lw=1.0, label="θv"),
@@ -89,7 +106,7 @@ _FIGSIZE = (4.4, 3.3)
 _FONT = {"font.size": 8.0, "axes.titlesize": 8.5, "legend.fontsize": 7.5}
 
 
-def _imports():
+def _imports() -> tuple[ModuleType, ModuleType, type[Figure]]:
     try:
         import ipywidgets
     except ImportError as error:
@@ -104,7 +121,7 @@ def _imports():
     return ipywidgets, matplotlib, Figure
 
 
-def _accepts(function, keyword: str) -> bool:
+def _accepts(function: Callable[..., object], keyword: str) -> bool:
     try:
         parameter = inspect.signature(function).parameters.get(keyword)
     except (TypeError, ValueError):
@@ -117,16 +134,16 @@ def supports_energy_compensation() -> bool:
     return _accepts(importlib.import_module(__package__).eval, "energy_compensation")
 
 
-def _linear_to_srgb(c: np.ndarray) -> np.ndarray:
+def _linear_to_srgb(c: RealArrayLike) -> Float64Array:
     c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)
     return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
 
 
-def _hex(linear) -> str:
+def _hex(linear: RealArrayLike) -> str:
     return "#" + "".join(f"{int(round(v * 255.0)):02x}" for v in _linear_to_srgb(linear))
 
 
-def _picked(value: str) -> tuple:
+def _picked(value: str) -> tuple[float, ...]:
     """The ColorPicker's value (``#rrggbb``, ``#rgb`` or a CSS colour name, sRGB) as linear RGB."""
     from matplotlib.colors import to_rgb
 
@@ -137,7 +154,7 @@ def _picked(value: str) -> tuple:
 _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 
 
-def _power_of_ten(value, position=None) -> str:
+def _power_of_ten(value: float, position: int | None = None) -> str:
     """Tick label ``10³`` for a power of ten (plain text: no mathtext to parse), else empty."""
     if not value > 0.0:
         return ""
@@ -147,13 +164,13 @@ def _power_of_ten(value, position=None) -> str:
     return "10" + str(int(round(exponent))).translate(_SUPERSCRIPT)
 
 
-def _direction(theta_degrees: float, phi_degrees: float) -> np.ndarray:
+def _direction(theta_degrees: float, phi_degrees: float) -> Float64Array:
     theta, phi = math.radians(theta_degrees), math.radians(phi_degrees)
     cos_theta = 0.0 if theta_degrees == 90.0 else math.cos(theta)  # on the horizon, not 6e-17 above it
     return np.array([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), cos_theta])
 
 
-def _uniform(material) -> tuple:
+def _uniform(material: object) -> tuple[Material, str | None]:
     """(Material, preset name or None) from None, a Material or a preset name."""
     if material is None:
         return Material(), None
@@ -189,7 +206,21 @@ class Explorer:
     update), :meth:`refresh`, :meth:`write_pngs`, :meth:`close`.
     """
 
-    def __init__(self, material=None, *, model: str = "disney2014", resolution: int = 192):
+    # (the widgets are ipywidgets', untyped: Any)
+    sliders: dict[str, Any]
+    images: dict[str, Any]
+    timings: dict[str, float]
+    _rendered: dict[str, tuple[Any, ...]]
+    _figures: dict[str, Figure]
+    _legend_cache: dict[tuple[tuple[str, ...], int, bool], NDArray[np.float32]]
+    _sphere_linear: tuple[tuple[Any, ...] | None, Float32Array | None]
+    _initial: tuple[Material, str | None, dict[Any, tuple[Any, float | None]]]
+    _polar: dict[str, Any]  # the polar plot's Axes, angles, lines, legend image and title
+    _slice: dict[str, Any]
+    _albedo: dict[str, Any]
+
+    def __init__(self, material: Material | str | None = None, *, model: Model = "disney2014",
+                 resolution: int = 192) -> None:
         widgets, self._matplotlib, Figure = _imports()
         material, preset = _uniform(material)
         _validate.model_index(model)
@@ -209,7 +240,8 @@ class Explorer:
         style = {"description_width": "104px"}
         layout = widgets.Layout(width="330px")
 
-        def slider(description, value, lower, upper, step, fmt=".2f"):
+        def slider(description: str, value: float, lower: float, upper: float, step: float,
+                   fmt: str = ".2f") -> Any:
             return widgets.FloatSlider(value=value, min=lower, max=upper, step=step, description=description,
                                        continuous_update=True, readout_format=fmt, style=style, layout=layout)
 
@@ -255,10 +287,10 @@ class Explorer:
             else:
                 control.observe(self._changed, names="value")
 
-        def header(text):
+        def header(text: str) -> Any:
             return widgets.HTML(f"<b>{text}</b>")
 
-        def cell(image):
+        def cell(image: Any) -> Any:
             return widgets.Box([image], layout=widgets.Layout(width=f"{self._figures_size[0] + 8}px",
                                                              justify_content="center", align_items="center"))
 
@@ -280,14 +312,14 @@ class Explorer:
     # state
 
     @staticmethod
-    def _default_light() -> tuple:
+    def _default_light() -> tuple[float, float]:
         light = np.asarray(_render.DEFAULT_LIGHT, dtype=np.float64)
         light = light / np.linalg.norm(light)
         theta = math.degrees(math.acos(float(light[2])))
         phi = math.degrees(math.atan2(float(light[1]), float(light[0]))) % 360.0
         return round(theta * 2.0) / 2.0, float(round(phi))
 
-    def _controls(self) -> list:
+    def _controls(self) -> list[Any]:
         controls = [*self.sliders.values(), self.base_color, self.model, self.preset, self.light_theta,
                     self.light_phi, self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius]
         return controls + ([self.energy_compensation] if self.energy_compensation else [])
@@ -298,7 +330,7 @@ class Explorer:
         values = {name: float(s.value) for name, s in self.sliders.items()}
         return Material(base_color=self._base_color, **values, bright_base_color=True)
 
-    def _state(self) -> dict:
+    def _state(self) -> dict[str, Any]:
         return {
             "material": (self._base_color,) + tuple(float(s.value) for s in self.sliders.values()),
             "model": self.model.value,
@@ -310,13 +342,13 @@ class Explorer:
             "energy_compensation": bool(self.energy_compensation.value) if self.energy_compensation else None,
         }
 
-    def _options(self, function, state) -> dict:
+    def _options(self, function: Callable[..., object], state: Mapping[str, Any]) -> dict[str, Any]:
         """Keyword options the model takes beyond ``model=``, where ``function`` accepts them."""
         ec = state["energy_compensation"]
         return {"energy_compensation": ec} if ec is not None and _accepts(function, "energy_compensation") else {}
 
     @contextlib.contextmanager
-    def hold(self):
+    def hold(self) -> Iterator[Explorer]:
         """Change several controls with one update at the end: ``with explorer.hold(): ...``."""
         self._holding += 1
         try:
@@ -326,7 +358,7 @@ class Explorer:
             if not self._holding:
                 self.refresh()
 
-    def refresh(self) -> dict:
+    def refresh(self) -> dict[str, float]:
         """Redraw the pictures whose inputs changed; returns ``{name: seconds}`` of those drawn."""
         state = self._state()
         material = self.material
@@ -348,21 +380,21 @@ class Explorer:
                                  f"({parts})</small>")
         return drawn
 
-    def _changed(self, change) -> None:
+    def _changed(self, change: Mapping[str, Any]) -> None:
         material_control = change["owner"] is self.base_color or change["owner"] in self.sliders.values()
         if material_control and not self._quiet and self.preset.value != CUSTOM:
             self._quietly(lambda: setattr(self.preset, "value", CUSTOM))
         if not self._holding:
             self.refresh()
 
-    def _quietly(self, action) -> None:
+    def _quietly(self, action: Callable[[], object]) -> None:
         quiet, self._quiet = self._quiet, True
         try:
             action()
         finally:
             self._quiet = quiet
 
-    def _color_picked(self, change) -> None:
+    def _color_picked(self, change: Mapping[str, Any]) -> None:
         if self._quiet:
             return
         try:
@@ -371,7 +403,7 @@ class Explorer:
             return
         self._changed(change)
 
-    def _preset_chosen(self, change) -> None:
+    def _preset_chosen(self, change: Mapping[str, Any]) -> None:
         if self._quiet or change["new"] == CUSTOM:
             return
         self.set_material(_presets.get(change["new"]), preset=change["new"])
@@ -380,19 +412,23 @@ class Explorer:
         """Every control back to where the explorer started (one update)."""
         material, preset, controls = self._initial
         with self.hold():
-            self._quietly(lambda: [setattr(control, "max", upper) for control, (_, upper) in controls.items()
-                                   if upper is not None])
+            def restore_ranges() -> None:
+                for control, (_, upper) in controls.items():
+                    if upper is not None:
+                        control.max = upper
+
+            self._quietly(restore_ranges)
             self.set_material(material, preset=preset)
             for control, (value, _) in controls.items():
                 if control not in self.sliders.values():
                     control.value = value
 
-    def set_material(self, material, *, preset=None) -> None:
+    def set_material(self, material: Material | str, *, preset: str | None = None) -> None:
         """Set every material control to ``material`` (a uniform Material or a preset name), one update."""
         material, named = _uniform(material)
         preset = preset or named
 
-        def apply():
+        def apply() -> None:
             for name, s in self.sliders.items():
                 value = float(getattr(material, name))
                 if value > s.max:  # an unbounded parameter beyond the slider's range
@@ -411,10 +447,10 @@ class Explorer:
     # A legend costs as much to draw as the rest of a plot: each one is drawn once, to pixels, and
     # shown as a figure image (cached by its entries).
 
-    def _legend(self, fig):
+    def _legend(self, fig: Figure) -> FigureImage:
         return fig.figimage(np.zeros((1, 1, 4)), 0, 0, origin="upper", zorder=10)
 
-    def _legend_pixels(self, entries: tuple, ncol: int, frame: bool) -> np.ndarray:
+    def _legend_pixels(self, entries: tuple[str, ...], ncol: int, frame: bool) -> NDArray[np.float32]:
         key = (entries, ncol, frame)
         if key not in self._legend_cache:
             from matplotlib.lines import Line2D
@@ -422,13 +458,14 @@ class Explorer:
             fig = self._Figure(figsize=(_FIGSIZE[0], 1.2), dpi=_DPI)
             self._canvas(fig)
             fig.patch.set_alpha(0.0)
-            styles = {**{name: dict(color=color, lw=1.8 if name == "total" else 1.2, label=name)
-                         for name, color in _LOBE_COLORS.items()}, **_KEY_STYLES}
+            styles: dict[str, dict[str, Any]] = {
+                **{name: dict(color=color, lw=1.8 if name == "total" else 1.2, label=name)
+                   for name, color in _LOBE_COLORS.items()}, **_KEY_STYLES}
             legend = fig.legend(handles=[Line2D([], [], **styles[name]) for name in entries], loc="center", ncol=ncol,
                                 frameon=frame, framealpha=0.85, edgecolor="none", handlelength=1.5,
                                 columnspacing=1.0, borderpad=0.3)
             fig.canvas.draw()
-            pixels = np.asarray(fig.canvas.buffer_rgba())
+            pixels = np.asarray(cast("_AggCanvas", fig.canvas).buffer_rgba())  # the canvas _canvas made
             box = legend.get_window_extent()
             height = pixels.shape[0]
             rows = slice(max(0, int(height - box.y1) - 1), min(height, int(math.ceil(height - box.y0)) + 1))
@@ -436,34 +473,37 @@ class Explorer:
             self._legend_cache[key] = pixels[rows, columns].astype(np.float32) / 255.0
         return self._legend_cache[key]
 
-    def _place_legend(self, image, entries: tuple, *, ncol: int, frame: bool, top: float, centre_x=None,
-                      left=None) -> None:
+    def _place_legend(self, image: FigureImage, entries: tuple[str, ...], *, ncol: int, frame: bool, top: float,
+                      centre_x: float | None = None, left: float | None = None) -> None:
         pixels = self._legend_pixels(entries, ncol, frame)
         width, height = self._figures_size
         image.set_data(pixels)
-        image.ox = round(centre_x * width - pixels.shape[1] / 2) if centre_x is not None else round(left * width)
+        # (the callers give centre_x or left)
+        image.ox = (round(centre_x * width - pixels.shape[1] / 2) if centre_x is not None
+                    else round(cast(float, left) * width))
         image.oy = round(top * height) - pixels.shape[0]
 
-    def _canvas(self, fig) -> None:
+    def _canvas(self, fig: Figure) -> None:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
 
         FigureCanvasAgg(fig)
 
     def _savefig(self, name: str) -> bytes:
         # the figure's own Agg canvas and renderer, kept between draws (its text metrics stay cached)
-        canvas = self._figures[name].canvas
+        canvas = cast("_AggCanvas", self._figures[name].canvas)  # the canvas _canvas made
         canvas.draw()
         return _render.png_bytes(np.asarray(canvas.buffer_rgba()))
 
-    def _draw_sphere(self, material, state) -> bytes:
+    def _draw_sphere(self, material: Material, state: Mapping[str, Any]) -> bytes:
         key = tuple(state[k] for k in _DEPENDS["sphere"] if k != "exposure")
         if self._sphere_linear[0] != key:  # an exposure change only tone maps again
             self._sphere_linear = (key, self._render_sphere(material, state))
+        assert self._sphere_linear[1] is not None  # rendered above (key is never None)
         rgb = _render.to_srgb8(self._sphere_linear[1], 2.0 ** state["exposure"])
         alpha = np.where(self._inside, 255, 0).astype(np.uint8)
         return _render.png_bytes(np.concatenate([rgb, alpha[..., None]], axis=-1))
 
-    def _render_sphere(self, material, state) -> np.ndarray:
+    def _render_sphere(self, material: Material, state: Mapping[str, Any]) -> Float32Array:
         light = _direction(*state["light"])
         model = state["model"]
         n = self.resolution
@@ -471,12 +511,12 @@ class Explorer:
         return _render.render_sphere(material, n, light=light, ambient=0.0 if state["sky"] else _AMBIENT, model=model,
                                      environment="sky" if state["sky"] else None, samples=_SKY_SAMPLES, **options)
 
-    def _build_polar(self, Figure) -> None:
+    def _build_polar(self, Figure: type[Figure]) -> None:
         fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
         self._canvas(fig)
         # The Axes becomes a square, the half disc (radius: half its side) centred in it: a radius of
         # 135 px, the horizon 75 px above the bottom (room for the legend); the title is a figure text.
-        ax = fig.add_axes((0.117, 0.028, 0.767, 1.023), projection="polar")
+        ax = cast("PolarAxes", fig.add_axes((0.117, 0.028, 0.767, 1.023), projection="polar"))
         ax.set_theta_zero_location("N")
         ax.set_theta_direction(-1)
         ax.set_thetamin(-90)
@@ -492,7 +532,7 @@ class Explorer:
         self._polar = {"ax": ax, "t": t, "lines": lines, "legend": self._legend(fig), "title": title}
         self._figures["polar"] = fig
 
-    def _draw_polar(self, material, state) -> bytes:
+    def _draw_polar(self, material: Material, state: Mapping[str, Any]) -> bytes:
         ax, t, lines = self._polar["ax"], self._polar["t"], self._polar["lines"]
         theta_v, phi_v = state["view"]
         azimuth = np.array([math.cos(math.radians(phi_v)), math.sin(math.radians(phi_v))])
@@ -501,13 +541,13 @@ class Explorer:
         wo = _direction(theta_v, phi_v)
         values = _eval_lobes(material, wi, wo, model=state["model"], **self._options(_eval_lobes, state))
         curves = {name: np.asarray(v, dtype=np.float64) @ _LUMINANCE for name, v in zip(_validate.LOBE_NAMES, values)}
-        curves["total"] = sum(curves.values())
+        curves["total"] = cast("Float64Array", sum(curves.values()))  # (not 0: there are four lobes)
         peak = float(curves["total"].max())
         log = state["log"]
         top = 10.0 ** math.ceil(math.log10(peak)) if peak > 0.0 else 1.0
         floor = top * 10.0 ** -_POLAR_DECADES
 
-        def radius(f):
+        def radius(f: Float64Array) -> Float64Array:
             return np.log10(np.maximum(f, floor) / floor) if log else f
 
         r_max = float(_POLAR_DECADES) if log else (peak * 1.05 if peak > 0.0 else 1.0)
@@ -537,7 +577,7 @@ class Explorer:
                            centre_x=0.5, top=0.2)
         return self._savefig("polar")
 
-    def _build_slice(self, Figure) -> None:
+    def _build_slice(self, Figure: type[Figure]) -> None:
         colors = self._matplotlib.colors
         fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
         self._canvas(fig)
@@ -563,7 +603,7 @@ class Explorer:
                        "valid": valid}
         self._figures["slice"] = fig
 
-    def _draw_slice(self, material, state) -> bytes:
+    def _draw_slice(self, material: Material, state: Mapping[str, Any]) -> bytes:
         s = self._slice
         f = _eval_lobes(material, s["wi"], s["wo"], model=state["model"], **self._options(_eval_lobes, state))
         luminance = np.asarray(f.total(), dtype=np.float64) @ _LUMINANCE
@@ -590,7 +630,7 @@ class Explorer:
         s["ax"].set_title(f"BRDF slice at φd = 90°, log luminance\n{where}", pad=4)
         return self._savefig("slice")
 
-    def _build_albedo(self, Figure) -> None:
+    def _build_albedo(self, Figure: type[Figure]) -> None:
         fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
         self._canvas(fig)
         ax = fig.add_axes((0.13, 0.14, 0.83, 0.74))
@@ -606,12 +646,12 @@ class Explorer:
         self._albedo = {"ax": ax, "lines": lines, "bands": {}, "legend": self._legend(fig)}
         self._figures["albedo"] = fig
 
-    def _draw_albedo(self, material, state) -> bytes:
+    def _draw_albedo(self, material: Material, state: Mapping[str, Any]) -> bytes:
         a = self._albedo
         ax, lines = a["ax"], a["lines"]
         result = _albedo(material, np.cos(np.radians(_ALBEDO_ANGLES)), samples=_ALBEDO_SAMPLES, seed=0,
                          model=state["model"], **self._options(_albedo, state))
-        curves = {"total": (result.total, result.total_error)}
+        curves: dict[str, tuple[FloatArray, FloatArray]] = {"total": (result.total, result.total_error)}
         curves.update({name: (value, error) for name, value, error in
                        zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)})
         for band in a["bands"].values():
@@ -641,7 +681,7 @@ class Explorer:
 
     # ------------------------------------------------------------------
 
-    def write_pngs(self, prefix: str) -> dict:
+    def write_pngs(self, prefix: str) -> dict[str, str]:
         """Write the four pictures to ``{prefix}{name}.png``; returns ``{name: path}``."""
         paths = {}
         for name in OUTPUTS:
@@ -652,7 +692,7 @@ class Explorer:
 
     def close(self) -> None:
         """Close the widgets (and drop the figures)."""
-        def close(widget):
+        def close(widget: Any) -> None:
             for child in getattr(widget, "children", ()):
                 close(child)
             widget.close()
@@ -660,14 +700,14 @@ class Explorer:
         close(self.widget)
         self._figures.clear()
 
-    def _repr_mimebundle_(self, **kwargs):
+    def _repr_mimebundle_(self, **kwargs: Any) -> dict[str, Any] | None:
         return self.widget._repr_mimebundle_(**kwargs)
 
     def __repr__(self) -> str:
         return f"Explorer({self.material!r}, model={self.model.value!r}, resolution={self.resolution})"
 
 
-def explorer(material=None, *, model: str = "disney2014", resolution: int = 192) -> Explorer:
+def explorer(material: Material | str | None = None, *, model: Model = "disney2014", resolution: int = 192) -> Explorer:
     """An interactive BRDF explorer for Jupyter (module :mod:`principled_brdf.explorer`).
 
     ``material``: the starting material (a uniform Material or a preset name;

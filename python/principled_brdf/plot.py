@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import numbers
 import operator
+import typing
 
 import numpy as np
 
@@ -38,6 +39,19 @@ from . import _validate
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material
 from . import render as _render
+
+if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
+    from collections.abc import Iterable, Mapping
+    from types import ModuleType
+    from typing import Any, SupportsIndex
+
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+    from matplotlib.projections.polar import PolarAxes
+    from numpy.typing import NDArray
+
+    from ._typing import Float64Array, FloatArray, Model, RealArrayLike
+    from .render import _EnvironmentArg
 
 __all__ = ["brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves", "parameter_sweep", "blend_demo",
            "slice_directions", "SCALAR_PARAMETERS", "CHANNELS"]
@@ -54,7 +68,7 @@ CHANNELS = {
 }
 
 _LOBE_COLORS = {"diffuse": "tab:orange", "sheen": "tab:purple", "specular": "tab:blue", "clearcoat": "tab:green",
-                "total": "black"}
+                "multiple_scattering": "tab:cyan", "total": "black"}
 
 # Shading of pb.render.render_sphere, used where many spheres are shaded in one kernel call.
 _LIGHT_INTENSITY = 3.0
@@ -65,7 +79,7 @@ _BACKGROUND = "0.75"  # masked (undefined) pixels
 # argument checks
 
 
-def _pyplot():
+def _pyplot() -> ModuleType:
     try:
         import matplotlib.pyplot as plt
     except ImportError as error:  # pragma: no cover - depends on the environment
@@ -73,7 +87,7 @@ def _pyplot():
     return plt
 
 
-def _material(name: str, value) -> Material:
+def _material(name: str, value: object) -> Material:
     """A Material from a Material or a preset name; TypeError naming ``name`` otherwise."""
     if isinstance(value, Material):
         return value
@@ -85,7 +99,7 @@ def _material(name: str, value) -> Material:
     raise TypeError(f"{name}: expected a principled_brdf.Material or a preset name, got {type(value).__name__}")
 
 
-def _uniform_material(name: str, value) -> Material:
+def _uniform_material(name: str, value: object) -> Material:
     material = _material(name, value)
     if not material.is_uniform:
         raise ValueError(f"{name}: expected a uniform material (one value per parameter), "
@@ -93,7 +107,7 @@ def _uniform_material(name: str, value) -> Material:
     return material
 
 
-def _resolution(value, name: str = "resolution", minimum: int = 2) -> int:
+def _resolution(value: SupportsIndex, name: str = "resolution", minimum: int = 2) -> int:
     if isinstance(value, bool):
         raise TypeError(f"{name}: expected an integer, got bool")
     try:
@@ -105,7 +119,8 @@ def _resolution(value, name: str = "resolution", minimum: int = 2) -> int:
     return count
 
 
-def _real(name: str, value, lower=-np.inf, upper=np.inf, open_upper: bool = False, open_lower: bool = False) -> float:
+def _real(name: str, value: object, lower: float = -np.inf, upper: float = np.inf, open_upper: bool = False,
+          open_lower: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name}: expected a real number, got {type(value).__name__}")
     x = float(value)
@@ -117,13 +132,13 @@ def _real(name: str, value, lower=-np.inf, upper=np.inf, open_upper: bool = Fals
     return x
 
 
-def _channel(value) -> np.ndarray:
+def _channel(value: object) -> Float64Array:
     if not isinstance(value, str) or value not in CHANNELS:
         raise ValueError(f"channel: expected one of {', '.join(repr(c) for c in CHANNELS)}, got {value!r}")
     return np.asarray(CHANNELS[value], dtype=np.float64)
 
 
-def _axes(ax, polar: bool = False):
+def _axes(ax: Axes | None, polar: bool = False) -> Axes:
     """``ax`` checked, or a new Axes (polar if asked) on a new figure."""
     plt = _pyplot()
     if ax is None:
@@ -138,18 +153,18 @@ def _axes(ax, polar: bool = False):
     return ax
 
 
-def _project(rgb: np.ndarray, weights: np.ndarray) -> np.ndarray:
+def _project(rgb: RealArrayLike, weights: Float64Array) -> Float64Array:
     return np.asarray(rgb, dtype=np.float64) @ weights
 
 
-def _rgba(linear: np.ndarray, inside: np.ndarray, exposure: float) -> np.ndarray:
+def _rgba(linear: RealArrayLike, inside: NDArray[np.bool_], exposure: float) -> NDArray[np.uint8]:
     """8-bit sRGB with alpha 0 off the sphere, ``(..., R, R, 4)``."""
     rgb = _render.to_srgb8(linear, exposure)
     alpha = np.broadcast_to(np.where(inside, 255, 0).astype(np.uint8), rgb.shape[:-1])
     return np.concatenate([rgb, alpha[..., None]], axis=-1)
 
 
-def _sphere_axes(ax, title: str) -> None:
+def _sphere_axes(ax: Axes, title: str) -> None:
     ax.set_xticks([])
     ax.set_yticks([])
     for spine in ax.spines.values():
@@ -161,7 +176,8 @@ def _sphere_axes(ax, title: str) -> None:
 # 1. BRDF image slice
 
 
-def slice_directions(resolution: int, phi_d: float = 90.0):
+def slice_directions(resolution: int, phi_d: float = 90.0) -> tuple[FloatArray, FloatArray, Float64Array,
+                                                                    Float64Array]:
     """``(theta_h, theta_d, wi, wo)`` of the (θh, θd) slice at ``phi_d`` (degrees).
 
     ``theta_h``, ``theta_d``: pixel-centre angles in degrees, ``(resolution,)``
@@ -179,24 +195,25 @@ def slice_directions(resolution: int, phi_d: float = 90.0):
     dx, dy = sd * np.cos(phi), sd * np.sin(phi)
     sh, ch = np.sin(th), np.cos(th)
 
-    def rotate(x, y, z):  # rotation by θh about y: z -> h
+    def rotate(x: Float64Array, y: Float64Array, z: Float64Array) -> Float64Array:  # rotation by θh about y: z -> h
         return np.stack([x * ch + z * sh, y, z * ch - x * sh], axis=-1)
 
     return theta, theta.copy(), rotate(dx, dy, cd), rotate(-dx, -dy, cd)
 
 
-def _srgb_encode(c: np.ndarray) -> np.ndarray:
+def _srgb_encode(c: Float64Array) -> Float64Array:
     c = np.clip(c, 0.0, 1.0)
     return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
 
 
-def _srgb_decode(c: np.ndarray) -> np.ndarray:
+def _srgb_decode(c: Float64Array) -> Float64Array:
     return np.where(c <= 0.04045, c / 12.92, np.power((c + 0.055) / 1.055, 2.4))
 
 
-def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
-               log: bool = True, model: str = "disney2014", vmin=None, vmax=None, percentile=None,
-               exposure: float = 1.0, cmap: str = "inferno", colorbar: bool = True, ax=None):
+def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
+               log: bool = True, model: Model = "disney2014", vmin: float | None = None, vmax: float | None = None,
+               percentile: float | None = None, exposure: float = 1.0, cmap: str = "inferno", colorbar: bool = True,
+               ax: Axes | None = None) -> Axes:
     """The BRDF image slice f(θh, θd) at azimuth ``phi_d`` (Burley 2012, figures 3, 4 and 17).
 
     θh (half-vector angle from the normal, degrees) runs left to right from 0
@@ -223,6 +240,7 @@ def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel:
     rgb_mode = channel == "rgb"
     weights = np.asarray(CHANNELS["luminance"]) if rgb_mode else _channel(channel)
     _validate.model_index(model)
+    value: float | Float64Array | None  # vmin or vmax in the loop, then the projected slice
     for name, value in (("vmin", vmin), ("vmax", vmax)):
         if value is not None and _real(name, value, 0.0) <= 0.0 and log:
             raise ValueError(f"{name}: a logarithmic scale needs a positive value, got {value!r}")
@@ -253,6 +271,7 @@ def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel:
     extent = (0.0, 90.0, 0.0, 90.0)
     title = f"BRDF slice, φd = {float(phi_d):g}°" + (f", exposure {exposure:g}" if exposure != 1.0 else "")
 
+    assert norm.vmin is not None  # set above (for type checkers: Normalize.vmin is float | None)
     if rgb_mode:
         # display brightness (sRGB-encoded) = the luminance's place on the scale, as on the grey colour bar
         level = np.clip(np.ma.filled(norm(np.maximum(value, norm.vmin)), 0.0), 0.0, 1.0)
@@ -286,9 +305,9 @@ def brdf_slice(material, *, resolution: int = 256, phi_d: float = 90.0, channel:
 # 2. polar plot in the plane of incidence
 
 
-def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = False, model: str = "disney2014",
-                resolution: int = 721, channel: str = "luminance", log: bool = False, decades: float = 4.0,
-                legend: bool = True, ax=None):
+def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True, cosine: bool = False,
+                model: Model = "disney2014", resolution: int = 721, channel: str = "luminance", log: bool = False,
+                decades: float = 4.0, legend: bool = True, ax: Axes | None = None) -> PolarAxes:
     """f(wi, wo) in the plane of incidence, per lobe and in total, on a polar Axes.
 
     ``wo = (sin θo, 0, cos θo)`` (``theta_o`` in degrees, in (-90, 90)), ``wi =
@@ -310,7 +329,7 @@ def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = 
     weights = _channel(channel)
     decades = _real("decades", decades, 0.0, open_lower=True)
     _validate.model_index(model)
-    ax = _axes(ax, polar=True)
+    ax = typing.cast("PolarAxes", _axes(ax, polar=True))  # checked: its name is "polar"
     from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
 
     t = np.radians(np.linspace(-90.0, 90.0, n))
@@ -319,15 +338,15 @@ def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = 
     wo = np.array([np.sin(np.radians(theta)), 0.0, np.cos(np.radians(theta))])
     values = _eval_lobes(material, wi, wo, cosine=cosine, model=model)
     curves = {name: _project(v, weights) for name, v in zip(_validate.LOBE_NAMES, values)}
-    total = sum(curves.values())
+    total = typing.cast("Float64Array", sum(curves.values()))  # (not 0: there are four lobes)
     peak = float(total.max()) if total.max() > 0 else 1.0
     if log:
         floor = np.log10(peak) - decades
 
-        def radius(f):  # log10 f above the floor; nothing below it
+        def radius(f: Float64Array) -> Float64Array:  # log10 f above the floor; nothing below it
             return np.maximum(np.log10(np.maximum(f, 1e-300)) - floor, 0.0)
     else:
-        def radius(f):
+        def radius(f: Float64Array) -> Float64Array:
             return f
 
     drawn = [(name, curve) for name, curve in curves.items() if lobes and np.any(curve > 0.0)]
@@ -363,9 +382,10 @@ def polar_lobes(material, theta_o: float, *, lobes: bool = True, cosine: bool = 
 # 3. lit sphere, optionally with an environment
 
 
-def lit_sphere(material, *, resolution: int = 256, light=_render.DEFAULT_LIGHT, light_intensity: float = 3.0,
-               environment="sky", environment_samples: int = _render.DEFAULT_SAMPLES, seed: int = 0,
-               exposure: float = 1.0, model: str = "disney2014", ax=None):
+def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealArrayLike = _render.DEFAULT_LIGHT,
+               light_intensity: float = 3.0, environment: _EnvironmentArg = "sky",
+               environment_samples: int = _render.DEFAULT_SAMPLES, seed: int = 0, exposure: float = 1.0,
+               model: Model = "disney2014", ax: Axes | None = None, energy_compensation: bool = False) -> Axes:
     """The material on a sphere (``pb.render.render_sphere``), tone mapped to sRGB; returns the Axes.
 
     ``material`` is uniform or per pixel (leading shape ``(resolution,
@@ -378,6 +398,7 @@ def lit_sphere(material, *, resolution: int = 256, light=_render.DEFAULT_LIGHT, 
     ``environment_samples`` importance samples at lattice points (deterministic
     for a ``seed``). ``exposure`` scales the linear image before the tone
     curve (``pb.render.tone_map``). Off the sphere is transparent.
+    ``energy_compensation`` as in ``pb.eval``.
     """
     material = _material("material", material)
     n = _resolution(resolution)
@@ -392,7 +413,8 @@ def lit_sphere(material, *, resolution: int = 256, light=_render.DEFAULT_LIGHT, 
     ax = _axes(ax)
 
     image = _render.render_sphere(material, n, light=light, light_intensity=intensity, model=model,
-                                  environment=environment, samples=count, seed=seed)
+                                  environment=environment, samples=count, seed=seed,
+                                  energy_compensation=energy_compensation)
     inside, _ = _render.sphere_frames(n)
     ax.imshow(_rgba(image, inside, exposure), interpolation="nearest")
     _sphere_axes(ax, "lit sphere" + (" + environment" if environment is not None else ""))
@@ -403,8 +425,9 @@ def lit_sphere(material, *, resolution: int = 256, light=_render.DEFAULT_LIGHT, 
 # 4. directional albedo
 
 
-def albedo_curves(material, *, angles=np.linspace(0, 89, 46), samples: int = 1 << 14, seed: int = 0,
-                  model: str = "disney2014", channel: str = "luminance", lobes: bool = True, ax=None):
+def albedo_curves(material: Material | str, *, angles: RealArrayLike = np.linspace(0, 89, 46), samples: int = 1 << 14,
+                  seed: int = 0, model: Model = "disney2014", channel: str = "luminance", lobes: bool = True,
+                  ax: Axes | None = None, energy_compensation: bool = False) -> Axes:
     """Directional albedo ``E(θo) = ∫ f cos θl dωi`` against θo (``pb.albedo``), per lobe and in total.
 
     ``angles``: view angles in degrees, in [0, 90). Each point is the mean of
@@ -412,6 +435,7 @@ def albedo_curves(material, *, angles=np.linspace(0, 89, 46), samples: int = 1 <
     (for ``"luminance"`` the luminance-weighted sum of the per-channel errors,
     an upper bound). Lobes whose albedo is zero at every angle are left out.
     Returns the Axes; lines carry labels ``"total"``, ``"diffuse"``, ...
+    (``"multiple_scattering"`` with ``energy_compensation``, as in ``pb.albedo``).
     """
     material = _uniform_material("material", material)
     weights = _channel(channel)
@@ -424,8 +448,9 @@ def albedo_curves(material, *, angles=np.linspace(0, 89, 46), samples: int = 1 <
     _validate.model_index(model)
     ax = _axes(ax)
 
-    result = _albedo(material, np.cos(np.radians(theta)), samples=samples, seed=seed, model=model)
-    curves = [("total", result.total, result.total_error)]
+    result = _albedo(material, np.cos(np.radians(theta)), samples=samples, seed=seed, model=model,
+                     energy_compensation=energy_compensation)
+    curves: list[tuple[str, FloatArray, FloatArray]] = [("total", result.total, result.total_error)]
     if lobes:
         curves += [(name, value, error) for name, value, error in zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)]
     for name, value, error in curves:
@@ -449,12 +474,14 @@ def albedo_curves(material, *, angles=np.linspace(0, 89, 46), samples: int = 1 <
 
 
 def _default_sweep_base() -> Material:
-    return Material(base_color=(0.7, 0.2, 0.1), roughness=0.5)
+    return Material(base_color=(0.5, 0.03, 0.02), roughness=0.5)  # a saturated red: the lobes show against it
 
 
-def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11, resolution: int = 64, ranges=None,
-                    light=_render.DEFAULT_LIGHT, environment="sky", exposure: float = 1.0, model: str = "disney2014",
-                    figsize=None):
+def parameter_sweep(base: Material | str | None = None, *, parameters: str | Iterable[str] = SCALAR_PARAMETERS,
+                    steps: int = 11, resolution: int = 64, ranges: Mapping[str, tuple[float, float]] | None = None,
+                    light: RealArrayLike = _render.DEFAULT_LIGHT, environment: _EnvironmentArg = "sky",
+                    exposure: float = 1.0, model: Model = "disney2014",
+                    figsize: tuple[float, float] | None = None) -> Figure:
     """The grid of Burley 2012 figure 16: one row per parameter, that parameter
     going from 0 to 1 (or ``ranges[name] = (lo, hi)``) in ``steps`` spheres
     along the row, every other parameter as in ``base``; returns the Figure.
@@ -490,7 +517,7 @@ def parameter_sweep(base=None, *, parameters=SCALAR_PARAMETERS, steps: int = 11,
         spans.append((_real(f"ranges[{name!r}]", lo), _real(f"ranges[{name!r}]", hi)))
 
     rows = len(names)
-    params = {"base_color": base.base_color}
+    params: dict[str, Any] = {"base_color": base.base_color}  # (Any: Material(**) also takes a bool keyword)
     for name in SCALAR_PARAMETERS:
         grid = np.full((rows, count), float(getattr(base, name)))
         if name in names:
@@ -542,8 +569,9 @@ def _checker(resolution: int, cells: int = 8) -> np.ndarray:
     return ((index[:, None] + index[None, :]) % 2).astype(np.float64)
 
 
-def blend_demo(a, b, *, mask=None, resolution: int = 256, light=_render.DEFAULT_LIGHT, environment="sky",
-               exposure: float = 1.0, model: str = "disney2014", ax=None):
+def blend_demo(a: Material | str, b: Material | str, *, mask: RealArrayLike | None = None, resolution: int = 256,
+               light: RealArrayLike = _render.DEFAULT_LIGHT, environment: _EnvironmentArg = "sky",
+               exposure: float = 1.0, model: Model = "disney2014", ax: Axes | None = None) -> Axes:
     """A sphere of ``Material.mix(a, b, mask)`` with a per-pixel mask; returns the Axes.
 
     ``a``, ``b``: Materials or preset names. ``mask``: weights of ``b`` in

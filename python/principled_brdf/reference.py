@@ -70,12 +70,13 @@ def _prepare(material: Material, wi: RealArrayLike, wo: RealArrayLike,
 # reference is one float64 loop, and always checks its directions.
 
 def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
-         cosine: bool = False, layout: Layout = "aos") -> Float64Array:
+         cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False) -> Float64Array:
     """f(wi, wo) in 1/sr as float64 ``(..., 3)`` (``(3, ...)`` for ``layout="soa"``); times cos θl if ``cosine``."""
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     cosine = _validate.flag("cosine", cosine)
-    f = _core.reference_eval(wi_rows, wo_rows, params, model_id, False)
+    f = _core.reference_eval(wi_rows, wo_rows, params, model_id, False,
+                             _validate.flag("energy_compensation", energy_compensation))
     if cosine:
         f *= np.maximum(wi_rows[:, 2:3], 0.0)
     return _as_layout(f.reshape(shape + (3,)), soa)
@@ -83,13 +84,16 @@ def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mod
 
 def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
               wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014",
-              cosine: bool = False, layout: Layout = "aos") -> Gradient:
+              cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False) -> Gradient:
     """f in float64 and its Jacobian in the material's parameters (README "Gradients"):
     ``value`` ``(..., 3)`` as :func:`eval`, ``jacobian`` ``(..., 3, P)`` with
     ``jacobian[..., c, k] = ∂f_c/∂names[k]``, ``names`` the P parameters ``wrt``
     selects (default all 13, ``base_color`` as three channels). A uniform
     parameter still gets a per-element derivative. ``layout="soa"``: ``(3, ...)``
-    and ``(3, P, ...)``."""
+    and ``(3, P, ...)``. ``energy_compensation=True`` raises NotImplementedError."""
+    if _validate.flag("energy_compensation", energy_compensation):
+        raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
+                                  "multiple-scattering lobe is not implemented)")
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     cosine = _validate.flag("cosine", cosine)
@@ -104,12 +108,14 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
 
 
 def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
-               cosine: bool = False, layout: Layout = "aos") -> Lobes:
-    """The four lobes as a :class:`Lobes` of float64 ``(..., 3)`` (``(3, ...)``) arrays."""
+               cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False) -> Lobes:
+    """The lobes as a :class:`Lobes` of float64 ``(..., 3)`` (``(3, ...)``) arrays
+    (multiple_scattering 0 unless ``energy_compensation``)."""
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     cosine = _validate.flag("cosine", cosine)
-    lobes = _core.reference_eval(wi_rows, wo_rows, params, model_id, True)
+    lobes = _core.reference_eval(wi_rows, wo_rows, params, model_id, True,
+                                 _validate.flag("energy_compensation", energy_compensation))
     if cosine:
         lobes *= np.maximum(wi_rows[:, None, 2:3], 0.0)
     return Lobes(*(_as_layout(lobes[:, k, :].reshape(shape + (3,)), soa) for k in range(len(Lobes._fields))))
@@ -154,7 +160,8 @@ def _check_material(material: object) -> None:
 
 
 def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Model = "disney2014",
-           specular_sampler: SpecularSampler = "visible", layout: Layout = "aos") -> Sample:
+           specular_sampler: SpecularSampler = "visible", layout: Layout = "aos",
+           energy_compensation: bool = False) -> Sample:
     """Draws ``wi`` for each ``wo`` from the three-lobe mixture of README "Sampling and pdf".
 
     ``u`` holds three uniforms in [0, 1] per element, ``(u0, u1, u2)`` on the last
@@ -177,17 +184,19 @@ def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Mo
         return Sample(empty, np.zeros(shape), empty.copy(), np.zeros(shape, np.int32))
     wi, density, weight, lobe = _core.reference_sample(
         _shared_or_rows(wo, shape, 3), _shared_or_rows(u, shape, 3), _material_rows(material, shape),
-        model_id, sampler_id)
+        model_id, sampler_id, _validate.flag("energy_compensation", energy_compensation))
     return Sample(_as_layout(_to_shape(wi, shape, (3,)), soa), _to_shape(density, shape),
                   _as_layout(_to_shape(weight, shape, (3,)), soa), _to_shape(lobe, shape))
 
 
 def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
-        specular_sampler: SpecularSampler = "visible", layout: Layout = "aos") -> Float64Array:
+        specular_sampler: SpecularSampler = "visible", layout: Layout = "aos",
+        energy_compensation: bool = False) -> Float64Array:
     """The mixture density ``P0 pdf0 + P1 pdf1 + P2 pdf2`` of ``wi`` given ``wo``, float64 ``(...)``.
 
     0 unless both directions lie strictly above the horizon. It does not depend on
-    ``model`` (accepted for symmetry with :func:`sample`; only the weights do).
+    ``model`` (accepted for symmetry with :func:`sample`; only the weights do)
+    unless ``energy_compensation``, whose lobe's weight reads the model's tables.
     """
     _check_material(material)
     model_id = _validate.model_index(model)
@@ -199,17 +208,23 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
     if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape)
     density = _core.reference_pdf(_shared_or_rows(wi, shape, 3), _shared_or_rows(wo, shape, 3),
-                                  _material_rows(material, shape), model_id, sampler_id)
+                                  _material_rows(material, shape), model_id, sampler_id,
+                                  _validate.flag("energy_compensation", energy_compensation))
     return _to_shape(density, shape)
 
 
-def lobe_probabilities(material: Material, wo: RealArrayLike) -> Float64Array:
+def lobe_probabilities(material: Material, wo: RealArrayLike, *, model: Model = "disney2014",
+                       energy_compensation: bool = False) -> Float64Array:
     """``(P0, P1, P2)`` on the last axis, ``(..., 3)``: the chances of the cosine, primary
-    specular and clearcoat lobes at ``wo`` (README "Lobe probabilities")."""
+    specular and clearcoat lobes at ``wo`` (README "Lobe probabilities"); with
+    ``energy_compensation`` the cosine lobe's includes the multiple-scattering lobe's."""
     _check_material(material)
+    model_id = _validate.model_index(model)
+    compensated = _validate.flag("energy_compensation", energy_compensation)
     wo = _validate.directions("wo", wo)
     shape = _validate.broadcast_leading(wo=wo.shape[:-1], material=material.shape)
     if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape + (3,))
-    p = _core.reference_lobe_probabilities(_shared_or_rows(wo, shape, 3), _material_rows(material, shape))
+    p = _core.reference_lobe_probabilities(_shared_or_rows(wo, shape, 3), _material_rows(material, shape), model_id,
+                                           compensated)
     return _to_shape(p, shape, (3,))

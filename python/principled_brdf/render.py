@@ -14,6 +14,7 @@ writes PNG, OpenEXR (linear) or ``.npy`` (linear) by the file's extension.
 from __future__ import annotations
 
 import struct
+import typing
 import zlib
 
 import numpy as np
@@ -23,6 +24,21 @@ from ._batch import eval as _eval
 from ._batch import random_uniforms as _random_uniforms
 from ._batch import sample as _sample
 from .material import Material
+
+if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
+    import os
+    from collections.abc import Callable
+    from typing import Any, Literal, Union
+
+    from numpy.typing import ArrayLike, NDArray
+
+    from ._typing import Float32Array, Float64Array, FloatArray, Model, RealArrayLike
+
+    #: L(direction): camera-space directions (..., 3) to RGB radiance (..., 3)
+    _Environment = Callable[[Float32Array], ArrayLike]
+    #: what the ``environment=`` arguments take: "sky", None, False (none), True (the sky) or an L(direction)
+    _EnvironmentArg = Union[str, bool, None, _Environment]
+    _ToneCurve = Literal["filmic", "reinhard", "clip"]
 
 __all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_frames", "lattice_uniforms", "tone_map",
            "to_srgb8", "png_bytes", "write_png", "save_image", "IMAGE_FORMATS", "DEFAULT_LIGHT", "DEFAULT_SAMPLES", "MAX_RESOLUTION",
@@ -35,14 +51,14 @@ MAX_RESOLUTION = 16384
 DEFAULT_SAMPLES = 64  # sky samples per pixel: with the lattice below, no visible noise on any preset
 
 
-def _resolution(value) -> int:
+def _resolution(value: object) -> int:
     value = _validate.integer("resolution", value)
     if not 2 <= value <= MAX_RESOLUTION:
         raise ValueError(f"resolution: expected 2 to {MAX_RESOLUTION} pixels, got {value}")
     return value
 
 
-def _light_direction(value) -> np.ndarray:
+def _light_direction(value: object) -> Float64Array:
     light = _validate.as_real_array("light", value)
     if light.shape != (3,):
         raise ValueError(f"light: expected a 3-vector towards the light, got shape {light.shape}")
@@ -53,7 +69,7 @@ def _light_direction(value) -> np.ndarray:
     return light / length
 
 
-def _non_negative(name: str, value) -> float:
+def _non_negative(name: str, value: object) -> float:
     array = _validate.as_real_array(name, value)
     if array.shape != ():
         raise ValueError(f"{name}: expected one number, got shape {array.shape}")
@@ -61,7 +77,7 @@ def _non_negative(name: str, value) -> float:
     return float(array)
 
 
-def sphere_frames(resolution: int):
+def sphere_frames(resolution: int) -> tuple[NDArray[np.bool_], Callable[[RealArrayLike], Float32Array]]:
     """Per-pixel local directions for a sphere image.
 
     Returns ``(inside, to_local)``: ``inside`` is the ``(resolution, resolution)``
@@ -81,7 +97,7 @@ def sphere_frames(resolution: int):
     tangent /= np.linalg.norm(tangent, axis=-1, keepdims=True)
     bitangent = np.cross(normal, tangent)
 
-    def to_local(direction) -> np.ndarray:
+    def to_local(direction: RealArrayLike) -> Float32Array:
         d = np.asarray(direction, dtype=np.float64)
         d = d / np.linalg.norm(d)
         local = np.stack([tangent @ d, bitangent @ d, normal @ d], axis=-1)
@@ -91,7 +107,7 @@ def sphere_frames(resolution: int):
     return inside, to_local
 
 
-def _environment(value):
+def _environment(value: _EnvironmentArg) -> _Environment | None:
     """``"sky"`` (the default sky), None or False (none), or a callable ``L(direction)``."""
     if isinstance(value, str):
         if value != "sky":
@@ -106,9 +122,10 @@ def _environment(value):
     return value
 
 
-def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT, light_intensity: float = 3.0,
-                  ambient: float = 0.0, model: str = "disney2014", *, environment="sky", samples: int = DEFAULT_SAMPLES,
-                  seed: int = 0) -> np.ndarray:
+def render_sphere(material: Material, resolution: int = 256, light: RealArrayLike = DEFAULT_LIGHT,
+                  light_intensity: float = 3.0, ambient: float = 0.0, model: Model = "disney2014", *,
+                  environment: _EnvironmentArg = "sky", samples: int = DEFAULT_SAMPLES,
+                  seed: int = 0, energy_compensation: bool = False) -> Float32Array:
     """Linear RGB ``(resolution, resolution, 3)`` image of ``material`` on a sphere.
 
     Lit by a directional light (``light``: direction towards it in camera
@@ -123,7 +140,7 @@ def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT
     ``material`` may be uniform or per pixel (leading shape ``(resolution, resolution)``,
     e.g. made by :meth:`Material.mix` with a mask); a leading shape ``S + (1, 1)``
     renders one sphere per material, ``S + (resolution, resolution, 3)``, in one
-    kernel call. Background is 0.
+    kernel call. Background is 0. ``energy_compensation`` as in ``pb.eval``.
     """
     light = _light_direction(light)
     light_intensity = _non_negative("light_intensity", light_intensity)
@@ -131,16 +148,20 @@ def render_sphere(material: Material, resolution: int = 256, light=DEFAULT_LIGHT
     environment = _environment(environment)
     inside, to_local = sphere_frames(resolution)
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
-    radiance = np.float32(light_intensity) * _eval(material, wi, wo, cosine=True, model=model)
+    radiance = np.float32(light_intensity) * _eval(material, wi, wo, cosine=True, model=model,
+                                                   energy_compensation=energy_compensation)
     if ambient > 0.0:
         radiance += np.float32(ambient) * np.asarray(material.base_color, dtype=np.float32)
     if environment is not None:
-        radiance += render_environment(material, resolution, environment, samples, seed, model).astype(np.float32)
+        radiance += render_environment(material, resolution, environment, samples, seed, model,
+                                       energy_compensation=energy_compensation).astype(np.float32)
     radiance[..., ~inside, :] = 0.0
     return radiance
 
 
-def sky_environment(direction, zenith=(0.65, 0.75, 0.9), horizon=(1.0, 1.0, 1.0), ground=(0.12, 0.11, 0.1)):
+def sky_environment(direction: RealArrayLike, zenith: RealArrayLike = (0.65, 0.75, 0.9),
+                    horizon: RealArrayLike = (1.0, 1.0, 1.0),
+                    ground: RealArrayLike = (0.12, 0.11, 0.1)) -> Float32Array:
     """A simple sky/ground gradient ``L(w)`` (RGB radiance, float32) for camera-space directions ``(..., 3)``.
 
     y is up (as in :mod:`principled_brdf.render`): above the horizon the sky
@@ -165,7 +186,7 @@ _PHI3 = 1.2207440846057596
 _LATTICE_STEP = np.array([_PHI3 ** -1, _PHI3 ** -2, _PHI3 ** -3])
 
 
-def lattice_uniforms(count: int, shape: tuple, seed: int = 0, first: int = 0) -> np.ndarray:
+def lattice_uniforms(count: int, shape: tuple[int, ...], seed: int = 0, first: int = 0) -> Float32Array:
     """``(count,) + shape + (3,)`` float32 uniforms: sample ``k`` of each element is the
     Kronecker point ``frac(k α + s)``, ``s`` the element's random shift (Cranley-Patterson
     rotation, from ``seed``), for ``k = first .. first + count - 1``. Every element gets a
@@ -178,15 +199,17 @@ def lattice_uniforms(count: int, shape: tuple, seed: int = 0, first: int = 0) ->
     return np.minimum(points, np.nextafter(np.float32(1.0), np.float32(0.0)))
 
 
-def render_environment(material: Material, resolution: int = 256, environment=None, samples: int = DEFAULT_SAMPLES,
-                       seed: int = 0, model: str = "disney2014") -> np.ndarray:
+def render_environment(material: Material, resolution: int = 256, environment: _EnvironmentArg = None,
+                       samples: int = DEFAULT_SAMPLES, seed: int = 0, model: Model = "disney2014", *,
+                       energy_compensation: bool = False) -> Float64Array:
     """Linear RGB ``(resolution, resolution, 3)`` (or ``S + (resolution, resolution, 3)`` as
     :func:`render_sphere`): the sphere lit by ``environment`` alone (camera-space directions
     ``(..., 3)`` to RGB radiance; default :func:`sky_environment`), per pixel
     ``∫ f L(wi) cos θl dωi`` estimated from ``samples`` importance samples (``pb.sample``) at
     :func:`lattice_uniforms` points shifted per pixel from ``seed``: deterministic, and far
-    less noisy than independent samples."""
-    environment = sky_environment if environment is None else _environment(environment)
+    less noisy than independent samples. ``energy_compensation`` as in ``pb.sample``."""
+    # (False, which _environment maps to None, is not checked here: calling it fails as before)
+    environment = typing.cast("_Environment", sky_environment if environment is None else _environment(environment))
     samples = _validate.integer("samples", samples)
     if samples < 1:
         raise ValueError(f"samples: expected at least 1, got {samples}")
@@ -203,7 +226,7 @@ def render_environment(material: Material, resolution: int = 256, environment=No
     for start in range(0, samples, chunk):
         count = min(chunk, samples - start)
         u = lattice_uniforms(count, inside.shape, seed, first=start).reshape((count,) + spheres + inside.shape + (3,))
-        wi = _sample(material, wo, u=u, model=model)
+        wi = _sample(material, wo, u=u, model=model, energy_compensation=energy_compensation)
         local = [wi.wi[..., j] for j in range(3)]
         direction = np.stack([local[0] * frame[k][..., 0] + local[1] * frame[k][..., 1] + local[2] * frame[k][..., 2]
                               for k in range(3)], axis=-1)
@@ -221,18 +244,18 @@ REINHARD_WHITE = 4.0  # the luminance the "reinhard" curve maps to display white
 FILMIC_WHITE = (0.56 + (0.56**2 + 4 * 0.08 * 0.14) ** 0.5) / 0.16  # 7.24: the "filmic" curve reaches 1 (0.08 x² - 0.56 x - 0.14 = 0)
 
 
-def _filmic(luminance: np.ndarray) -> np.ndarray:
+def _filmic(luminance: Float64Array) -> Float64Array:
     # Narkowicz's 2015 fit of the ACES reference rendering transform, y = x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14):
     # a toe, midtones near the identity (0.18 -> 0.27, 1 -> 0.80) and a shoulder reaching 1 at FILMIC_WHITE
     mapped = luminance * (2.51 * luminance + 0.03) / (luminance * (2.43 * luminance + 0.59) + 0.14)
     return np.where(luminance < FILMIC_WHITE, mapped, 1.0)
 
 
-def _reinhard(luminance: np.ndarray) -> np.ndarray:
+def _reinhard(luminance: Float64Array) -> Float64Array:
     return luminance * (1.0 + luminance / REINHARD_WHITE**2) / (1.0 + luminance)
 
 
-def tone_map(linear: np.ndarray, exposure: float = 1.0, curve: str = "filmic") -> np.ndarray:
+def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "filmic") -> Float64Array:
     """Scene-referred linear RGB ``(..., 3)`` to display-referred linear RGB in [0, 1].
 
     The curve maps each pixel's luminance ``Y`` (Rec. 709 weights) to ``Y'``;
@@ -257,14 +280,14 @@ def tone_map(linear: np.ndarray, exposure: float = 1.0, curve: str = "filmic") -
     return c / np.maximum(1.0, c.max(axis=-1, keepdims=True))
 
 
-def to_srgb8(linear: np.ndarray, exposure: float = 1.0, curve: str = "filmic") -> np.ndarray:
+def to_srgb8(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "filmic") -> NDArray[np.uint8]:
     """Linear RGB to 8-bit sRGB for saving or showing: :func:`tone_map`, then the sRGB encoding."""
     c = tone_map(linear, exposure, curve)
     srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
     return np.round(srgb * 255.0).astype(np.uint8)
 
 
-def png_bytes(image: np.ndarray) -> bytes:
+def png_bytes(image: RealArrayLike) -> bytes:
     """An 8-bit ``(H, W, 3)`` RGB or ``(H, W, 4)`` RGBA image as PNG bytes (no dependency beyond zlib)."""
     pixels = np.ascontiguousarray(image, dtype=np.uint8)
     if pixels.ndim != 3 or pixels.shape[2] not in (3, 4):
@@ -280,7 +303,7 @@ def png_bytes(image: np.ndarray) -> bytes:
             + chunk(b"IEND", b""))
 
 
-def write_png(path: str, image: np.ndarray) -> None:
+def write_png(path: str | os.PathLike[str], image: RealArrayLike) -> None:
     """Write an 8-bit RGB ``(H, W, 3)`` (or RGBA) image as PNG (:func:`png_bytes`)."""
     data = png_bytes(image)
     with open(path, "wb") as f:
@@ -292,7 +315,8 @@ IMAGE_FORMATS = {".png": "8-bit sRGB after tone_map", ".exr": "linear float32 RG
                  ".npy": "linear float32 RGB (numpy)"}
 
 
-def save_image(path, linear: np.ndarray, exposure: float = 1.0, curve: str = "filmic") -> str:
+def save_image(path: str | os.PathLike[str], linear: RealArrayLike, exposure: float = 1.0,
+               curve: _ToneCurve = "filmic") -> str:
     """Write a linear RGB ``(H, W, 3)`` image in the format of ``path``'s extension
     (:data:`IMAGE_FORMATS`): ``.png`` tone-mapped and sRGB-encoded (:func:`to_srgb8`),
     ``.exr`` and ``.npy`` the linear values times ``exposure`` (high dynamic range kept).

@@ -43,7 +43,7 @@ struct ParamSlot {
 
 enum class Output : int {
     kTotal = 0,  // f
-    kLobes = 1,  // diffuse, sheen, specular, clearcoat
+    kLobes = 1,  // diffuse, sheen, specular, clearcoat, multiple_scattering
     kPdf = 2,    // the sampling pdf of (wi, wo)
     kGradient = 3,  // f and its Jacobian in the parameter slots
     kValuePdf = 4,  // f and the sampling pdf of (wi, wo), in one pass
@@ -89,7 +89,9 @@ struct EvalJob {
     Model model = Model::kDisney2014;
     Output output = Output::kTotal;
     bool cosine = false;  // multiply by cos θl
-    // out[0] is f; with Output::kLobes, out[0..3] are the four lobes.
+    // the multiple-scattering energy compensation (model/energy.hpp); not with Output::kGradient
+    bool energy_compensation = false;
+    // out[0] is f; with Output::kLobes, out[0..4] are the lobes of kLobeNames.
     MutableVec3Array out[kLobeCount];
     // Output::kGradient: out[0] is f, and element i's ∂f_c/∂p is at
     // jacobian[kJacobianWidth i + kParamSlots c + p] (an (N, 3, 13) array) or,
@@ -116,6 +118,7 @@ struct SampleJob {
     ParamSlot params[kParamSlots];
     Model model = Model::kDisney2014;
     SpecularSampler sampler = SpecularSampler::kVisibleNormals;
+    bool energy_compensation = false;  // as in EvalJob
     MutableVec3Array wi, weight;  // outputs, (N, 3) or (3, N)
     float* pdf = nullptr;         // output, N
     std::int32_t* lobe = nullptr; // output, N: 0 cosine, 1 specular, 2 clearcoat

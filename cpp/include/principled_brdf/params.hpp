@@ -69,8 +69,9 @@ enum class Model : int {
 };
 inline constexpr std::array<const char*, 2> kModelNames{"disney2014", "disney2012"};
 
-// The lobes of f, in the order eval_lobes returns them.
-inline constexpr std::array<const char*, 4> kLobeNames{"diffuse", "sheen", "specular", "clearcoat"};
+// The lobes of f, in the order eval_lobes returns them; multiple_scattering is
+// the energy compensation's (0 unless it is on).
+inline constexpr std::array<const char*, 5> kLobeNames{"diffuse", "sheen", "specular", "clearcoat", "multiple_scattering"};
 inline constexpr int kLobeCount = static_cast<int>(kLobeNames.size());
 
 // The lobes sampling draws from, by the index a sample reports.

@@ -92,7 +92,22 @@ struct GradientShading {
 
 inline GradientShading gradient_shading_of(const double* row) { return {shading_of(row), material_partials_of(row)}; }
 
+// A material's shading with its multiple-scattering lobe (energy compensation,
+// Kulla & Conty 2017; model/energy.hpp), for one model's tables.
+struct Compensated {
+    Shading<double> shading;
+    MultipleScatteringLobe<double> ms;
+};
+
+template <Model model>
+Compensated compensated_of(const double* row) {
+    const Shading<double> s = shading_of(row);
+    return {s, multiple_scattering_of(row, s, model)};
+}
+
 using ShadingCache = RowCache<Shading<double>, &shading_of<double>>;
+template <Model model>
+using CompensatedCache = RowCache<Compensated, &compensated_of<model>>;
 using GradientShadingCache = RowCache<GradientShading, &gradient_shading_of>;
 
 // The four lobes, each already weighted as it enters the sum.
@@ -101,7 +116,8 @@ struct Lobes {
     Vector3d sheen = Vector3d::Zero();      // times (1 - metallic)
     Vector3d specular = Vector3d::Zero();   // primary GGX lobe
     Vector3d clearcoat = Vector3d::Zero();  // grey
-    Vector3d total() const { return diffuse + sheen + specular + clearcoat; }
+    Vector3d multiple_scattering = Vector3d::Zero();  // energy compensation (model/energy.hpp); 0 when off
+    Vector3d total() const { return diffuse + sheen + specular + clearcoat + multiple_scattering; }
 };
 
 inline Vec3<double> vec3(const Vector3d& w) { return {w.x(), w.y(), w.z()}; }
@@ -231,6 +247,64 @@ inline Sample sample(const Shading<double>& s, const Vector3d& wo, double u0, do
 inline Sample sample(const Material& m, const Vector3d& wo, double u0, double u1, double u2,
                      Model model = Model::kDisney2014, SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
     return sample(m.shading(), wo, u0, u1, u2, model, sampler);
+}
+
+// ---------------------------------------------------------------- energy compensation (model/energy.hpp)
+// The same functions for a Compensated material: f gains the multiple-scattering
+// lobe, the cosine lobe's mixture weight gains w3 = its albedo at wo. `model`
+// must be the one c was prepared for (its tables).
+
+inline double missing_energy_of_view(const Compensated& c, const Vector3d& wo) { return c.ms.missing_energy(wo.z()); }
+
+inline Vector3d multiple_scattering_of(const Compensated& c, const Vector3d& wi, const Vector3d& wo) {
+    const Geometry<double> g = geometry_of(vec3(wi), vec3(wo));
+    if (!above_surface(g)) return Vector3d::Zero();
+    return vector3d(c.ms.rgb(c.ms.value(g, c.ms.missing_energy(wo.z()))));
+}
+
+inline Lobes eval_lobes(const Compensated& c, const Vector3d& wi, const Vector3d& wo, Model model = Model::kDisney2014) {
+    Lobes out = eval_lobes(c.shading, wi, wo, model);
+    out.multiple_scattering = multiple_scattering_of(c, wi, wo);
+    return out;
+}
+
+inline Vector3d eval(const Compensated& c, const Vector3d& wi, const Vector3d& wo, Model model = Model::kDisney2014) {
+    return eval(c.shading, wi, wo, model) + multiple_scattering_of(c, wi, wo);
+}
+
+inline Shading<double> compensated_mixture(const Compensated& c, const Vector3d& wo) {
+    return with_multiple_scattering_weight(c.shading, c.ms.weight(c.ms.missing_energy(wo.z())));
+}
+
+// (P0, P1, P2): the cosine lobe's chance includes the multiple-scattering lobe's
+inline std::array<double, 3> lobe_probabilities(const Compensated& c, const Vector3d& wo) {
+    return lobe_probabilities(compensated_mixture(c, wo), wo);
+}
+
+inline double pdf(const Compensated& c, const Vector3d& wi, const Vector3d& wo,
+                  SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
+    return pdf(compensated_mixture(c, wo), wi, wo, sampler);
+}
+
+template <Model model>
+Sample compensated_sample_of(const Compensated& c, const Vec3<double>& wo, const Uniforms<double>& u,
+                             SpecularSampler sampler) {
+    const double missing_wo = c.ms.missing_energy(wo.z);
+    const Shading<double> s = with_multiple_scattering_weight(c.shading, c.ms.weight(missing_wo));
+    const double fv = schlick_weight(wo.z);
+    const LobeWeights<double> weights = lobe_weights(fv, s);
+    const LobeChoice<double> choice = choose_lobe(u.u0, s, weights);
+    const CompensatedWeighed<double> cw =
+            weigh_compensated<model>(wo, fv, weights, sample_direction(wo, u, choice, s, sampler), s, c.ms, missing_wo, sampler);
+    const Weighed<double>& w = cw.weighed;
+    return {vector3d(w.wi), w.pdf, vector3d(w.weight), choice.cosine ? 0 : choice.specular ? 1 : 2};
+}
+
+inline Sample sample(const Compensated& c, const Vector3d& wo, double u0, double u1, double u2,
+                     Model model = Model::kDisney2014, SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
+    const Uniforms<double> u{u0, u1, u2};
+    return model == Model::kDisney2012 ? compensated_sample_of<Model::kDisney2012>(c, vec3(wo), u, sampler)
+                                       : compensated_sample_of<Model::kDisney2014>(c, vec3(wo), u, sampler);
 }
 
 }  // namespace principled_brdf::reference

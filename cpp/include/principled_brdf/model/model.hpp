@@ -8,4 +8,5 @@
 #include "distributions.hpp"
 #include "lobes.hpp"
 #include "principled.hpp"
+#include "energy.hpp"
 #include "gradients.hpp"

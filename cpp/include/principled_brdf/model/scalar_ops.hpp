@@ -34,3 +34,9 @@ inline std::pair<double, double> sincos_turns(double u) {
     const double phi = 6.283185307179586476925 * u;
     return {std::sin(phi), std::cos(phi)};
 }
+
+// table lookups (model/energy.hpp): the integer part of x >= 0, back to a real, table[i]
+inline int truncate_to_index(double x) { return static_cast<int>(x); }
+inline double index_to_real(int i) { return static_cast<double>(i); }
+inline int min(int a, int b) { return a < b ? a : b; }
+inline double gather(const float* table, int i) { return static_cast<double>(table[i]); }
