@@ -1,4 +1,4 @@
-"""SPEC §7 at the Python boundary: every bad input raises ValueError (TypeError for
+"""README "Bad input" at the Python boundary: every bad input raises ValueError (TypeError for
 types) naming the argument and, where there is one, the first offending element."""
 
 from __future__ import annotations
@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 import principled_brdf as pb
-from conftest import SPEC_DOMAINS, random_directions, seeded_rng
+from conftest import TABLE_DOMAINS, random_directions, seeded_rng
 
 EVALUATORS = {"eval": pb.reference.eval, "eval_lobes": pb.reference.eval_lobes}
 DIRECTIONS = ("wi", "wo")
 
-SCALAR_DOMAINS = {name: domain for name, domain in SPEC_DOMAINS.items() if name != "base_color"}
-# (parameter, side) for every finite bound of SPEC §2
+SCALAR_DOMAINS = {name: domain for name, domain in TABLE_DOMAINS.items() if name != "base_color"}
+# (parameter, side) for every finite bound of README "The model"
 DOMAIN_CASES = [(name, "below") for name in SCALAR_DOMAINS] + [
     (name, "above") for name, (_, hi) in SCALAR_DOMAINS.items() if np.isfinite(hi)
 ]

@@ -1,4 +1,4 @@
-"""Material: SPEC §2 defaults and domains, immutability, replace, mix; gamma22_to_linear."""
+"""Material: README "The model" defaults and domains, immutability, replace, mix; gamma22_to_linear."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import pytest
 
 import principled_brdf as pb
 import numpy_model
-from conftest import SPEC_DOMAINS, random_directions, random_material_arrays, random_material_dict, seeded_rng
+from conftest import TABLE_DOMAINS, random_directions, random_material_arrays, random_material_dict, seeded_rng
 
-# SPEC §2, copied from the table (not from the library)
-SPEC_DEFAULTS = numpy_model.DEFAULTS  # SPEC §2, restated once in the independent transcription
+# README "The model", copied from the table (not from the library)
+TABLE_DEFAULTS = numpy_model.DEFAULTS  # README "The model", restated once in the independent transcription
 
 
 # --------------------------------------------------------------------------
@@ -19,27 +19,27 @@ SPEC_DEFAULTS = numpy_model.DEFAULTS  # SPEC §2, restated once in the independe
 
 def test_defaults_equal_spec():
     m = pb.Material()
-    for name, value in SPEC_DEFAULTS.items():
+    for name, value in TABLE_DEFAULTS.items():
         np.testing.assert_array_equal(getattr(m, name), np.asarray(value), err_msg=name)
     assert m.is_uniform and m.shape == ()
     assert m.base_color.shape == (3,) and m.roughness.shape == ()
 
 
 def test_parameter_table_matches_spec():
-    assert list(pb.PARAMETERS) == list(SPEC_DEFAULTS)  # SPEC order, snake_case
+    assert list(pb.PARAMETERS) == list(TABLE_DEFAULTS)  # the table order, snake_case
     for name, info in pb.PARAMETERS.items():
-        assert np.array_equal(np.asarray(info.default), np.asarray(SPEC_DEFAULTS[name])), name
-        assert (info.lower, info.upper) == SPEC_DOMAINS[name], name
+        assert np.array_equal(np.asarray(info.default), np.asarray(TABLE_DEFAULTS[name])), name
+        assert (info.lower, info.upper) == TABLE_DOMAINS[name], name
 
 
 def test_keyword_and_positional_construction_agree():
-    assert pb.Material(*SPEC_DEFAULTS.values()) == pb.Material()
-    assert pb.Material(roughness=0.25) == pb.Material(**dict(SPEC_DEFAULTS, roughness=0.25))
+    assert pb.Material(*TABLE_DEFAULTS.values()) == pb.Material()
+    assert pb.Material(roughness=0.25) == pb.Material(**dict(TABLE_DEFAULTS, roughness=0.25))
 
 
-@pytest.mark.parametrize("name", list(SPEC_DOMAINS))
+@pytest.mark.parametrize("name", list(TABLE_DOMAINS))
 def test_domain_edges_are_accepted(name):
-    lo, hi = SPEC_DOMAINS[name]
+    lo, hi = TABLE_DOMAINS[name]
     for value in (lo, hi if np.isfinite(hi) else 1e6):
         arg = (value,) * 3 if name == "base_color" else value
         m = pb.Material(**{name: arg})
@@ -48,7 +48,7 @@ def test_domain_edges_are_accepted(name):
 
 def test_parameters_are_float64_arrays():
     m = pb.Material(roughness=1, metallic=np.float32(0.25), base_color=[1, 0, 0], anisotropic=True)
-    for name in SPEC_DEFAULTS:
+    for name in TABLE_DEFAULTS:
         assert isinstance(getattr(m, name), np.ndarray) and getattr(m, name).dtype == np.float64, name
     assert m.roughness == 1.0 and m.metallic == 0.25 and m.anisotropic == 1.0
 
@@ -61,7 +61,7 @@ def test_repr_names_every_parameter_and_value():
     m = pb.Material(base_color=(0.9, 0.6, 0.2), metallic=1.0, roughness=0.35, clearcoat_gloss=0.25)
     text = repr(m)
     assert text.startswith("Material(")
-    for name in SPEC_DEFAULTS:
+    for name in TABLE_DEFAULTS:
         assert f"{name}=" in text, name
     for fragment in ("base_color=(0.9, 0.6, 0.2)", "metallic=1", "roughness=0.35", "clearcoat_gloss=0.25", "specular=0.5"):
         assert fragment in text, fragment
@@ -129,7 +129,7 @@ def test_replace_changes_only_the_named_parameters():
     a = pb.Material(**params)
     b = a.replace(roughness=0.125, base_color=(0.1, 0.2, 0.3))
     assert a == pb.Material(**params)  # a unchanged
-    for name in SPEC_DEFAULTS:
+    for name in TABLE_DEFAULTS:
         expected = {"roughness": 0.125, "base_color": (0.1, 0.2, 0.3)}.get(name, params[name])
         np.testing.assert_array_equal(getattr(b, name), np.asarray(expected), err_msg=name)
     assert a.replace() == a and a.replace() is not a
@@ -148,7 +148,7 @@ def test_replace_with_per_element_values_and_validation():
 def test_as_dict_round_trips():
     m = pb.Material(**random_material_arrays(seeded_rng("as_dict"), 7))
     d = m.as_dict()
-    assert list(d) == list(SPEC_DEFAULTS)
+    assert list(d) == list(TABLE_DEFAULTS)
     assert pb.Material(**d) == m
 
 
@@ -179,7 +179,7 @@ def test_mix_interpolates_every_parameter(t):
     pa, pb_ = _two_materials(t)
     mixed = pb.Material.mix(pb.Material(**pa), pb.Material(**pb_), t)
     assert isinstance(mixed, pb.Material)
-    for name in SPEC_DEFAULTS:
+    for name in TABLE_DEFAULTS:
         a, b = np.asarray(pa[name]), np.asarray(pb_[name])
         np.testing.assert_allclose(getattr(mixed, name), a + (b - a) * t, rtol=1e-15, atol=1e-300, err_msg=name)
     if t == 0.0:
@@ -203,7 +203,7 @@ def test_mix_with_a_per_element_mask():
     mixed = pb.Material.mix(pb.Material(**pa), pb.Material(**pb_), mask)
     assert mixed.shape == (6, 9)
     assert mixed.base_color.shape == (6, 9, 3)
-    for name in SPEC_DEFAULTS:
+    for name in TABLE_DEFAULTS:
         if name == "base_color":
             expected = np.asarray(pa[name]) + (np.asarray(pb_[name]) - np.asarray(pa[name])) * mask[..., None]
         else:
@@ -237,7 +237,7 @@ def test_mix_result_stays_in_the_domains():
     for _ in range(20):
         pa, pb_ = random_material_dict(rng), random_material_dict(rng)
         mixed = pb.Material.mix(pb.Material(**pa), pb.Material(**pb_), rng.uniform(0, 1, 50))
-        for name, (lo, hi) in SPEC_DOMAINS.items():
+        for name, (lo, hi) in TABLE_DOMAINS.items():
             value = getattr(mixed, name)
             assert np.all(value >= lo) and np.all(value <= hi), name
 
@@ -261,7 +261,7 @@ def test_gamma22_to_linear_is_c_to_the_2_2():
 
 
 def test_gamma22_to_linear_is_not_applied_implicitly():
-    # SPEC §1: base_color is linear; mon2lin is a helper, not a hidden step
+    # README "The model": base_color is linear; mon2lin is a helper, not a hidden step
     m = pb.Material(base_color=(0.5, 0.5, 0.5))
     np.testing.assert_array_equal(m.base_color, [0.5, 0.5, 0.5])
     n = np.array([0.0, 0.0, 1.0])

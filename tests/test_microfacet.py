@@ -1,4 +1,4 @@
-"""The microfacet toolkit, principled_brdf.microfacet (SPEC §4; checks §6.4, §6.5, §6.7, §6.9, §7).
+"""The microfacet toolkit, principled_brdf.microfacet (README "The model"; checks §6.4, §6.5, §6.7, §6.9, §7).
 
 Integrals over the hemisphere of half vectors use a product rule in (θ, ψ):
 ψ is the stretched azimuth, tan φ = (αy/αx) tan ψ, in which GGX and Beckmann
@@ -7,7 +7,7 @@ is cut into geometric panels from min(α)/4 up to π/2 (each panel as wide as
 the distance to the complex poles of D, which lie about α away) with
 Gauss-Legendre nodes on each. Where an integrand has a kink (max(0, wo·h)),
 the kink's θ on each ψ row is one more panel end. Normalisations come out at
-~1e-15, far below the SPEC bounds, which is what lets the tests use tight
+~1e-15, far below the stated bounds, which is what lets the tests use tight
 tolerances.
 """
 
@@ -90,7 +90,7 @@ def direction(theta_deg, phi=0.0):
 
 
 # --------------------------------------------------------------------------
-# §6.4 normalisation: ∫ D(h) cos θh dω_h = 1 (SPEC bound 1e-4; the quadrature reaches ~1e-15)
+# §6.4 normalisation: ∫ D(h) cos θh dω_h = 1 (stated bound 1e-4; the quadrature reaches ~1e-15)
 
 NORMALISATION_TOLERANCE = 1e-9
 GTR_ALPHAS = (0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 0.9, 0.99, 1.0 - 1e-9, 1.0)
@@ -146,7 +146,7 @@ FURNACE_VIEWS = [(0.0, 0.0), (30.0, 0.3), (60.0, 0.0), (60.0, 1.2), (80.0, 0.7),
 
 def furnace_tolerance(theta_deg):
     # the ψ rule loses its exactness where the kink reaches the horizon; that matters only at grazing wo
-    return 1e-9 if theta_deg <= 80.0 else 1e-4  # SPEC bound 1e-3
+    return 1e-9 if theta_deg <= 80.0 else 1e-4  # stated bound 1e-3
 
 
 @pytest.mark.parametrize("alpha_x, alpha_y", FURNACE_ALPHAS)
@@ -236,7 +236,7 @@ def test_ggx_formulas(rng):
     np.testing.assert_allclose(mf.ggx_d(h, ax, ay), d, rtol=1e-13)
     np.testing.assert_allclose(mf.ggx_pdf(h, ax, ay), d * h[:, 2], rtol=1e-13)
 
-    def lam(v):  # SPEC §4, literally
+    def lam(v):  # README "The model", literally
         return (-1.0 + np.sqrt(1.0 + ((ax * v[:, 0]) ** 2 + (ay * v[:, 1]) ** 2) / v[:, 2] ** 2)) / 2.0
 
     np.testing.assert_allclose(mf.ggx_lambda(w, ax, ay), lam(w), rtol=1e-10)
@@ -420,7 +420,7 @@ def test_smith_at_the_normal_and_grazing():
 
 
 # --------------------------------------------------------------------------
-# samplers against their pdf (chi-square; SPEC §6.7 "each D with its own sampler")
+# samplers against their pdf (chi-square; README "What is checked" "each D with its own sampler")
 
 GTR_SAMPLER_CASES = [(a, g, cf) for g in (0.5, 1.0, 1.5, 2.0, 3.0) for a in (0.05, 0.3, 1.0)
                      for cf in ((True, False) if g in (1.0, 1.5, 2.0) else (True,))]
@@ -499,7 +499,7 @@ def check_sampler(h, pdf, stretch_x, stretch_y, *, equal_area=False):
     assert np.all(np.isfinite(h))
     np.testing.assert_allclose(np.linalg.norm(h, axis=-1), 1.0, rtol=1e-14)
     assert np.all(h[:, 2] >= 0.0)
-    if equal_area:  # SPEC §6.7 grid: 50 x 50 cells equal in (cos θ, φ)
+    if equal_area:  # README "What is checked" grid: 50 x 50 cells equal in (cos θ, φ)
         stretch_x = stretch_y = 1.0
         theta_edges = np.arccos(np.linspace(1.0, 0.0, 51))
         psi_edges = np.linspace(-np.pi, np.pi, 51)
@@ -580,7 +580,7 @@ EQUAL_AREA_SAMPLERS = {
 
 @pytest.mark.parametrize("case", EQUAL_AREA_CASES)
 def test_sampler_equal_area_grid(rng, case):
-    # SPEC §6.7's grid: 10^6 samples, 50 x 50 cells of equal solid angle
+    # README "What is checked"'s grid: 10^6 samples, 50 x 50 cells of equal solid angle
     sample, pdf = EQUAL_AREA_SAMPLERS[case]
     h = sample(*uniforms(rng, 1_000_000))
     check_sampler(h, pdf, 1.0, 1.0, equal_area=True)
