@@ -59,6 +59,12 @@ def sweep(path: str) -> None:
     plt.close(fig)
 
 
+def family(path: str) -> None:
+    fig = pb.plot.microfacet_family(0.3)
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
 def shrink(path: str) -> None:
     """To a 256-colour palette (dithered): a third of the size, no visible change at this size."""
     from PIL import Image  # matplotlib's own dependency
@@ -72,7 +78,8 @@ def shrink(path: str) -> None:
 def main(directory: str) -> None:
     os.makedirs(directory, exist_ok=True)
     pictures = [("demo", lambda path: demo.run(pairs=1 << 16, output=path, repeats=1, report=lambda message: None)),
-                ("presets", presets), ("metals", metals), ("plots", plots), ("parameter_sweep", sweep)]
+                ("presets", presets), ("metals", metals), ("plots", plots), ("parameter_sweep", sweep),
+                ("microfacet_family", family)]
     for name, draw in pictures:
         path = os.path.join(directory, f"{name}.png")
         draw(path)

@@ -12,11 +12,8 @@
 # the module satisfies (--plat auto); it grafts nothing, since the module needs
 # only libc, libm, libstdc++ and libgcc_s, which every manylinux system provides.
 set -euo pipefail
-export PIP_ROOT_USER_ACTION=ignore
-cd "$(dirname "$0")/.."
-python=${PYTHON:-python3}
-exec 9>"${TMPDIR:-/tmp}/principled-brdf-build.lock"
-flock 9
+# shellcheck source-path=SCRIPTDIR source=_common.sh
+source "$(dirname "$0")/_common.sh"  # repo root, $python, the build lock
 
 raw=build/wheel-raw
 rm -rf "$raw"

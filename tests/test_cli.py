@@ -49,7 +49,8 @@ def test_demo_writes_a_picture_and_reports_throughput(tmp_path):
     for phrase in ("M pairs/s", "roofline", "sample", "float64 reference", "max relative error"):
         assert phrase in result.stdout
     width, height = read_png_size(output)
-    assert width == 6 * 160 and height == 2 * (160 + 22)  # a label strip above each row of spheres
+    # row titles on the left; a label strip above the presets and above each metal's first row
+    assert width == 120 + 6 * 128 and height == 5 * 128 + 3 * 22 + 2 * 4
 
 
 def test_render_preset_with_parameters(tmp_path, capsys):

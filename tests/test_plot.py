@@ -493,3 +493,103 @@ def test_blend_demo_bad_arguments():
     with pytest.raises(ValueError, match="resolution"):
         pbplot.blend_demo("gold", "chrome", resolution=1)
     assert plt.get_fignums() == []
+
+
+# --------------------------------------------------------------------------
+# energy compensation (Kulla & Conty 2017; README "Energy compensation")
+
+WHITE_METAL = pb.Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=1.0)
+
+
+def test_energy_compensation_brightens_a_rough_white_metal_sphere():
+    # a constant white environment, light off: each pixel shows the albedo at its view angle,
+    # 0.31 (normal) to less at grazing without the lobe, about 1 with it
+    n, white = 32, (lambda w: np.ones_like(w))
+    inside = pb.render.sphere_frames(n)[0]
+    plain, compensated = (pb.render.render_sphere(WHITE_METAL, n, light_intensity=0.0, environment=white, samples=16,
+                                                  energy_compensation=flag) for flag in (False, True))
+    assert np.all(compensated[inside] >= plain[inside])
+    assert compensated[inside].mean() > 2.0 * plain[inside].mean()
+    centre = (slice(n // 2 - 2, n // 2 + 2),) * 2
+    np.testing.assert_allclose(plain[centre].mean(), 1.0 - np.log(2.0), atol=0.03)  # E = 1 - ln 2 at the normal
+    np.testing.assert_allclose(compensated[centre].mean(), 1.0, atol=0.03)
+    # plot.lit_sphere passes the option through: its image is render_sphere's in sRGB
+    fig, axes = plt.subplots(1, 2)
+    shown = [image_of(pbplot.lit_sphere(WHITE_METAL, resolution=n, environment_samples=8, ax=ax,
+                                        energy_compensation=flag)) for ax, flag in zip(axes, (False, True))]
+    expected = pb.render.to_srgb8(pb.render.render_sphere(WHITE_METAL, n, samples=8, energy_compensation=True))
+    np.testing.assert_array_equal(shown[1][..., :3], expected)
+    assert shown[1][..., :3][inside].astype(float).mean() > shown[0][..., :3][inside].astype(float).mean() + 20
+
+
+def test_albedo_curves_with_energy_compensation_pass_the_white_furnace():
+    fig, axes = plt.subplots(1, 2)
+    angles = np.array([0.0, 30.0, 60.0, 80.0])
+    plain = pbplot.albedo_curves(WHITE_METAL, angles=angles, samples=1 << 13, ax=axes[0])
+    compensated = pbplot.albedo_curves(WHITE_METAL, angles=angles, samples=1 << 13, ax=axes[1],
+                                       energy_compensation=True)
+    _, without = line(plain, "total")
+    _, with_lobe = line(compensated, "total")
+    np.testing.assert_allclose(with_lobe, 1.0, atol=1e-2)
+    assert np.all(without < 0.7)
+    np.testing.assert_allclose(without[0], 1.0 - np.log(2.0), atol=1e-2)
+    _, lobe = line(compensated, "multiple_scattering")  # the lost energy, drawn as its own lobe
+    np.testing.assert_allclose(lobe, with_lobe - without, atol=2e-2)
+    assert "multiple_scattering" not in [l.get_label() for l in plain.get_lines()]
+
+
+# --------------------------------------------------------------------------
+# microfacet_family
+
+
+def test_microfacet_family_draws_every_distribution(tmp_path):
+    fig = pbplot.microfacet_family(0.3, resolution=91)
+    assert isinstance(fig, Figure) and len(fig.axes) == 2
+    d_ax, lambda_ax = fig.axes
+    d_labels = [l.get_label() for l in d_ax.get_lines()]
+    assert d_labels == ["GGX", "Beckmann", "Blinn-Phong (n = 20.2)", "Student-t γ = 1.6", "Student-t γ = 4",
+                        "exponential power p = 0.5", "exponential power p = 2", "GTR γ = 1 (GTR1)", "GTR γ = 1.5"]
+    assert [l.get_label() for l in lambda_ax.get_lines()] == d_labels[:7]  # GTR has no closed-form Λ
+    for ax in (d_ax, lambda_ax):
+        assert ax.get_yscale() == "log"
+        for drawn in ax.get_lines():
+            y = np.asarray(drawn.get_ydata(), float)
+            assert y.size > 10 and np.all(np.isfinite(y)) and np.all(y > 0.0), drawn.get_label()
+    # the values are pb.microfacet's
+    theta, d = line(d_ax, "GGX")
+    h = np.stack([np.sin(np.radians(theta)), 0 * theta, np.cos(np.radians(theta))], -1)
+    np.testing.assert_allclose(d, pb.microfacet.ggx_d(h, 0.3), rtol=1e-12)
+    theta, lam = line(lambda_ax, "Student-t γ = 4")
+    w = np.stack([np.sin(np.radians(theta)), 0 * theta, np.cos(np.radians(theta))], -1)
+    np.testing.assert_allclose(lam, pb.microfacet.student_t_lambda(w, 0.3, gamma=4.0), rtol=1e-12)
+    assert d_ax.get_legend() is not None
+    assert_png_not_blank(fig, tmp_path, "family")
+
+
+def test_microfacet_family_into_existing_axes():
+    fig, axes = plt.subplots(1, 2)
+    assert pbplot.microfacet_family(0.5, student_t_gammas=[3.0], exponential_power_ps=[], gtr_gammas=[1.0],
+                                    resolution=16, legend=False, axes=(axes[0], axes[1])) is fig
+    assert len(axes[0].get_lines()) == 5 and len(axes[1].get_lines()) == 4
+    assert axes[0].get_legend() is None
+
+
+def test_microfacet_family_bad_arguments():
+    cases = [
+        (dict(alpha=0.0), ValueError, "alpha"), (dict(alpha=1.5), ValueError, "alpha"),
+        (dict(alpha="rough"), TypeError, "alpha"),
+        (dict(student_t_gammas=[1.5]), ValueError, r"student_t_gammas\[0\]"),
+        (dict(student_t_gammas=3.0), TypeError, "student_t_gammas"),
+        (dict(exponential_power_ps=[1.0, 20.0]), ValueError, r"exponential_power_ps\[1\]"),
+        (dict(gtr_gammas=[0.0]), ValueError, r"gtr_gammas\[0\]"),
+        (dict(resolution=2), ValueError, "resolution"), (dict(decades=0.0), ValueError, "decades"),
+        (dict(axes="left"), TypeError, "axes"),
+    ]
+    for kwargs, error, name in cases:
+        with pytest.raises(error, match=name):
+            pbplot.microfacet_family(**kwargs)
+    fig = plt.figure()
+    with pytest.raises(ValueError, match=r"axes\[1\]"):
+        pbplot.microfacet_family(axes=(fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2, projection="polar")))
+    plt.close(fig)
+    assert plt.get_fignums() == []

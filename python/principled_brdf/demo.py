@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _core, presets, reference
+from .albedo import albedo
 from ._batch import cpu_info, eval as _eval, sample as _sample
 from .benchmark import best_seconds, random_pairs
 from .material import Material
@@ -24,6 +25,12 @@ if TYPE_CHECKING:
 DEMO_MATERIAL: dict[str, Any] = dict(base_color=(0.9, 0.55, 0.25), metallic=0.3, roughness=0.35, anisotropic=0.4,
                                      sheen=0.3, clearcoat=0.6, clearcoat_gloss=0.8)
 PICTURE_PRESETS = ("gold", "chrome", "brushed_metal", "car_paint", "blue_rubber", "satin_cloth")
+PICTURE_RESOLUTION = 128  # pixels per sphere
+#: The metals of the picture's roughness sweep: a white one (F_avg ~ 1, the white furnace of
+#: README "Energy compensation") and gold (the lost energy is coloured: Kulla & Conty 2017's F_avg term).
+SWEEP_METALS = {"white metal": (0.95, 0.95, 0.95), "gold": (1.0, 0.71, 0.29)}
+SWEEP_ROUGHNESS = np.linspace(0.05, 1.0, len(PICTURE_PRESETS))
+LABEL_STRIP, ROW_GAP = 22, 4  # pixels above a row of spheres with labels, and above one without
 
 
 def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats: int = 5,
@@ -70,26 +77,55 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
     report(f"samples above the horizon: {above.mean():.4f}; mean weight (albedo estimate, RGB): "
            f"{np.round(drawn.weight.mean(axis=0), 4).tolist()}")
 
-    report(f"rendering {len(PICTURE_PRESETS)} presets and a roughness sweep ...")
-    roughness = np.linspace(0.05, 1.0, len(PICTURE_PRESETS))
-    materials = [presets.get(name) for name in PICTURE_PRESETS] + [
-        Material(base_color=(0.9, 0.55, 0.25), metallic=1.0, roughness=r) for r in roughness]
-    labels = list(PICTURE_PRESETS) + [f"roughness {r:.2f}" for r in roughness]
-    write_picture(output, [lit_sphere(m) for m in materials], labels, columns=len(PICTURE_PRESETS))
-    report(f"wrote {output}: presets {', '.join(PICTURE_PRESETS)} (top); a metal with roughness 0.05 to 1 (bottom), "
-           "under a sky and a key light")
-    return {"rates": rates, "max_relative_error": error, "output": output}
+    furnace = [float(albedo(Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=1.0), 1.0, samples=1 << 18,
+                            seed=1, energy_compensation=compensated).total[0]) for compensated in (False, True)]
+    report(f"white furnace (base_color 1, metallic 1, roughness 1, view along the normal): directional albedo "
+           f"{furnace[0]:.3f} single scattering, {furnace[1]:.3f} with energy_compensation")
+    report(f"rendering {len(PICTURE_PRESETS)} presets and a roughness sweep of two metals, without and with "
+           "energy compensation ...")
+    images, labels, titles = picture_spheres()
+    write_picture(output, images, labels, columns=len(PICTURE_PRESETS), row_titles=titles)
+    report(f"wrote {output}: presets {', '.join(PICTURE_PRESETS)} (top); below, a white and a gold metal from "
+           f"roughness {SWEEP_ROUGHNESS[0]:g} to {SWEEP_ROUGHNESS[-1]:g}, each without and with energy_compensation "
+           "(Kulla & Conty 2017), under a sky and a key light")
+    return {"rates": rates, "max_relative_error": error, "white_furnace": furnace, "output": output}
 
 
-def lit_sphere(material: Material, resolution: int = 160) -> Float32Array:
+def picture_spheres(resolution: int = PICTURE_RESOLUTION) -> tuple[list[Float32Array], list[str], list[str]]:
+    """The demo picture's spheres (row by row), their labels and the row titles: the presets,
+    then each of :data:`SWEEP_METALS` along :data:`SWEEP_ROUGHNESS` without and, in the row
+    below, with ``energy_compensation`` (README "Energy compensation")."""
+    images = [lit_sphere(presets.get(name), resolution) for name in PICTURE_PRESETS]
+    labels, titles = list(PICTURE_PRESETS), ["presets"]
+    for name, color in SWEEP_METALS.items():
+        sweep = Material(base_color=color, metallic=1.0, roughness=SWEEP_ROUGHNESS[:, None, None])
+        for compensated in (False, True):
+            spheres = lit_sphere(sweep, resolution, energy_compensation=compensated)  # one batched render
+            images += list(spheres)
+            # the roughness above the first row of each pair; the second follows without a strip
+            labels += ["" if compensated else f"roughness {r:.2f}" for r in SWEEP_ROUGHNESS]
+            titles.append("+ energy\ncompensation" if compensated else name)
+    return images, labels, titles
+
+
+def lit_sphere(material: Material, resolution: int = PICTURE_RESOLUTION, *,
+               energy_compensation: bool = False) -> Float32Array:
     """A sphere under render_sphere's key light and default sky (linear RGB), with 256
-    sky samples per pixel: no grain where a rough metal reflects the dark ground."""
-    return render_sphere(material, resolution, samples=256)
+    sky samples per pixel: no grain where a rough metal reflects the dark ground.
+    ``material`` of leading shape ``S + (1, 1)`` gives ``S`` spheres (``render_sphere``);
+    ``energy_compensation`` as in ``pb.eval``."""
+    return render_sphere(material, resolution, samples=256, energy_compensation=energy_compensation)
 
 
-def write_picture(output: str, images: Sequence[FloatArray], labels: Sequence[str], columns: int) -> None:
-    """The tone-mapped images in a grid, each labelled (with matplotlib; without it, unlabelled)."""
+def write_picture(output: str, images: Sequence[FloatArray], labels: Sequence[str], columns: int,
+                  row_titles: Sequence[str] | None = None, title_width: int = 120) -> None:
+    """The tone-mapped images in a grid, each labelled (with matplotlib; without it, unlabelled).
+
+    ``row_titles``: one title per row, written in a margin ``title_width`` pixels wide on the
+    left (lines split at newlines)."""
     rows = [np.concatenate(images[k:k + columns], axis=1) for k in range(0, len(images), columns)]
+    if row_titles is not None and len(row_titles) != len(rows):
+        raise ValueError(f"row_titles: expected {len(rows)} titles (one per row), got {len(row_titles)}")
     grid = to_srgb8(np.concatenate(rows, axis=0))
     try:
         import matplotlib
@@ -99,18 +135,32 @@ def write_picture(output: str, images: Sequence[FloatArray], labels: Sequence[st
         write_png(output, grid)
         return
     size = images[0].shape[0]
-    figure = plt.figure(figsize=(grid.shape[1] / 100, (grid.shape[0] + 22 * len(rows)) / 100), dpi=100)
-    for index, label in enumerate(labels):
-        row, column = divmod(index, columns)
-        # matplotlib's stub types rect as a tuple only; add_axes takes any sequence of four numbers
-        axes = figure.add_axes(  # type: ignore[call-overload]
-            [column / columns, 1 - (row + 1) / len(rows), 1 / columns, 1 / len(rows)])
-        axes.imshow(grid[row * size:(row + 1) * size, column * size:(column + 1) * size], extent=(0, 1, 0, 1))
-        axes.set_xlim(0, 1)
-        axes.set_ylim(0, 1.14)
-        axes.text(0.5, 1.07, label, ha="center", va="center", color="white", fontsize=9)
-        axes.set_facecolor("black")
-        axes.set_axis_off()
+    margin = title_width if row_titles is not None else 0
+    # a label strip above each row that has a label; a thin gap above one that has none
+    strips = [LABEL_STRIP if any(labels[k:k + columns]) else ROW_GAP for k in range(0, len(images), columns)]
+    width, height = margin + grid.shape[1], grid.shape[0] + sum(strips)
+    figure = plt.figure(figsize=(width / 100, height / 100), dpi=100)
+    top = height
+    for row, strip in enumerate(strips):
+        top -= strip + size
+        for column in range(columns):
+            index = row * columns + column
+            if index >= len(images):
+                break
+            # matplotlib's stub types rect as a tuple only; add_axes takes any sequence of four numbers
+            axes = figure.add_axes(  # type: ignore[call-overload]
+                [(margin + column * size) / width, top / height, size / width, (size + strip) / height])
+            axes.imshow(grid[row * size:(row + 1) * size, column * size:(column + 1) * size], extent=(0, 1, 0, 1))
+            axes.set_xlim(0, 1)
+            axes.set_ylim(0, 1 + strip / size)
+            if index < len(labels) and labels[index]:
+                axes.text(0.5, 1 + strip / 2 / size, labels[index], ha="center", va="center", color="white",
+                          fontsize=9)
+            axes.set_facecolor("black")
+            axes.set_axis_off()
+        if row_titles is not None:
+            figure.text(margin / 2 / width, (top + size / 2) / height, row_titles[row], ha="center",
+                        va="center", color="white", fontsize=10, linespacing=1.3)
     figure.patch.set_facecolor("black")
     figure.savefig(output, facecolor="black")
     plt.close(figure)

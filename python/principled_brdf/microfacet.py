@@ -39,6 +39,13 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
 
     from ._typing import Float64Array, RealArrayLike
 
+    _Core = Callable[..., Float64Array]  # a binding of _core.microfacet
+    _AlphaCheck = Callable[[RealArrayLike, RealArrayLike | None], tuple[Float64Array, Float64Array]]
+    # a family's shape argument: fixed, or checked (by calling it) after the alphas; None: the binding takes none
+    _Shape = Float64Array | Callable[[], Float64Array] | None
+    # Beckmann's Walter binding and the approximation keyword, checked after the alphas
+    _Walter = tuple[_Core, str | None] | None
+
 __all__ = [
     "MIN_ALPHA",
     "MAX_ALPHA",
@@ -171,6 +178,57 @@ def _run(core_function: Callable[..., Float64Array], *args: bool | int, returns_
     return out.reshape(shape + trailing)
 
 
+def _checked_run(core_function: _Core, directions: dict[str, RealArrayLike], uniforms: dict[str, RealArrayLike],
+                 alpha_x: RealArrayLike, alpha_y: RealArrayLike | None, alphas: _AlphaCheck, shape: _Shape,
+                 walter: _Walter, flags: tuple[int, ...] = (), returns_vector: bool = False) -> Float64Array:
+    """Checks the arguments of a GGX-like wrapper in its order (the directions, the uniforms, the
+    alphas, then the shape or Beckmann's ``approximation``) and calls the binding with them in that order."""
+    arguments: dict[str, Float64Array | _Vector] = {
+        name: _Vector(_validate.directions(name, value)) for name, value in directions.items()
+    }
+    arguments.update((name, _uniform(name, value)) for name, value in uniforms.items())
+    arguments["alpha_x"], arguments["alpha_y"] = alphas(alpha_x, alpha_y)
+    if walter is not None and _beckmann_approximation(walter[1]):
+        core_function, shape = walter[0], _NO_SHAPE
+    if shape is not None:
+        arguments["shape"] = shape if isinstance(shape, np.ndarray) else shape()
+    return _run(core_function, *flags, returns_vector=returns_vector, **arguments)
+
+
+def _one_direction(core_function: _Core, name: str, direction: RealArrayLike, alpha_x: RealArrayLike,
+                   alpha_y: RealArrayLike | None, *, alphas: _AlphaCheck = _alphas, shape: _Shape = None,
+                   walter: _Walter = None) -> Float64Array:
+    """D, pdf, Λ, G1: of one direction ``name`` (``h`` or ``w``)."""
+    return _checked_run(core_function, {name: direction}, {}, alpha_x, alpha_y, alphas, shape, walter)
+
+
+def _two_directions(core_function: _Core, wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
+                    alpha_y: RealArrayLike | None, *, alphas: _AlphaCheck = _alphas, shape: _Shape = None,
+                    walter: _Walter = None, flags: tuple[int, ...] = ()) -> Float64Array:
+    """The G2 forms, of ``wi`` and ``wo``."""
+    return _checked_run(core_function, {"wi": wi, "wo": wo}, {}, alpha_x, alpha_y, alphas, shape, walter, flags)
+
+
+def _h_and_wo(core_function: _Core, h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
+              alpha_y: RealArrayLike | None, *, alphas: _AlphaCheck = _alphas, shape: _Shape = None) -> Float64Array:
+    """The visible-normal densities, of ``h`` seen from ``wo``."""
+    return _checked_run(core_function, {"h": h, "wo": wo}, {}, alpha_x, alpha_y, alphas, shape, None)
+
+
+def _sample(core_function: _Core, u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
+            alpha_y: RealArrayLike | None, *, alphas: _AlphaCheck = _alphas, shape: _Shape = None) -> Float64Array:
+    """The samplers of ``D(h) (h·n)``: half vectors from the uniforms ``u1``, ``u2``."""
+    return _checked_run(core_function, {}, {"u1": u1, "u2": u2}, alpha_x, alpha_y, alphas, shape, None,
+                        returns_vector=True)
+
+
+def _sample_visible(core_function: _Core, wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayLike,
+                    alpha_x: RealArrayLike, alpha_y: RealArrayLike | None) -> Float64Array:
+    """The visible-normal samplers: half vectors seen from ``wo``, from the uniforms ``u1``, ``u2``."""
+    return _checked_run(core_function, {"wo": wo}, {"u1": u1, "u2": u2}, alpha_x, alpha_y, _alphas, None, None,
+                        returns_vector=True)
+
+
 # --------------------------------------------------------------------------
 # GTR (Burley 2012 appendix B)
 
@@ -234,16 +292,12 @@ def ggx_d(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | Non
 
         D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²),  0 for h·n <= 0.
     """
-    hv = _validate.directions("h", h)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
+    return _one_direction(_core_mf.ggx_d, "h", h, alpha_x, alpha_y)
 
 
 def ggx_pdf(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Density in solid angle of :func:`ggx_sample`: ``D(h) (h·n)``."""
-    hv = _validate.directions("h", h)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
+    return _one_direction(_core_mf.ggx_pdf, "h", h, alpha_x, alpha_y)
 
 
 def ggx_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
@@ -254,10 +308,7 @@ def ggx_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
 
     with density :func:`ggx_pdf`.
     """
-    v1 = _uniform("u1", u1)
-    v2 = _uniform("u2", u2)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_sample, returns_vector=True, u1=v1, u2=v2, alpha_x=ax, alpha_y=ay)
+    return _sample(_core_mf.ggx_sample, u1, u2, alpha_x, alpha_y)
 
 
 def ggx_sample_visible(wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
@@ -269,11 +320,7 @@ def ggx_sample_visible(wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayLike, 
     warped towards the visible half), lifted and unstretched. A ``wo`` below the
     horizon is mirrored to ``-wo`` (two-sided use).
     """
-    w = _validate.directions("wo", wo)
-    v1 = _uniform("u1", u1)
-    v2 = _uniform("u2", u2)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_sample_visible, returns_vector=True, wo=_Vector(w), u1=v1, u2=v2, alpha_x=ax, alpha_y=ay)
+    return _sample_visible(_core_mf.ggx_sample_visible, wo, u1, u2, alpha_x, alpha_y)
 
 
 def ggx_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
@@ -285,10 +332,7 @@ def ggx_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
     with ``G1 / |wo·n|`` written ``2 / (|wo·n| + sqrt((wo·n)² + αx² wox² + αy² woy²))``, finite at
     grazing ``wo``; ``wo`` below the horizon is mirrored to ``-wo`` as in the sampler.
     """
-    hv = _validate.directions("h", h)
-    w = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_pdf_visible, h=_Vector(hv), wo=_Vector(w), alpha_x=ax, alpha_y=ay)
+    return _h_and_wo(_core_mf.ggx_pdf_visible, h, wo, alpha_x, alpha_y)
 
 
 def ggx_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
@@ -299,25 +343,18 @@ def ggx_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike 
     evaluated as ``p² / (2|wz| (sqrt(wz² + p²) + |wz|))``, ``p² = αx² wx² + αy² wy²``:
     no cancellation and no overflow as ``wz -> 0``; +inf at exactly ``wz = 0``.
     """
-    wv = _validate.directions("w", w)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
+    return _one_direction(_core_mf.ggx_lambda, "w", w, alpha_x, alpha_y)
 
 
 def ggx_g1(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Smith masking ``G1 = 1 / (1 + Λ(w)) = 2|wz| / (|wz| + sqrt(wz² + αx² wx² + αy² wy²))``."""
-    wv = _validate.directions("w", w)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
+    return _one_direction(_core_mf.ggx_g1, "w", w, alpha_x, alpha_y)
 
 
 def ggx_g2_separable(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                      alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Separable masking-shadowing ``G2 = G1(wi) G1(wo)`` (what the model uses)."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_g2_separable, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay)
+    return _two_directions(_core_mf.ggx_g2_separable, wi, wo, alpha_x, alpha_y)
 
 
 def ggx_g2_height_correlated(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
@@ -327,10 +364,7 @@ def ggx_g2_height_correlated(wi: RealArrayLike, wo: RealArrayLike, alpha_x: Real
     Evaluated as ``2|zi||zo| / (|zi| ro + |zo| ri)``, ``r = sqrt(z² + αx² x² + αy² y²)``;
     0 when either direction is grazing.
     """
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_g2_height_correlated, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay)
+    return _two_directions(_core_mf.ggx_g2_height_correlated, wi, wo, alpha_x, alpha_y)
 
 
 # --------------------------------------------------------------------------
@@ -342,16 +376,12 @@ def beckmann_d(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike 
 
         D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴),  0 for h·n <= 0.
     """
-    hv = _validate.directions("h", h)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.beckmann_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
+    return _one_direction(_core_mf.beckmann_d, "h", h, alpha_x, alpha_y)
 
 
 def beckmann_pdf(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Density in solid angle of :func:`beckmann_sample`: ``D(h) (h·n)``."""
-    hv = _validate.directions("h", h)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.beckmann_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay)
+    return _one_direction(_core_mf.beckmann_pdf, "h", h, alpha_x, alpha_y)
 
 
 def beckmann_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
@@ -362,10 +392,7 @@ def beckmann_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike
 
     (the stretched slopes are Gaussian; ``u2 = 1`` gives the horizon).
     """
-    v1 = _uniform("u1", u1)
-    v2 = _uniform("u2", u2)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.beckmann_sample, returns_vector=True, u1=v1, u2=v2, alpha_x=ax, alpha_y=ay)
+    return _sample(_core_mf.beckmann_sample, u1, u2, alpha_x, alpha_y)
 
 
 def _beckmann_approximation(approximation: str | None) -> bool:
@@ -389,57 +416,38 @@ def beckmann_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArray
     within 3.2e-3 of the exact G1 relatively (measured: 3.13e-3 at a = 1.33), so
     within 3.2e-3 (1 + Λ) of the exact Λ, and 1.8e-3 absolutely beyond the cut at a = 1.6.
     """
-    wv = _validate.directions("w", w)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    if _beckmann_approximation(approximation):
-        return _run(_core_mf.beckmann_walter_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay, shape=_NO_SHAPE)
-    return _run(_core_mf.beckmann_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
+    return _one_direction(_core_mf.beckmann_lambda, "w", w, alpha_x, alpha_y,
+                          walter=(_core_mf.beckmann_walter_lambda, approximation))
 
 
 def beckmann_g1(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
                 approximation: str | None = None) -> Float64Array:
     """Smith masking for Beckmann, ``G1 = 1 / (1 + Λ(w))`` (``approximation`` as :func:`beckmann_lambda`)."""
-    wv = _validate.directions("w", w)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    if _beckmann_approximation(approximation):
-        return _run(_core_mf.beckmann_walter_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay, shape=_NO_SHAPE)
-    return _run(_core_mf.beckmann_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay)
+    return _one_direction(_core_mf.beckmann_g1, "w", w, alpha_x, alpha_y,
+                          walter=(_core_mf.beckmann_walter_g1, approximation))
 
 
 def beckmann_g2_separable(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                           alpha_y: RealArrayLike | None = None, *, approximation: str | None = None) -> Float64Array:
     """Separable masking-shadowing ``G2 = G1(wi) G1(wo)`` for Beckmann
     (``approximation`` as :func:`beckmann_lambda`)."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    if _beckmann_approximation(approximation):
-        return _run(_core_mf.beckmann_walter_g2_separable, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay,
-                    shape=_NO_SHAPE)
-    return _run(_core_mf.beckmann_g2_separable, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay)
+    return _two_directions(_core_mf.beckmann_g2_separable, wi, wo, alpha_x, alpha_y,
+                           walter=(_core_mf.beckmann_walter_g2_separable, approximation))
 
 
 def beckmann_g2_height_correlated(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                                   alpha_y: RealArrayLike | None = None, *,
                                   approximation: str | None = None) -> Float64Array:
     """Height-correlated ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99) for Beckmann."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    if _beckmann_approximation(approximation):
-        return _run(_core_mf.beckmann_walter_g2_height_correlated, wi=_Vector(a), wo=_Vector(b), alpha_x=ax,
-                    alpha_y=ay, shape=_NO_SHAPE)
-    return _run(_core_mf.beckmann_g2_height_correlated, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay)
+    return _two_directions(_core_mf.beckmann_g2_height_correlated, wi, wo, alpha_x, alpha_y,
+                           walter=(_core_mf.beckmann_walter_g2_height_correlated, approximation))
 
 
 def beckmann_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                          alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Density of Beckmann's visible normals, ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38),
     exact Λ; ``wo`` below the horizon is mirrored, 0 for a grazing ``wo``; drawn by :func:`beckmann_sample_visible`."""
-    hv = _validate.directions("h", h)
-    w = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.beckmann_pdf_visible, h=_Vector(hv), wo=_Vector(w), alpha_x=ax, alpha_y=ay)
+    return _h_and_wo(_core_mf.beckmann_pdf_visible, h, wo, alpha_x, alpha_y)
 
 
 def beckmann_sample_visible(wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
@@ -453,12 +461,7 @@ def beckmann_sample_visible(wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayL
     slope is Gaussian; the slope is rotated to the azimuth and unstretched. ``wo`` below the
     horizon is mirrored to ``-wo``.
     """
-    w = _validate.directions("wo", wo)
-    v1 = _uniform("u1", u1)
-    v2 = _uniform("u2", u2)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.beckmann_sample_visible, returns_vector=True, wo=_Vector(w), u1=v1, u2=v2, alpha_x=ax,
-                alpha_y=ay)
+    return _sample_visible(_core_mf.beckmann_sample_visible, wo, u1, u2, alpha_x, alpha_y)
 
 
 # --------------------------------------------------------------------------
@@ -488,11 +491,8 @@ def ggx_g2_over_4cos(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLik
     """
     if approximation not in _GGX_VISIBILITY_FORMS:
         raise ValueError(f"approximation: expected None, 'karis' or 'hammon', got {approximation!r}")
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.ggx_g2_over_4cos, _GGX_VISIBILITY_FORMS[approximation], wi=_Vector(a), wo=_Vector(b),
-                alpha_x=ax, alpha_y=ay)
+    return _two_directions(_core_mf.ggx_g2_over_4cos, wi, wo, alpha_x, alpha_y,
+                           flags=(_GGX_VISIBILITY_FORMS[approximation],))
 
 
 # --------------------------------------------------------------------------
@@ -513,16 +513,13 @@ def blinn_phong_d(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLi
 
     (isotropically ``(α_p + 2) / (2π) cos^α_p θh``), 0 for ``h·n <= 0``; ``alpha`` in (0, 1].
     """
-    hv = _validate.directions("h", h)
-    ax, ay = _blinn_phong_alphas(alpha_x, alpha_y)
-    return _run(_core_mf.blinn_phong_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay, shape=_NO_SHAPE)
+    return _one_direction(_core_mf.blinn_phong_d, "h", h, alpha_x, alpha_y, alphas=_blinn_phong_alphas, shape=_NO_SHAPE)
 
 
 def blinn_phong_pdf(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Density in solid angle of :func:`blinn_phong_sample`: ``D(h) (h·n)``."""
-    hv = _validate.directions("h", h)
-    ax, ay = _blinn_phong_alphas(alpha_x, alpha_y)
-    return _run(_core_mf.blinn_phong_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay, shape=_NO_SHAPE)
+    return _one_direction(_core_mf.blinn_phong_pdf, "h", h, alpha_x, alpha_y,
+                          alphas=_blinn_phong_alphas, shape=_NO_SHAPE)
 
 
 def blinn_phong_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
@@ -533,10 +530,7 @@ def blinn_phong_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayL
 
     ``u2 = 1`` gives the horizon. (No visible-normal sampler: none is known in closed form.)
     """
-    v1 = _uniform("u1", u1)
-    v2 = _uniform("u2", u2)
-    ax, ay = _blinn_phong_alphas(alpha_x, alpha_y)
-    return _run(_core_mf.blinn_phong_sample, returns_vector=True, u1=v1, u2=v2, alpha_x=ax, alpha_y=ay, shape=_NO_SHAPE)
+    return _sample(_core_mf.blinn_phong_sample, u1, u2, alpha_x, alpha_y, alphas=_blinn_phong_alphas, shape=_NO_SHAPE)
 
 
 def blinn_phong_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
@@ -550,46 +544,36 @@ def blinn_phong_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealAr
 
     Two-sided (reads ``|w·n|``); 0 at the normal, +inf at exactly grazing.
     """
-    wv = _validate.directions("w", w)
-    ax, ay = _blinn_phong_alphas(alpha_x, alpha_y)
-    return _run(_core_mf.blinn_phong_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay, shape=_NO_SHAPE)
+    return _one_direction(_core_mf.blinn_phong_lambda, "w", w, alpha_x, alpha_y,
+                          alphas=_blinn_phong_alphas, shape=_NO_SHAPE)
 
 
 def blinn_phong_g1(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Smith masking ``G1 = 1 / (1 + Λ(w))`` with :func:`blinn_phong_lambda`."""
-    wv = _validate.directions("w", w)
-    ax, ay = _blinn_phong_alphas(alpha_x, alpha_y)
-    return _run(_core_mf.blinn_phong_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay, shape=_NO_SHAPE)
+    return _one_direction(_core_mf.blinn_phong_g1, "w", w, alpha_x, alpha_y,
+                          alphas=_blinn_phong_alphas, shape=_NO_SHAPE)
 
 
 def blinn_phong_g2_separable(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                              alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Separable masking-shadowing ``G2 = G1(wi) G1(wo)``."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _blinn_phong_alphas(alpha_x, alpha_y)
-    return _run(_core_mf.blinn_phong_g2_separable, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay,
-                shape=_NO_SHAPE)
+    return _two_directions(_core_mf.blinn_phong_g2_separable, wi, wo, alpha_x, alpha_y,
+                           alphas=_blinn_phong_alphas, shape=_NO_SHAPE)
 
 
 def blinn_phong_g2_height_correlated(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                                      alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Height-correlated masking-shadowing ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99)."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _blinn_phong_alphas(alpha_x, alpha_y)
-    return _run(_core_mf.blinn_phong_g2_height_correlated, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay,
-                shape=_NO_SHAPE)
+    return _two_directions(_core_mf.blinn_phong_g2_height_correlated, wi, wo, alpha_x, alpha_y,
+                           alphas=_blinn_phong_alphas, shape=_NO_SHAPE)
 
 
 def blinn_phong_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                             alpha_y: RealArrayLike | None = None) -> Float64Array:
     """Density of visible normals, ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38);
     ``wo`` below the horizon is mirrored, 0 for a grazing ``wo``."""
-    hv = _validate.directions("h", h)
-    w = _validate.directions("wo", wo)
-    ax, ay = _blinn_phong_alphas(alpha_x, alpha_y)
-    return _run(_core_mf.blinn_phong_pdf_visible, h=_Vector(hv), wo=_Vector(w), alpha_x=ax, alpha_y=ay, shape=_NO_SHAPE)
+    return _h_and_wo(_core_mf.blinn_phong_pdf_visible, h, wo, alpha_x, alpha_y,
+                     alphas=_blinn_phong_alphas, shape=_NO_SHAPE)
 
 # --------------------------------------------------------------------------
 # Student-t slopes (Ribardière et al. 2017)
@@ -614,17 +598,13 @@ def student_t_d(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike
 
     γ = 2 is GGX; γ -> ∞ is Beckmann (the difference falls as 1/γ).
     """
-    hv = _validate.directions("h", h)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.student_t_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay, shape=_student_t_gamma(gamma))
+    return _one_direction(_core_mf.student_t_d, "h", h, alpha_x, alpha_y, shape=lambda: _student_t_gamma(gamma))
 
 
 def student_t_pdf(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
                   gamma: RealArrayLike) -> Float64Array:
     """Density in solid angle of :func:`student_t_sample`: ``D(h) (h·n)`` (``gamma`` as :func:`student_t_d`)."""
-    hv = _validate.directions("h", h)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.student_t_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay, shape=_student_t_gamma(gamma))
+    return _one_direction(_core_mf.student_t_pdf, "h", h, alpha_x, alpha_y, shape=lambda: _student_t_gamma(gamma))
 
 
 def student_t_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
@@ -635,11 +615,7 @@ def student_t_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLik
 
     ``u2 = 1`` gives the horizon. (No visible-normal sampler: none is known in closed form.)
     """
-    v1 = _uniform("u1", u1)
-    v2 = _uniform("u2", u2)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.student_t_sample, returns_vector=True, u1=v1, u2=v2, alpha_x=ax, alpha_y=ay,
-                shape=_student_t_gamma(gamma))
+    return _sample(_core_mf.student_t_sample, u1, u2, alpha_x, alpha_y, shape=lambda: _student_t_gamma(gamma))
 
 
 def student_t_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
@@ -656,38 +632,28 @@ def student_t_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArra
 
     Two-sided (reads ``|w·n|``); 0 at the normal, +inf at exactly grazing.
     """
-    wv = _validate.directions("w", w)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.student_t_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay, shape=_student_t_gamma(gamma))
+    return _one_direction(_core_mf.student_t_lambda, "w", w, alpha_x, alpha_y, shape=lambda: _student_t_gamma(gamma))
 
 
 def student_t_g1(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
                  gamma: RealArrayLike) -> Float64Array:
     """Smith masking ``G1 = 1 / (1 + Λ(w))`` with :func:`student_t_lambda` (``gamma`` as :func:`student_t_d`)."""
-    wv = _validate.directions("w", w)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.student_t_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay, shape=_student_t_gamma(gamma))
+    return _one_direction(_core_mf.student_t_g1, "w", w, alpha_x, alpha_y, shape=lambda: _student_t_gamma(gamma))
 
 
 def student_t_g2_separable(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                            alpha_y: RealArrayLike | None = None, *, gamma: RealArrayLike) -> Float64Array:
     """Separable masking-shadowing ``G2 = G1(wi) G1(wo)`` (``gamma`` as :func:`student_t_d`)."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.student_t_g2_separable, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay,
-                shape=_student_t_gamma(gamma))
+    return _two_directions(_core_mf.student_t_g2_separable, wi, wo, alpha_x, alpha_y,
+                           shape=lambda: _student_t_gamma(gamma))
 
 
 def student_t_g2_height_correlated(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                                    alpha_y: RealArrayLike | None = None, *, gamma: RealArrayLike) -> Float64Array:
     """Height-correlated masking-shadowing ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99)
     (``gamma`` as :func:`student_t_d`)."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.student_t_g2_height_correlated, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay,
-                shape=_student_t_gamma(gamma))
+    return _two_directions(_core_mf.student_t_g2_height_correlated, wi, wo, alpha_x, alpha_y,
+                           shape=lambda: _student_t_gamma(gamma))
 
 
 def student_t_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
@@ -695,11 +661,7 @@ def student_t_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArra
     """Density of visible normals, ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38)
     (``gamma`` as :func:`student_t_d`);
     ``wo`` below the horizon is mirrored, 0 for a grazing ``wo``."""
-    hv = _validate.directions("h", h)
-    w = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.student_t_pdf_visible, h=_Vector(hv), wo=_Vector(w), alpha_x=ax, alpha_y=ay,
-                shape=_student_t_gamma(gamma))
+    return _h_and_wo(_core_mf.student_t_pdf_visible, h, wo, alpha_x, alpha_y, shape=lambda: _student_t_gamma(gamma))
 
 # --------------------------------------------------------------------------
 # exponential-power slopes (Holzschuch & Pacanowski 2017)
@@ -718,18 +680,15 @@ def exponential_power_d(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealA
 
     ``p = 1`` is Beckmann.
     """
-    hv = _validate.directions("h", h)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.exponential_power_d, h=_Vector(hv), alpha_x=ax, alpha_y=ay, shape=_exponential_power_p(p))
+    return _one_direction(_core_mf.exponential_power_d, "h", h, alpha_x, alpha_y, shape=lambda: _exponential_power_p(p))
 
 
 def exponential_power_pdf(h: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
                           p: RealArrayLike) -> Float64Array:
     """Density in solid angle of :func:`exponential_power_sample`: ``D(h) (h·n)``
     (``p`` as :func:`exponential_power_d`)."""
-    hv = _validate.directions("h", h)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.exponential_power_pdf, h=_Vector(hv), alpha_x=ax, alpha_y=ay, shape=_exponential_power_p(p))
+    return _one_direction(_core_mf.exponential_power_pdf, "h", h, alpha_x, alpha_y,
+                          shape=lambda: _exponential_power_p(p))
 
 
 def exponential_power_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: RealArrayLike,
@@ -740,11 +699,7 @@ def exponential_power_sample(u1: RealArrayLike, u2: RealArrayLike, alpha_x: Real
 
     ``u2 = 1`` gives the horizon. (No visible-normal sampler: none is known in closed form.)
     """
-    v1 = _uniform("u1", u1)
-    v2 = _uniform("u2", u2)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.exponential_power_sample, returns_vector=True, u1=v1, u2=v2, alpha_x=ax, alpha_y=ay,
-                shape=_exponential_power_p(p))
+    return _sample(_core_mf.exponential_power_sample, u1, u2, alpha_x, alpha_y, shape=lambda: _exponential_power_p(p))
 
 
 def exponential_power_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
@@ -761,39 +716,31 @@ def exponential_power_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: 
 
     Two-sided (reads ``|w·n|``); 0 at the normal, +inf at exactly grazing.
     """
-    wv = _validate.directions("w", w)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.exponential_power_lambda, w=_Vector(wv), alpha_x=ax, alpha_y=ay, shape=_exponential_power_p(p))
+    return _one_direction(_core_mf.exponential_power_lambda, "w", w, alpha_x, alpha_y,
+                          shape=lambda: _exponential_power_p(p))
 
 
 def exponential_power_g1(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
                          p: RealArrayLike) -> Float64Array:
     """Smith masking ``G1 = 1 / (1 + Λ(w))`` with :func:`exponential_power_lambda`
     (``p`` as :func:`exponential_power_d`)."""
-    wv = _validate.directions("w", w)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.exponential_power_g1, w=_Vector(wv), alpha_x=ax, alpha_y=ay, shape=_exponential_power_p(p))
+    return _one_direction(_core_mf.exponential_power_g1, "w", w, alpha_x, alpha_y,
+                          shape=lambda: _exponential_power_p(p))
 
 
 def exponential_power_g2_separable(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                                    alpha_y: RealArrayLike | None = None, *, p: RealArrayLike) -> Float64Array:
     """Separable masking-shadowing ``G2 = G1(wi) G1(wo)`` (``p`` as :func:`exponential_power_d`)."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.exponential_power_g2_separable, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay,
-                shape=_exponential_power_p(p))
+    return _two_directions(_core_mf.exponential_power_g2_separable, wi, wo, alpha_x, alpha_y,
+                           shape=lambda: _exponential_power_p(p))
 
 
 def exponential_power_g2_height_correlated(wi: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
                                            alpha_y: RealArrayLike | None = None, *, p: RealArrayLike) -> Float64Array:
     """Height-correlated masking-shadowing ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99)
     (``p`` as :func:`exponential_power_d`)."""
-    a = _validate.directions("wi", wi)
-    b = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.exponential_power_g2_height_correlated, wi=_Vector(a), wo=_Vector(b), alpha_x=ax, alpha_y=ay,
-                shape=_exponential_power_p(p))
+    return _two_directions(_core_mf.exponential_power_g2_height_correlated, wi, wo, alpha_x, alpha_y,
+                           shape=lambda: _exponential_power_p(p))
 
 
 def exponential_power_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: RealArrayLike,
@@ -801,11 +748,8 @@ def exponential_power_pdf_visible(h: RealArrayLike, wo: RealArrayLike, alpha_x: 
     """Density of visible normals, ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38)
     (``p`` as :func:`exponential_power_d`);
     ``wo`` below the horizon is mirrored, 0 for a grazing ``wo``."""
-    hv = _validate.directions("h", h)
-    w = _validate.directions("wo", wo)
-    ax, ay = _alphas(alpha_x, alpha_y)
-    return _run(_core_mf.exponential_power_pdf_visible, h=_Vector(hv), wo=_Vector(w), alpha_x=ax, alpha_y=ay,
-                shape=_exponential_power_p(p))
+    return _h_and_wo(_core_mf.exponential_power_pdf_visible, h, wo, alpha_x, alpha_y,
+                     shape=lambda: _exponential_power_p(p))
 
 
 # --------------------------------------------------------------------------

@@ -9,10 +9,11 @@
     pbplot.albedo_curves(pb.presets.get("skin"))            # E(θo) per lobe, Axes
     pbplot.parameter_sweep()                                # Burley 2012 figure 16, Figure
     pbplot.blend_demo("gold", "blue_rubber")                # Material.mix with a mask, Axes
+    pbplot.microfacet_family(0.3)                           # D(θh) and Λ(θ) of pb.microfacet, Figure
 
 Every function that draws one panel takes ``ax=`` (an existing Axes to draw
 into; a new figure is made when it is None) and returns that Axes;
-:func:`parameter_sweep` draws many panels and returns the Figure. A material
+:func:`parameter_sweep` and :func:`microfacet_family` draw several panels and return the Figure. A material
 argument is a :class:`~principled_brdf.Material` or the name of a preset
 (``pb.presets.names()``). All numbers come from the batched kernel
 (``pb.eval``, ``pb.eval_lobes``, ``pb.sample``, ``pb.albedo``,
@@ -54,7 +55,7 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
     from .render import _EnvironmentArg
 
 __all__ = ["brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves", "parameter_sweep", "blend_demo",
-           "slice_directions", "SCALAR_PARAMETERS", "CHANNELS"]
+           "microfacet_family", "slice_directions", "SCALAR_PARAMETERS", "CHANNELS"]
 
 #: The ten scalar parameters of the model, in the library's order.
 SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items() if info.slots == 1)
@@ -603,3 +604,109 @@ def blend_demo(a: Material | str, b: Material | str, *, mask: RealArrayLike | No
     ax.imshow(_rgba(image, inside, exposure), interpolation="nearest")
     _sphere_axes(ax, "Material.mix(a, b, mask)")
     return ax
+
+
+# --------------------------------------------------------------------------
+# 7. the microfacet family (pb.microfacet)
+
+
+def _shapes(name: str, values: Iterable[float], lower: float, upper: float, open_lower: bool = False) -> list[float]:
+    if isinstance(values, (str, bytes)) or not isinstance(values, typing.Iterable):
+        raise TypeError(f"{name}: expected a sequence of numbers, got {type(values).__name__}")
+    return [_real(f"{name}[{k}]", value, lower, upper, open_lower=open_lower) for k, value in enumerate(values)]
+
+
+def _family_axes(axes: object) -> tuple[Axes, Axes] | None:
+    if axes is None:
+        return None
+    from matplotlib.axes import Axes
+
+    if isinstance(axes, (str, bytes)) or not isinstance(axes, typing.Sequence) or len(axes) != 2:
+        raise TypeError(f"axes: expected two matplotlib Axes (D and Λ), got {type(axes).__name__}")
+    for k, ax in enumerate(axes):
+        if not isinstance(ax, Axes):
+            raise TypeError(f"axes[{k}]: expected a matplotlib Axes, got {type(ax).__name__}")
+        if ax.name == "polar":
+            raise ValueError(f"axes[{k}]: expected a rectilinear Axes, got a polar one")
+    return axes[0], axes[1]
+
+
+def microfacet_family(alpha: float = 0.3, *, student_t_gammas: Iterable[float] = (1.6, 4.0),
+                      exponential_power_ps: Iterable[float] = (0.5, 2.0), gtr_gammas: Iterable[float] = (1.0, 1.5),
+                      resolution: int = 361, decades: float = 10.0, legend: bool = True,
+                      axes: tuple[Axes, Axes] | None = None, figsize: tuple[float, float] = (11.0, 4.4)) -> Figure:
+    """The distributions of ``pb.microfacet`` at one roughness ``alpha`` (isotropic, in (0, 1]):
+    ``D(θh)`` against θh (left) and Smith's ``Λ(θ)`` against the angle of the direction (right),
+    both on a logarithmic scale so that the tails show; returns the Figure.
+
+    Drawn: GGX, Beckmann, Blinn-Phong at the exponent that matches ``alpha`` (``n = 2/α² - 2``,
+    Walter et al. 2007), Student-t at each of ``student_t_gammas`` (γ > 3/2; Ribardière et al.
+    2017: γ = 2 is GGX, γ -> ∞ Beckmann), exponential power at each of ``exponential_power_ps``
+    (p in [0.1, 10]; Holzschuch & Pacanowski 2017: p = 1 is Beckmann) and, in the D panel only,
+    GTR at each of ``gtr_gammas`` (γ in (0, 1e6]; Burley 2012 appendix B: γ = 1 is the clear
+    coat's GTR1, γ = 2 GGX), which is not shape-invariant and has no closed-form Λ (README
+    "The microfacet family"). ``Λ`` is at ``w = (sin θ, 0, cos θ)``; ``G1 = 1 / (1 + Λ)``
+    (Smith masking, Heitz 2014). Each panel shows the ``decades`` below its largest value; a line stops
+    where it falls below that floor, so every plotted value is finite and positive.
+    ``resolution`` angles from 0 to 90 degrees (90 itself left out: ``Λ`` is infinite there).
+
+    ``axes``: two existing Axes to draw into (D, then Λ); by default a new Figure with two.
+    Both panels carry the same line labels (``"GGX"``, ``"Beckmann"``, ``"Student-t γ = 1.6"``,
+    ...); the legend (``legend``) is on the D panel.
+    """
+    a = _real("alpha", alpha, 0.0, 1.0, open_lower=True)
+    gammas = _shapes("student_t_gammas", student_t_gammas, 1.5, 1e12, open_lower=True)
+    ps = _shapes("exponential_power_ps", exponential_power_ps, 0.1, 10.0)
+    gtrs = _shapes("gtr_gammas", gtr_gammas, 0.0, 1e6, open_lower=True)
+    n = _resolution(resolution, minimum=8)
+    decades = _real("decades", decades, 0.0, open_lower=True)
+    drawn = _family_axes(axes)
+    from . import microfacet as mf
+
+    theta = np.linspace(0.0, 90.0, n, endpoint=False)
+    radians = np.radians(theta)
+    w = np.stack([np.sin(radians), np.zeros_like(radians), np.cos(radians)], axis=-1)
+    exponent = 2.0 / a**2 - 2.0
+    # (label, colour, line style, D(h), Λ(w) or None)
+    curves: list[tuple[str, str, str | tuple[int, tuple[int, ...]], Float64Array, Float64Array | None]] = [
+        ("GGX", "tab:blue", "-", mf.ggx_d(w, a), mf.ggx_lambda(w, a)),
+        ("Beckmann", "tab:orange", "-", mf.beckmann_d(w, a), mf.beckmann_lambda(w, a)),
+        (f"Blinn-Phong (n = {exponent:.3g})", "tab:green", "--", mf.blinn_phong_d(w, a), mf.blinn_phong_lambda(w, a)),
+    ]
+    shades = ("tab:purple", "tab:pink", "tab:olive", "tab:cyan")
+    curves += [(f"Student-t γ = {g:g}", shades[k % len(shades)], "-.", mf.student_t_d(w, a, gamma=g),
+                mf.student_t_lambda(w, a, gamma=g)) for k, g in enumerate(gammas)]
+    shades = ("tab:red", "tab:brown", "darkgoldenrod", "maroon")
+    curves += [(f"exponential power p = {p:g}", shades[k % len(shades)], ":", mf.exponential_power_d(w, a, p=p),
+                mf.exponential_power_lambda(w, a, p=p)) for k, p in enumerate(ps)]
+    shades = ("0.35", "0.6", "0.15", "0.75")
+    curves += [(f"GTR γ = {g:g}" + (" (GTR1)" if g == 1.0 else ""), shades[k % len(shades)], (0, (5, 1, 1, 1)),
+                mf.gtr_d(w[:, 2], a, g), None) for k, g in enumerate(gtrs)]
+
+    if drawn is None:
+        fig, (d_ax, lambda_ax) = _pyplot().subplots(1, 2, figsize=figsize, layout="constrained")
+    else:
+        d_ax, lambda_ax = drawn
+        fig = typing.cast("Figure", d_ax.figure)
+    panels = ((d_ax, [(label, color, style, d) for label, color, style, d, _ in curves]),
+              (lambda_ax, [(label, color, style, lam) for label, color, style, _, lam in curves if lam is not None]))
+    for ax, lines in panels:
+        top = max(float(np.max(value[np.isfinite(value)])) for *_, value in lines)
+        floor = top * 10.0 ** -decades
+        for label, color, style, value in lines:
+            keep = np.isfinite(value) & (value >= floor) & (value > 0.0)
+            ax.plot(theta[keep], value[keep], color=color, ls=style, lw=1.4, label=label)
+        ax.set_yscale("log")
+        ax.set_ylim(floor, top * 3.0)
+        ax.set_xlim(0.0, 90.0)
+        ax.set_xticks([0, 15, 30, 45, 60, 75, 90])
+        ax.grid(True, which="major", color="0.9", lw=0.6)
+    d_ax.set_xlabel("θh (degrees)")
+    d_ax.set_ylabel("D(θh) (1/sr)")
+    d_ax.set_title(f"normal distributions D, α = {a:g}")
+    lambda_ax.set_xlabel("θ of the direction (degrees)")
+    lambda_ax.set_ylabel("Λ(θ) (Smith; G1 = 1 / (1 + Λ))")
+    lambda_ax.set_title(f"Smith Λ, α = {a:g} (GTR: no closed form)")
+    if legend:
+        d_ax.legend(loc="lower left", fontsize="small", frameon=False)
+    return fig
