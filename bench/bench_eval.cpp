@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "materials.hpp"
 #include "native_loop.hpp"
 #include "principled_brdf/batch.hpp"
 #include "principled_brdf/reference.hpp"
@@ -113,6 +115,22 @@ void simd_eval(benchmark::State& state, std::string isa, bool soa, bool per_elem
 // f with the multiple-scattering energy compensation (pb.eval(..., energy_compensation=True))
 void simd_eval_compensated(benchmark::State& state, std::string isa, bool soa, bool per_element) {
     simd_eval_with(state, isa, soa, per_element, false, pb::Output::kTotal, true);
+}
+
+// The material set (materials.hpp): f of material `index`, or of the random
+// per-element materials at index -1, (N, 3), the direction check on or off.
+void simd_eval_material(benchmark::State& state, std::string isa, int index, bool checked) {
+    Data& d = data_for(state.range(0));
+    pb::EvalJob job = make_job(d, false, index < 0);
+    if (index >= 0)
+        for (int s = 0; s < pb::kParamSlots; ++s) job.params[s].value = bench::kMaterials[index].slots[s];
+    if (checked) job.check = pb::direction_check(1e-3);
+    const int threads = threads_of(state);
+    for (auto _ : state) {
+        pb::eval(job, d.n, threads, isa);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * d.n);
 }
 
 // Importance sampling with the counter-based generator: wi, pdf, weight, lobe per element.
@@ -252,6 +270,23 @@ void register_all() {
                     }
                 }
             }
+        }
+    }
+    // the material set: in cache on one thread, unchecked; 16M pairs on every thread, checked (the
+    // default call), beside the copy at the same size
+    for (const std::string& isa : pb::available_isas()) {
+        const int count = static_cast<int>(std::size(bench::kMaterials));
+        for (int index = -1; index < count; ++index) {
+            const std::string material = index < 0 ? "random_per_element" : bench::kMaterials[index].name;
+            const std::string name = "eval_material/" + isa + "/aos/" + material;
+            benchmark::RegisterBenchmark(name.c_str(), simd_eval_material, isa, index, false)
+                ->Args({kSizes[0], 1})
+                ->UseRealTime()
+                ->Unit(benchmark::kMicrosecond);
+            benchmark::RegisterBenchmark((name + "/checked").c_str(), simd_eval_material, isa, index, true)
+                ->Args({kSizes[2], all})
+                ->UseRealTime()
+                ->Unit(benchmark::kMicrosecond);
         }
     }
     for (std::int64_t n : kSizes) {

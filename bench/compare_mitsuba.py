@@ -11,8 +11,9 @@ against `pb.sample` with given uniforms. Each figure is the best of
 `--repeats` timed runs after a warm-up (which compiles Mitsuba's kernel);
 Dr.Jit runs asynchronously, so its timer stops after `dr.sync_thread()`.
 "One core" pins the process to CPU 0 (sched_setaffinity) and runs both on
-one thread; "all" uses every core. Prints a Markdown table (M pairs/s and
-ratios); not a test dependency.
+one thread; "all" uses every core. `--material` takes a preset instead of
+the benchmark material. Prints a Markdown table (M pairs/s and ratios); not a
+test dependency.
 """
 
 from __future__ import annotations
@@ -27,6 +28,15 @@ import principled_brdf as pb
 
 MATERIAL = dict(base_color=(0.82, 0.67, 0.16), metallic=0.2, roughness=0.4, sheen=0.2, clearcoat=0.5,
                 clearcoat_gloss=0.7, specular=0.5)
+# this library's names for Mitsuba's `principled` parameters (it has no subsurface)
+MITSUBA_NAMES = {"metallic": "metallic", "specular": "specular", "specular_tint": "spec_tint", "roughness": "roughness",
+                 "anisotropic": "anisotropic", "sheen": "sheen", "sheen_tint": "sheen_tint", "clearcoat": "clearcoat",
+                 "clearcoat_gloss": "clearcoat_gloss"}
+
+
+def material_named(name: str) -> pb.Material:
+    """`--material`: the default benchmark material, or a preset (every parameter passed to both)."""
+    return pb.Material(**MATERIAL) if name == "benchmark" else pb.presets.get(name)
 
 
 def best_seconds(run, repeats: int) -> float:
@@ -50,13 +60,17 @@ def random_pairs(n: int, seed: int = 1):
     return upper(n), upper(n), rng.random((n, 3), dtype=np.float32)
 
 
-def mitsuba_timers(n: int, wi, wo, u, repeats: int):
+def mitsuba_timers(material: pb.Material, n: int, wi, wo, u, repeats: int):
     import drjit as dr
     import mitsuba as mi
 
     mi.set_variant("llvm_ad_rgb")
-    bsdf = mi.load_dict({"type": "principled", "base_color": {"type": "rgb", "value": list(MATERIAL["base_color"])},
-                         **{k: v for k, v in MATERIAL.items() if k != "base_color"}})
+    values = material.as_dict()
+    if float(values["subsurface"]) != 0.0:
+        raise SystemExit("Mitsuba's principled BSDF has no subsurface: choose a material without it")
+    bsdf = mi.load_dict({"type": "principled",
+                         "base_color": {"type": "rgb", "value": [float(c) for c in values["base_color"]]},
+                         **{theirs: float(values[ours]) for ours, theirs in MITSUBA_NAMES.items()}})
     ctx = mi.BSDFContext()
     si = dr.zeros(mi.SurfaceInteraction3f, n)
     si.wi = mi.Vector3f(wo[:, 0], wo[:, 1], wo[:, 2])  # Mitsuba's wi: towards the viewer
@@ -76,8 +90,7 @@ def mitsuba_timers(n: int, wi, wo, u, repeats: int):
     return {"eval": best_seconds(evaluate, repeats), "sample": best_seconds(sample, repeats)}
 
 
-def library_timers(n: int, wi, wo, u, threads, repeats: int):
-    m = pb.Material(**MATERIAL)
+def library_timers(m: pb.Material, n: int, wi, wo, u, threads, repeats: int):
     out = np.empty_like(wi)
     return {
         "eval, out=, check=False": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, out=out, check=False,
@@ -94,19 +107,23 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[1 << 16, 1 << 20, 1 << 24])
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--material", default="benchmark", choices=["benchmark", *pb.presets.names()],
+                        help="the benchmark material (every lobe but subsurface on) or a preset")
     args = parser.parse_args()
     import drjit as dr
 
+    material = material_named(args.material)
+
     cores = sorted(os.sched_getaffinity(0))
-    print(f"principled-brdf {pb.__version__}, {pb.cpu_info()['isa']}; Mitsuba 3 llvm_ad_rgb\n")
+    print(f"principled-brdf {pb.__version__}, {pb.cpu_info()['isa']}; Mitsuba 3 llvm_ad_rgb; material {args.material}\n")
     print("| pairs | cores | call | pb M pairs/s | Mitsuba M pairs/s | pb / Mitsuba |\n|---:|---|---|---:|---:|---:|")
     for label, affinity, threads in (("one (pinned)", {cores[0]}, 1), ("all", set(cores), None)):
         os.sched_setaffinity(0, affinity)
         dr.set_thread_count(len(affinity))
         for n in args.sizes:
             wi, wo, u = random_pairs(n)
-            theirs = mitsuba_timers(n, wi, wo, u, args.repeats)
-            ours = library_timers(n, wi, wo, u, threads, args.repeats)
+            theirs = mitsuba_timers(material, n, wi, wo, u, args.repeats)
+            ours = library_timers(material, n, wi, wo, u, threads, args.repeats)
             for call, seconds in ours.items():
                 peer = theirs["sample" if call.startswith("sample") else "eval"]
                 print(f"| {n:,} | {label} | {call} | {n / seconds / 1e6:.0f} | {n / peer / 1e6:.0f} | "

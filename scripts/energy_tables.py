@@ -40,9 +40,11 @@ from multiprocessing import Pool
 
 import numpy as np
 
-# Nodes: μ_k = k / (COSINES - 1) (μ_0 = 0 evaluated at MU_FLOOR), r_j = j / (ROUGHNESSES - 1).
-COSINES = 96
-ROUGHNESSES = 64
+# Nodes: μ_k = k / (COSINES - 1) (μ_0 = 0 evaluated at MU_FLOOR), r_j = j / (ROUGHNESSES - 1),
+# at power-of-two spacings: the lookup's μ (COSINES - 1) and r (ROUGHNESSES - 1) are then
+# exact in float32, and so are their fractional parts, the interpolation weights.
+COSINES = 129
+ROUGHNESSES = 65
 MU_FLOOR = 1e-4
 SPAN = 16.0  # the y range either side of ln alpha: the measure beyond is below 1e-13
 MODELS = ("disney2014", "disney2012")

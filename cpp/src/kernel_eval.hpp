@@ -28,22 +28,6 @@ PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
 template <Output output>
 struct CompensatedPrepared : Prepared<output> {
     MultipleScatteringLobe<Floats> ms;
-    alignas(64) float row[energy::kCosines];
-
-    // For a uniform material, once per call: the two table rows about r_eff
-    // blended into `row`, so that a lookup fetches two values instead of four.
-    void blend_rows() {
-        alignas(64) std::int32_t offset[kLanes];
-        alignas(64) float fraction[kLanes];
-        ms.row.offset.store_aligned(offset);
-        ms.row.fraction.store_aligned(fraction);
-        const float* below = ms.missing + offset[0];
-        const float* above = below + energy::kCosines;
-        const float t = fraction[0];
-        for (int k = 0; k < energy::kCosines; ++k) row[k] = below[k] * (1.0f - t) + above[k] * t;
-        ms.missing = row;
-        ms.single_row = true;
-    }
 };
 
 template <Output output, bool compensated>
@@ -95,10 +79,9 @@ struct JacobianStore {
 // its weight w3 the cosine lobe's in the pdf (model/energy.hpp).
 template <Model model, Output output, Layouts layouts>
 PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi,
-                                             const Vec3<Floats>& wo, const CompensatedPrepared<output>& material) {
+                                             const Vec3<Floats>& wo, const Shading<Floats>& s,
+                                             const MultipleScatteringLobe<Floats>& ms) {
     static_assert(output != Output::kGradient, "the energy compensation has no gradient");
-    const Shading<Floats>& s = material.shading;
-    const MultipleScatteringLobe<Floats>& ms = material.ms;
     const Geometry<Floats> g = geometry_of(wi, wo);
     const Mask above = above_surface(g);
     const View<Floats> view = view_of<model>(wo, s);
@@ -124,18 +107,18 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
     }
 }
 
-template <Model model, Output output, Layouts layouts, bool compensated>
+template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes = LobeSet::kAll>
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
                                  const PreparedOf<output, compensated>& material) {
     if constexpr (compensated) {
-        eval_compensated_batch<model, output, layouts>(job, i, wi, wo, material);
+        eval_compensated_batch<model, output, layouts>(job, i, wi, wo, material.shading, material.ms);
         return;
     }
     const Shading<Floats>& s = material.shading;
     const Geometry<Floats> g = geometry_of(wi, wo);
     // select discards whatever the formulas gave below the surface (H may be 0)
     const Mask above = above_surface(g);
-    const View<Floats> view = view_of<model>(wo, s);
+    const View<Floats> view = view_of<model, lobes>(wo, s);
     if constexpr (output == Output::kGradient) {
         // x cos θl or x times 1 (the same bits), then 0 below the surface
         const Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
@@ -155,39 +138,75 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
         auto masked = [&](Floats x) { return select(above, job.cosine ? wi.z * x : x, Floats(0.0f)); };
         store_rgb<layouts>(job.out[0], i, {masked(f.r), masked(f.g), masked(f.b)});
     } else {
-        const LobeValues<Floats> lobes = eval_lobes<model>(g, s, view);
+        const LobeValues<Floats> values = eval_lobes<model, lobes>(g, s, view);
         const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
         auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };
         if constexpr (output == Output::kLobes) {
-            store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse_rgb(s)));
-            store_rgb<layouts>(job.out[1], i, masked(lobes.sheen_rgb(s)));
-            store_rgb<layouts>(job.out[2], i, masked(lobes.specular_rgb(s)));
-            store_rgb<layouts>(job.out[3], i, masked(lobes.clearcoat_rgb()));
+            store_rgb<layouts>(job.out[0], i, masked(values.diffuse_rgb(s)));
+            store_rgb<layouts>(job.out[1], i, masked(values.sheen_rgb(s)));
+            store_rgb<layouts>(job.out[2], i, masked(values.specular_rgb(s)));
+            store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
             store_rgb<layouts>(job.out[4], i, zero);
         } else {
-            store_rgb<layouts>(job.out[0], i, masked(lobes.total(s)));
+            store_rgb<layouts>(job.out[0], i, masked(values.template total<lobes>(s)));
         }
     }
 }
 
+// The lobes a material needs, from its values (LobeSet's conditions): a
+// uniform one's once per call, a batch's when all its lanes agree. The
+// clearcoat first: a batch of random materials is done after one test.
+template <class Value, class Condition>
+PB_KERNEL_INLINE LobeSet lobe_set_where(Value value, Condition holds) {
+    if (!holds(value(kClearcoat) == 0.0f)) return LobeSet::kAll;
+    if (holds(value(kMetallic) == 1.0f)) return LobeSet::kSpecular;
+    if (holds((value(kSheen) == 0.0f) & (value(kSubsurface) == 0.0f))) return LobeSet::kPlain;
+    return LobeSet::kAll;
+}
+
+inline LobeSet lobe_set_of(const ParamSlot* params) {
+    return lobe_set_where([&](Param slot) { return params[slot].value; }, [](bool b) { return b; });
+}
+
+PB_KERNEL_INLINE LobeSet lobe_set_of(const RawMaterial& m) {
+    return lobe_set_where([&](Param slot) { return m.slot[slot]; }, [](const Mask& b) { return all(b); });
+}
+
 // One batch at i; false, with nothing stored, when the fast direction test
 // does not accept it.
-template <Model model, Output output, bool per_element, Layouts layouts, bool compensated>
+template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes>
 PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const PreparedOf<output, compensated>& uniform) {
     const Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
     const Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled && !all(surely_unit_length(wi, job.check) & surely_unit_length(wo, job.check))) return false;
-    if constexpr (per_element) {
-        eval_batch<model, output, layouts, compensated>(job, i, wi, wo,
-                                                        prepare_for<model, output, compensated>(load_material(job.params, i)));
+    if constexpr (per_element && compensated) {
+        // the lobes' constants as locals: a CompensatedPrepared built per batch was copied whole (rep movs)
+        const RawMaterial m = load_material(job.params, i);
+        const Shading<Floats> s = shading_of(m);
+        eval_compensated_batch<model, output, layouts>(job, i, wi, wo, s, multiple_scattering_of(m.slot, s, model));
+    } else if constexpr (per_element && output == Output::kTotal) {
+        // the batch's LobeSet, when all its lanes agree (a texture's metal or plastic regions)
+        const RawMaterial m = load_material(job.params, i);
+        switch (lobe_set_of(m)) {
+            case LobeSet::kSpecular:
+                eval_batch<model, output, layouts, false, LobeSet::kSpecular>(job, i, wi, wo, prepare<output>(m));
+                break;
+            case LobeSet::kPlain:
+                eval_batch<model, output, layouts, false, LobeSet::kPlain>(job, i, wi, wo, prepare<output>(m));
+                break;
+            default:
+                eval_batch<model, output, layouts, false>(job, i, wi, wo, prepare<output>(m));
+        }
+    } else if constexpr (per_element) {
+        eval_batch<model, output, layouts, compensated>(job, i, wi, wo, prepare<output>(load_material(job.params, i)));
     } else {
-        eval_batch<model, output, layouts, compensated>(job, i, wi, wo, uniform);
+        eval_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, uniform);
     }
     return true;
 }
 
 // The last pad.count < kLanes elements, as one batch.
-template <Model model, Output output, bool per_element, bool compensated>
+template <Model model, Output output, bool per_element, bool compensated, LobeSet lobes>
 bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, compensated>& uniform) {
     alignas(64) PadBuffer wi, wo, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
@@ -202,7 +221,7 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, 
     padded.jacobian = jacobian;
     padded.jacobian_row_stride = 0;
 
-    if (!eval_one_batch<model, output, per_element, Layouts::kMixed, compensated>(padded, 0, uniform)) return false;
+    if (!eval_one_batch<model, output, per_element, Layouts::kMixed, compensated, lobes>(padded, 0, uniform)) return false;
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf || output == Output::kValuePdf) unpad_scalars(job.pdf, pad, pdf);
@@ -219,17 +238,18 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, 
 
 // -1 with every element of [begin, end) written, or the start of the first
 // batch the fast direction test did not accept (see run_checked).
-template <Model model, Output output, bool per_element, Layouts layouts, bool compensated>
+template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes>
 std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     PreparedOf<output, compensated> uniform{};
+    BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
         uniform = prepare_for<model, output, compensated>(load_material(job.params, 0));
-        if constexpr (compensated) uniform.blend_rows();
+        if constexpr (compensated) row.use_for(uniform.ms);
     }
     std::int64_t i = begin;
     for (; i + kLanes <= end; i += kLanes)
-        if (!eval_one_batch<model, output, per_element, layouts, compensated>(job, i, uniform)) return i;
-    if (i < end && !eval_tail<model, output, per_element, compensated>(job, Padding{i, end - i}, uniform)) return i;
+        if (!eval_one_batch<model, output, per_element, layouts, compensated, lobes>(job, i, uniform)) return i;
+    if (i < end && !eval_tail<model, output, per_element, compensated, lobes>(job, Padding{i, end - i}, uniform)) return i;
     return -1;
 }
 
@@ -244,14 +264,14 @@ inline Layouts layouts_of(const EvalJob& job) {
     return Layouts::kMixed;
 }
 
-template <Model model, Output output, bool per_element, Layouts layouts, bool compensated>
+template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes = LobeSet::kAll>
 std::int64_t eval_checked(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     auto rejected = [&](std::int64_t i) { return !unit_length_at(job.wi, i, job.check) || !unit_length_at(job.wo, i, job.check); };
-    return run_checked(job, begin, end, eval_loop<model, output, per_element, layouts, compensated>, rejected);
+    return run_checked(job, begin, end, eval_loop<model, output, per_element, layouts, compensated, lobes>, rejected);
 }
 
 // -1 with every element written, or the first element whose wi or wo fails the direction check.
-template <Model model, Output output, bool per_element, bool compensated>
+template <Model model, Output output, bool per_element, bool compensated, LobeSet lobes = LobeSet::kAll>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     if constexpr (compensated) {  // (N, 3) arrays, or any layout through the mixed loads and stores
         return layouts_of(job) == Layouts::kInterleaved
@@ -260,18 +280,26 @@ std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t
     }
     switch (layouts_of(job)) {
         case Layouts::kInterleaved:
-            return eval_checked<model, output, per_element, Layouts::kInterleaved, compensated>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kInterleaved, compensated, lobes>(job, begin, end);
         case Layouts::kRows:
-            return eval_checked<model, output, per_element, Layouts::kRows, compensated>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kRows, compensated, lobes>(job, begin, end);
         default:
-            return eval_checked<model, output, per_element, Layouts::kMixed, compensated>(job, begin, end);
+            return eval_checked<model, output, per_element, Layouts::kMixed, compensated, lobes>(job, begin, end);
     }
 }
 
+// f alone (Output::kTotal) of a uniform material gets the loop of its LobeSet.
 template <Model model, Output output, bool compensated = false>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    return job.uniform_material() ? eval_range_for<model, output, false, compensated>(job, begin, end)
-                                  : eval_range_for<model, output, true, compensated>(job, begin, end);
+    if (!job.uniform_material()) return eval_range_for<model, output, true, compensated>(job, begin, end);
+    if constexpr (output == Output::kTotal && !compensated) {
+        switch (lobe_set_of(job.params)) {
+            case LobeSet::kSpecular: return eval_range_for<model, output, false, false, LobeSet::kSpecular>(job, begin, end);
+            case LobeSet::kPlain: return eval_range_for<model, output, false, false, LobeSet::kPlain>(job, begin, end);
+            default: break;
+        }
+    }
+    return eval_range_for<model, output, false, compensated>(job, begin, end);
 }
 
 // The energy compensation's loops: every output but the Jacobian (the bindings refuse it).

@@ -18,9 +18,10 @@ struct Chosen {
     Floats fv;
 };
 
-// false, with nothing computed, when the fast direction test does not accept wo
-template <Model model, Layouts layouts>
-PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed, Chosen& c) {
+// wo and the uniforms (given or counter-based); false, with nothing loaded,
+// when the fast direction test does not accept wo
+template <Layouts layouts>
+PB_KERNEL_INLINE bool load_inputs(const SampleJob& job, std::int64_t i, const CounterSeed& seed, Chosen& c) {
     c.wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled && !all(surely_unit_length(c.wo, job.check))) return false;
     if (job.u.data != nullptr) {
@@ -29,9 +30,20 @@ PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading
     } else {
         c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index) + static_cast<std::uint64_t>(i), seed);
     }
+    return true;
+}
+
+PB_KERNEL_INLINE void choose_lobe_for(Chosen& c, const Shading<Floats>& s) {
     c.fv = schlick_weight(c.wo.z);
     c.weights = lobe_weights(c.fv, s);
     c.lobe = choose_lobe(c.u.u0, s, c.weights);
+}
+
+// false, with nothing computed, when the fast direction test does not accept wo
+template <Model model, Layouts layouts>
+PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed, Chosen& c) {
+    if (!load_inputs<layouts>(job, i, seed, c)) return false;
+    choose_lobe_for(c, s);
     return true;
 }
 
@@ -39,11 +51,12 @@ PB_KERNEL_INLINE Direction<Floats> draw(const SampleJob& job, const Chosen& c, c
     return sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
 }
 
-// Stores a batch's sample; with_lobes also each lobe's share of the weight.
-template <Model model, Layouts layouts, bool with_lobes>
-PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction<Floats>& d,
-                            const Shading<Floats>& s) {
-    const Weighed<Floats> w = weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler);
+// Stores a batch's sample; with_lobes also each lobe's share of the weight,
+// the fifth (the multiple-scattering lobe's) given.
+template <Layouts layouts, bool with_lobes>
+PB_KERNEL_INLINE void store_sample(const SampleJob& job, std::int64_t i, const LobeChoice<Floats>& lobe,
+                                   const Weighed<Floats>& w, const Shading<Floats>& s,
+                                   const Rgb<Floats>& multiple_scattering_share) {
     store_rgb<layouts>(job.wi, i, Rgb<Floats>{w.wi.x, w.wi.y, w.wi.z});
     w.pdf.store_unaligned(job.pdf + i);
     store_rgb<layouts>(job.weight, i, w.weight);
@@ -52,13 +65,19 @@ PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& 
         store_rgb<layouts>(job.lobe_weight[1], i, w.share(w.lobes.sheen_rgb(s)));
         store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
         store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
-        const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
-        store_rgb<layouts>(job.lobe_weight[4], i, zero);
+        store_rgb<layouts>(job.lobe_weight[4], i, multiple_scattering_share);
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
-    const Floats lobe_index = select(c.lobe.cosine, index_bits(0), select(c.lobe.specular, index_bits(1), index_bits(2)));
+    const Floats lobe_index = select(lobe.cosine, index_bits(0), select(lobe.specular, index_bits(1), index_bits(2)));
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
+}
+
+template <Model model, Layouts layouts, bool with_lobes>
+PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction<Floats>& d,
+                            const Shading<Floats>& s) {
+    const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+    store_sample<layouts, with_lobes>(job, i, c.lobe, weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler), s, zero);
 }
 
 // The energy compensation's batch (model/energy.hpp): the multiple-scattering
@@ -77,35 +96,13 @@ PB_KERNEL_INLINE bool sample_compensated_batch(const SampleJob& job, std::int64_
     const Shading<Floats>& material = per_element ? per_batch : uniform;
     const MultipleScatteringLobe<Floats>& ms = per_element ? per_batch_ms : uniform_ms;
     Chosen c;
-    c.wo = load_vec3<layouts>(job.wo, i);
-    if (job.check.enabled && !all(surely_unit_length(c.wo, job.check))) return false;
-    if (job.u.data != nullptr) {
-        const Vec3<Floats> given = load_vec3<layouts>(job.u, i);
-        c.u = {given.x, given.y, given.z};
-    } else {
-        c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index) + static_cast<std::uint64_t>(i), seed);
-    }
+    if (!load_inputs<layouts>(job, i, seed, c)) return false;
     const Floats missing_wo = ms.missing_energy(c.wo.z);
     const Shading<Floats> s = with_multiple_scattering_weight(material, ms.weight(missing_wo));
-    c.fv = schlick_weight(c.wo.z);
-    c.weights = lobe_weights(c.fv, s);
-    c.lobe = choose_lobe(c.u.u0, s, c.weights);
+    choose_lobe_for(c, s);
     const CompensatedWeighed<Floats> cw =
             weigh_compensated<model>(c.wo, c.fv, c.weights, draw(job, c, s), s, ms, missing_wo, job.sampler);
-    const Weighed<Floats>& w = cw.weighed;
-    store_rgb<layouts>(job.wi, i, Rgb<Floats>{w.wi.x, w.wi.y, w.wi.z});
-    w.pdf.store_unaligned(job.pdf + i);
-    store_rgb<layouts>(job.weight, i, w.weight);
-    if constexpr (with_lobes) {
-        store_rgb<layouts>(job.lobe_weight[0], i, w.share(w.lobes.diffuse_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[1], i, w.share(w.lobes.sheen_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
-        store_rgb<layouts>(job.lobe_weight[4], i, w.share(cw.multiple_scattering));
-    }
-    auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
-    const Floats lobe_index = select(c.lobe.cosine, index_bits(0), select(c.lobe.specular, index_bits(1), index_bits(2)));
-    xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
+    store_sample<layouts, with_lobes>(job, i, c.lobe, cw.weighed, s, cw.weighed.share(cw.multiple_scattering));
     return true;
 }
 
@@ -190,10 +187,14 @@ template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool 
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     Shading<Floats> uniform{};
     MultipleScatteringLobe<Floats> uniform_ms{};
+    BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
         const RawMaterial m = load_material(job.params, 0);
         uniform = shading_of(m);
-        if constexpr (compensated) uniform_ms = multiple_scattering_of(m.slot, uniform, model);
+        if constexpr (compensated) {
+            uniform_ms = multiple_scattering_of(m.slot, uniform, model);
+            row.use_for(uniform_ms);
+        }
     }
     const CounterSeed seed = counter_seed(job.seed);
     const std::int64_t batches = (end - begin) / kLanes;

@@ -369,22 +369,44 @@ PB_KERNEL_INLINE Floats log(Floats x) { return xsimd::log(x); }
 PB_KERNEL_INLINE Floats exp(Floats x) { return xsimd::exp(x); }
 PB_KERNEL_INLINE Floats largest_finite(Floats) { return Floats(std::numeric_limits<float>::max()); }
 // table lookups (model/energy.hpp): the integer part of x >= 0 (truncation), back to
-// floats, table[i] per lane (one gather instruction on AVX2 and AVX-512)
+// floats, and (table[i], table[i + 1]) per lane, the two nodes of a linear interpolation
 PB_KERNEL_INLINE Ints truncate_to_index(Floats x) { return xsimd::to_int(x); }
 PB_KERNEL_INLINE Floats index_to_real(Ints i) { return xsimd::to_float(i); }
 PB_KERNEL_INLINE Ints min(Ints a, Ints b) { return xsimd::min(a, b); }
 // (the intrinsics: xsimd 8.1's batch::gather for fma3<avx2> falls back to an out-of-line element loop)
 #if defined(__AVX512F__)
-PB_KERNEL_INLINE Floats gather(const float* table, Ints i) { return _mm512_i32gather_ps(i, table, 4); }
+PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints i) {
+    return {_mm512_i32gather_ps(i, table, 4), _mm512_i32gather_ps(_mm512_add_epi32(i, _mm512_set1_epi32(1)), table, 4)};
+}
 #elif defined(__AVX2__)
-PB_KERNEL_INLINE Floats gather(const float* table, Ints i) { return _mm256_i32gather_ps(table, i, 4); }
-#else
-PB_KERNEL_INLINE Floats gather(const float* table, Ints i) {
-    alignas(64) std::int32_t index[kLanes];
-    alignas(64) float value[kLanes];
+// Each lane's two adjacent floats as one 8-byte load, four lanes to a pair of
+// 128-bit halves, then split into the nodes below and above. Scalar loads, not
+// gathers, which measured slower on Zen 3 (bench/RESULTS.md).
+PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints i) {
+    alignas(32) std::int32_t index[kLanes];
     i.store_aligned(index);
-    for (std::int64_t j = 0; j < kLanes; ++j) value[j] = table[index[j]];
-    return Floats::load_aligned(value);
+    auto pairs = [&](int lane) {  // lanes l and l + 1: (t[i_l], t[i_l + 1], t[i_(l+1)], t[i_(l+1) + 1])
+        const __m128d low = _mm_castsi128_pd(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(table + index[lane])));
+        return _mm_castpd_ps(_mm_loadh_pd(low, reinterpret_cast<const double*>(table + index[lane + 1])));
+    };
+    // lanes 0-3 and 4-7: (t[i0], t[i0 + 1], t[i1], t[i1 + 1] | t[i2], ...)
+    const __m256 low = _mm256_set_m128(pairs(2), pairs(0));
+    const __m256 high = _mm256_set_m128(pairs(6), pairs(4));
+    // even or odd floats of each half: (lanes 0 1 4 5 | 2 3 6 7), then the 64-bit quarters reordered
+    auto split = [](__m256 x) { return _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(x), _MM_SHUFFLE(3, 1, 2, 0))); };
+    return {split(_mm256_shuffle_ps(low, high, _MM_SHUFFLE(2, 0, 2, 0))), split(_mm256_shuffle_ps(low, high, _MM_SHUFFLE(3, 1, 3, 1)))};
+}
+#else
+PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints i) {
+    alignas(64) std::int32_t index[kLanes];
+    alignas(64) float below[kLanes];
+    alignas(64) float above[kLanes];
+    i.store_aligned(index);
+    for (std::int64_t j = 0; j < kLanes; ++j) {
+        below[j] = table[index[j]];
+        above[j] = table[index[j] + 1];
+    }
+    return {Floats::load_aligned(below), Floats::load_aligned(above)};
 }
 #endif
 

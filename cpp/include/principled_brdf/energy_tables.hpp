@@ -9,8 +9,8 @@
 
 namespace principled_brdf::energy {
 
-inline constexpr int kCosines = 96;
-inline constexpr int kRoughnesses = 64;
+inline constexpr int kCosines = 129;
+inline constexpr int kRoughnesses = 65;
 
 extern const float kMissing[2][kRoughnesses * kCosines];
 extern const float kMissingAverage[2][kRoughnesses];

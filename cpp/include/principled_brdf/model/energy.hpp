@@ -14,8 +14,15 @@
 //   ∫ f_ms cos θl dωl = lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))) (1 - E(μo))
 // (since 2 ∫ (1 - E(μ)) μ dμ = 1 - E_avg), added to the cosine lobe's w0.
 // The ops of the number type provide truncate_to_index (x >= 0), index_to_real
-// and gather (table[index] per lane).
+// and gather_pair ((table[index], table[index + 1]) per lane).
 #pragma once  // (per namespace that includes the model)
+
+// The nodes' spacings are powers of two, so that μ (kCosines - 1) and
+// r (kRoughnesses - 1) are exact in float32 and so are the interpolation weights:
+// the float32 lookup then differs from the float64 one by the blend's roundings
+// alone, also where 1 - E is small and steep between nodes.
+static_assert(((energy::kCosines - 1) & (energy::kCosines - 2)) == 0, "kCosines - 1 is a power of two");
+static_assert(((energy::kRoughnesses - 1) & (energy::kRoughnesses - 2)) == 0, "kRoughnesses - 1 is a power of two");
 
 template <class F>
 using IndexOf = decltype(truncate_to_index(F()));
@@ -40,12 +47,14 @@ struct MultipleScatteringLobe {
         const F x = min(max(mu, F(0.0)), F(1.0)) * F(energy::kCosines - 1);
         const IndexOf<F> k = min(truncate_to_index(x), IndexOf<F>(energy::kCosines - 2));
         const F t = x - index_to_real(k);
-        if (single_row) return mix(gather(missing, k), gather(missing, k + IndexOf<F>(1)), t);
+        if (single_row) {
+            const auto [at_k, at_next] = gather_pair(missing, k);
+            return mix(at_k, at_next, t);
+        }
         const IndexOf<F> at = row.offset + k;
-        const F below = mix(gather(missing, at), gather(missing, at + IndexOf<F>(1)), t);
-        const F above = mix(gather(missing, at + IndexOf<F>(energy::kCosines)),
-                            gather(missing, at + IndexOf<F>(energy::kCosines + 1)), t);
-        return mix(below, above, row.fraction);
+        const auto [below_k, below_next] = gather_pair(missing, at);
+        const auto [above_k, above_next] = gather_pair(missing + energy::kCosines, at);  // (the same indices)
+        return mix(mix(below_k, below_next, t), mix(above_k, above_next, t), row.fraction);
     }
 
     // the scalar factor of color: (1 - E(μl)) (1 - E(μo)), 1 - E(μo) given
@@ -68,7 +77,8 @@ PB_MODEL_INLINE MultipleScatteringLobe<F> multiple_scattering_of(const F* p, con
     const IndexOf<F> j = min(truncate_to_index(y), IndexOf<F>(energy::kRoughnesses - 2));
     ms.row = {truncate_to_index(index_to_real(j) * F(energy::kCosines)), y - index_to_real(j)};
     const float* average = energy::kMissingAverage[static_cast<int>(model)];
-    const F missing_average = mix(gather(average, j), gather(average, j + IndexOf<F>(1)), ms.row.fraction);
+    const auto [average_j, average_next] = gather_pair(average, j);
+    const F missing_average = mix(average_j, average_next, ms.row.fraction);
     const F e_average = one - missing_average;
     // F_avg = (20 Cspec0 + 1) / 21 per channel, at most 1 (Cspec0 > 1 for a base_color or
     // specular past the physical range, where 1 - F_avg (1 - E_avg) could reach 0)

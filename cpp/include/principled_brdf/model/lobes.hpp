@@ -51,7 +51,8 @@ struct DiffuseLobe {
     F subsurface, roughness;
     F cosine_lobe_weight;  // w0 = (1 - metallic) (Cdlum + 0.1 sheen lum(Csheen))
 
-    // the scalar factor of color
+    // the scalar factor of color (with_subsurface false: for a subsurface of 0, known)
+    template <bool with_subsurface = true>
     PB_MODEL_INLINE F value(const Geometry<F>& g, const Fresnel<F>& fresnel) const {
         const F one(1.0);
         const F cos2_theta_d = F(0.25) * g.h_len2;
@@ -59,7 +60,7 @@ struct DiffuseLobe {
         const F fd = mul_add(fd90_minus_1, fresnel.fl, one) * mul_add(fd90_minus_1, fresnel.fv, one);
         // Skipped when 0 in every lane: for a uniform material the test has the
         // same outcome for every batch, and mix(fd, ss, 0) = fd bit for bit.
-        if (!any(subsurface != F(0.0))) return fd;
+        if (!with_subsurface || !any(subsurface != F(0.0))) return fd;
         const F fss90_minus_1 = mul_sub(roughness, cos2_theta_d, one);
         const F fss = mul_add(fss90_minus_1, fresnel.fl, one) * mul_add(fss90_minus_1, fresnel.fv, one);
         const F inv_cos_sum = reciprocal(g.wi.z + g.wo.z);

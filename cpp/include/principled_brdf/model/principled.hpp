@@ -55,6 +55,16 @@ PB_MODEL_INLINE Shading<F> shading_of(const F* p) {
     return s;
 }
 
+// The lobes an evaluation computes, a compile-time choice (the kernels make it
+// once per call from a uniform material): each set leaves out only terms that
+// are exactly 0 for the materials it is chosen for, so that f has the same
+// bits as with kAll (a multiply-add with a zero product returns its addend).
+enum class LobeSet : int {
+    kAll,       // every lobe (subsurface and clearcoat still skipped when 0 in every lane)
+    kPlain,     // diffuse and primary specular: subsurface, sheen and clearcoat 0
+    kSpecular,  // the primary specular alone: metallic 1 (no diffuse, subsurface or sheen), clearcoat 0
+};
+
 // What f and the pdf need of wo alone.
 template <class F>
 struct View {
@@ -65,7 +75,7 @@ struct View {
 };
 
 // given FV and the visible-normal Smith denominator (sampling has them from the choice and the draw)
-template <Model model, class F>
+template <Model model, LobeSet lobes = LobeSet::kAll, class F>
 PB_MODEL_INLINE View<F> view_of(const Vec3<F>& wo, const Shading<F>& s, F smith_visible, F fv) {
     View<F> v;
     v.fv = fv;
@@ -75,13 +85,17 @@ PB_MODEL_INLINE View<F> view_of(const Vec3<F>& wo, const Shading<F>& s, F smith_
     } else {
         v.smith_specular = v.smith_visible;
     }
-    v.smith_clearcoat = s.clearcoat.smith_wo(wo);
+    if constexpr (lobes == LobeSet::kAll) {
+        v.smith_clearcoat = s.clearcoat.smith_wo(wo);
+    } else {
+        v.smith_clearcoat = F(1.0);
+    }
     return v;
 }
 
-template <Model model, class F>
+template <Model model, LobeSet lobes = LobeSet::kAll, class F>
 PB_MODEL_INLINE View<F> view_of(const Vec3<F>& wo, const Shading<F>& s) {
-    return view_of<model>(wo, s, s.specular.ggx.smith_denominator(wo), schlick_weight(wo.z));
+    return view_of<model, lobes>(wo, s, s.specular.ggx.smith_denominator(wo), schlick_weight(wo.z));
 }
 
 // The lobes as scalar factors of the material's colours:
@@ -99,10 +113,21 @@ struct LobeValues {
     Rgb<F> clearcoat_rgb() const { return {clearcoat, clearcoat, clearcoat}; }
 
     // f per channel: D dc + FH sc + S (1 - FH) Cspec0 + (S FH + C), three FMAs a channel
+    // (fewer for a LobeSet without the diffuse or the sheen: their terms are 0)
+    template <LobeSet lobes = LobeSet::kAll>
     Rgb<F> total(const Shading<F>& s) const {
         const F specular_tinted = specular * (F(1.0) - fh);
-        const F grey = mul_add(specular, fh, clearcoat);
-        auto channel = [&](F dc, F sc, F f0) { return mul_add(diffuse, dc, mul_add(fh, sc, mul_add(specular_tinted, f0, grey))); };
+        const F grey = lobes == LobeSet::kAll ? mul_add(specular, fh, clearcoat) : specular * fh;
+        auto channel = [&](F dc, F sc, F f0) {
+            const F specular_part = mul_add(specular_tinted, f0, grey);
+            if constexpr (lobes == LobeSet::kSpecular) {
+                return specular_part;
+            } else if constexpr (lobes == LobeSet::kPlain) {
+                return mul_add(diffuse, dc, specular_part);
+            } else {
+                return mul_add(diffuse, dc, mul_add(fh, sc, specular_part));
+            }
+        };
         return {channel(s.diffuse.color.r, s.sheen.color.r, s.specular.f0.r),
                 channel(s.diffuse.color.g, s.sheen.color.g, s.specular.f0.g),
                 channel(s.diffuse.color.b, s.sheen.color.b, s.specular.f0.b)};
@@ -116,14 +141,23 @@ PB_MODEL_INLINE MaskOf<F> above_surface(const Geometry<F>& g) {
     return (g.wi.z > F(0.0)) & (g.wo.z > F(0.0)) & g.finite;
 }
 
-template <Model model, class F>
+// (the lobes a LobeSet leaves out are 0)
+template <Model model, LobeSet lobes = LobeSet::kAll, class F>
 PB_MODEL_INLINE LobeValues<F> eval_lobes(const Geometry<F>& g, const Shading<F>& s, const View<F>& view) {
     const F fh = schlick_weight_of_complement(g.one_minus_cos_theta_d);
     LobeValues<F> out;
-    out.diffuse = s.diffuse.value(g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
+    if constexpr (lobes == LobeSet::kSpecular) {
+        out.diffuse = F(0.0);
+    } else {
+        out.diffuse = s.diffuse.template value<lobes == LobeSet::kAll>(g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
+    }
     out.fh = fh;
     out.specular = s.specular.template value<model>(g, view.smith_specular);
-    out.clearcoat = s.clearcoat.value(g, fh, view.smith_clearcoat);
+    if constexpr (lobes == LobeSet::kAll) {
+        out.clearcoat = s.clearcoat.value(g, fh, view.smith_clearcoat);
+    } else {
+        out.clearcoat = F(0.0);
+    }
     return out;
 }
 

@@ -35,8 +35,10 @@ inline std::pair<double, double> sincos_turns(double u) {
     return {std::sin(phi), std::cos(phi)};
 }
 
-// table lookups (model/energy.hpp): the integer part of x >= 0, back to a real, table[i]
+// table lookups (model/energy.hpp): the integer part of x >= 0, back to a real, (table[i], table[i + 1])
 inline int truncate_to_index(double x) { return static_cast<int>(x); }
 inline double index_to_real(int i) { return static_cast<double>(i); }
 inline int min(int a, int b) { return a < b ? a : b; }
-inline double gather(const float* table, int i) { return static_cast<double>(table[i]); }
+inline std::pair<double, double> gather_pair(const float* table, int i) {
+    return {static_cast<double>(table[i]), static_cast<double>(table[i + 1])};
+}

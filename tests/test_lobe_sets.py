@@ -1,0 +1,93 @@
+"""README "Performance": a material whose lobes are off runs a kernel compiled
+without them (specular alone for metallic 1 without clearcoat; diffuse and
+specular without sheen, subsurface and clearcoat), chosen once per call for a
+uniform material and per batch, when all its lanes agree, for a per-element
+one. Such a kernel leaves out only terms that are exactly 0, so its f must be
+the same bits as the full kernel's, which a batch runs when one of its lanes
+has a clearcoat."""
+
+import numpy as np
+import pytest
+
+import principled_brdf as pb
+from conftest import MODELS, random_direction_pairs, seeded_rng
+
+ISAS = pb.cpu_info()["available"]
+
+MATERIALS = {
+    # the specular alone (sheen and subsurface do not matter without a diffuse)
+    "metal": dict(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.3),
+    "metal_with_dormant_lobes": dict(base_color=(0.5, 0.5, 0.6), metallic=1.0, roughness=0.7, anisotropic=0.8,
+                                     sheen=1.0, subsurface=0.5, specular_tint=0.4),
+    "mirror": dict(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=0.0),
+    # diffuse and specular
+    "plastic": dict(base_color=(0.2, 0.5, 0.8), metallic=0.3, roughness=0.45, anisotropic=0.5, specular=0.7,
+                    specular_tint=0.3),
+    "black_dielectric": dict(base_color=(0.0, 0.0, 0.0), roughness=0.9),
+    # every lobe: the full kernel, also at the boundaries of the sets
+    "almost_metal": dict(base_color=(0.9, 0.6, 0.3), metallic=float(np.float32(1.0) - np.float32(6e-8)),
+                         roughness=0.3),
+    "faint_clearcoat": dict(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.3, clearcoat=1e-30),
+    "faint_sheen": dict(base_color=(0.2, 0.5, 0.8), sheen=1e-30),
+    "faint_subsurface": dict(base_color=(0.2, 0.5, 0.8), subsurface=1e-30),
+    **{name: pb.presets.parameters(name) for name in pb.presets.names()},
+}
+
+
+@pytest.fixture(scope="module")
+def pairs():
+    rng = seeded_rng("lobe-sets")
+    wi, wo = random_direction_pairs(rng, 4_099, grazing_fraction=0.2)  # a tail in every instruction set
+    return wi.astype(np.float32), wo.astype(np.float32)
+
+
+def full_kernel(material: pb.Material, wi: np.ndarray, wo: np.ndarray, **options) -> np.ndarray:
+    """f by the full kernel: each element beside one with a clearcoat, so that no batch
+    of any width has all its lanes in a smaller LobeSet (the elements are independent)."""
+    n = len(wi)
+    values = {k: np.broadcast_to(np.asarray(v, np.float64), (n, 3) if k == "base_color" else (n,))
+              for k, v in material.as_dict().items()}
+    breaker = {**values, "clearcoat": np.full(n, 0.5)}
+    pairs = {k: np.stack([values[k], breaker[k]], axis=1).reshape((2 * n,) + values[k].shape[1:]) for k in values}
+    f = pb.eval(pb.Material(**pairs), np.repeat(wi, 2, axis=0), np.repeat(wo, 2, axis=0), **options)
+    return f[0::2]
+
+
+def bits(x: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(x).view(np.uint32)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("name", sorted(MATERIALS))
+def test_the_kernel_of_a_lobe_set_has_the_full_kernels_bits(pairs, isa, model, name):
+    wi, wo = pairs
+    material = pb.Material(**MATERIALS[name])
+    for cosine in (False, True):
+        expected = full_kernel(material, wi, wo, model=model, isa=isa, cosine=cosine)
+        got = pb.eval(material, wi, wo, model=model, isa=isa, cosine=cosine)
+        np.testing.assert_array_equal(bits(got), bits(expected), err_msg=f"{name} cosine={cosine}")
+        assert np.all(np.isfinite(got))
+    rows = pb.eval(material, np.ascontiguousarray(wi.T), np.ascontiguousarray(wo.T), layout="soa", model=model,
+                   isa=isa)
+    np.testing.assert_array_equal(bits(rows.T), bits(full_kernel(material, wi, wo, model=model, isa=isa)))
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", MODELS)
+def test_a_textures_batches_take_their_lobe_set(pairs, isa, model):
+    """Per element: runs of one material (metal, plastic, a coated one) of random
+    lengths, so that some batches agree on a smaller set and some straddle two."""
+    wi, wo = pairs
+    rng = seeded_rng("lobe-sets-texture", isa, model)
+    names = ["metal", "plastic", "car_paint", "metal_with_dormant_lobes", "black_dielectric"]
+    runs, total = [], 0
+    while total < len(wi):
+        length = int(rng.integers(1, 70))
+        runs.append((names[int(rng.integers(len(names)))], length))
+        total += length
+    choice = np.concatenate([[names.index(name)] * length for name, length in runs])[:len(wi)]
+    tables = [pb.Material(**MATERIALS[name]).as_dict() for name in names]
+    texture = pb.Material(**{k: np.array([table[k] for table in tables], np.float64)[choice] for k in tables[0]})
+    got = pb.eval(texture, wi, wo, model=model, isa=isa)
+    np.testing.assert_array_equal(bits(got), bits(full_kernel(texture, wi, wo, model=model, isa=isa)))
