@@ -86,6 +86,8 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
     const Mask above = above_surface(g);
     const View<Floats> view = view_of<model>(wo, s);
     const Floats missing_wo = ms.missing_energy(wo.z);
+    // (1 - E(μl)) (1 - E(μo)), the lookups read before the lobes need their registers
+    const Floats multiple_scattering = ms.missing_energy(wi.z) * missing_wo;
     const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
     auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };
     if constexpr (output == Output::kPdf || output == Output::kValuePdf) {
@@ -95,15 +97,14 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
     }
     if constexpr (output == Output::kPdf) return;
     const LobeValues<Floats> lobes = eval_lobes<model>(g, s, view);
-    const Rgb<Floats> multiple_scattering = ms.rgb(ms.value(g, missing_wo));
     if constexpr (output == Output::kLobes) {
         store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse_rgb(s)));
         store_rgb<layouts>(job.out[1], i, masked(lobes.sheen_rgb(s)));
         store_rgb<layouts>(job.out[2], i, masked(lobes.specular_rgb(s)));
         store_rgb<layouts>(job.out[3], i, masked(lobes.clearcoat_rgb()));
-        store_rgb<layouts>(job.out[4], i, masked(multiple_scattering));
+        store_rgb<layouts>(job.out[4], i, masked(ms.rgb(multiple_scattering)));
     } else if constexpr (output != Output::kPdf) {
-        store_rgb<layouts>(job.out[0], i, masked(lobes.total(s) + multiple_scattering));
+        store_rgb<layouts>(job.out[0], i, masked(ms.added_to(lobes.total(s), multiple_scattering)));
     }
 }
 

@@ -375,8 +375,37 @@ PB_KERNEL_INLINE Floats index_to_real(Ints i) { return xsimd::to_float(i); }
 PB_KERNEL_INLINE Ints min(Ints a, Ints b) { return xsimd::min(a, b); }
 // (the intrinsics: xsimd 8.1's batch::gather for fma3<avx2> falls back to an out-of-line element loop)
 #if defined(__AVX512F__)
+// Each lane's two adjacent floats as one 8-byte element of two 8-lane gathers,
+// then split into the nodes below and above: half the gathered elements of two
+// 16-lane float gathers, which cost about twice as much on Zen 5 (bench/RESULTS.md).
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints i) {
-    return {_mm512_i32gather_ps(i, table, 4), _mm512_i32gather_ps(_mm512_add_epi32(i, _mm512_set1_epi32(1)), table, 4)};
+    const __m512i index = i;
+    const __m512 low = _mm512_castpd_ps(_mm512_i32gather_pd(_mm512_castsi512_si256(index), table, 4));
+    const __m512 high = _mm512_castpd_ps(_mm512_i32gather_pd(_mm512_extracti64x4_epi64(index, 1), table, 4));
+    const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+    const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+    return {_mm512_permutex2var_ps(low, even, high), _mm512_permutex2var_ps(low, odd, high)};
+}
+
+// nodes[k] per lane for k in [0, 128): four two-register permutes of 32 nodes
+// each (index bits 0-4), then bits 5 and 6 choose among them. No gather: a
+// row that every lane shares fits in eight registers.
+PB_KERNEL_INLINE Floats permute_lookup_128(const float* nodes, Ints k) {
+    const __m512i index = k;
+    auto quarter = [&](int q) {
+        return _mm512_permutex2var_ps(_mm512_loadu_ps(nodes + 32 * q), index, _mm512_loadu_ps(nodes + 32 * q + 16));
+    };
+    const __mmask16 bit5 = _mm512_test_epi32_mask(index, _mm512_set1_epi32(32));
+    const __mmask16 bit6 = _mm512_test_epi32_mask(index, _mm512_set1_epi32(64));
+    return _mm512_mask_blend_ps(bit6, _mm512_mask_blend_ps(bit5, quarter(0), quarter(1)),
+                                _mm512_mask_blend_ps(bit5, quarter(2), quarter(3)));
+}
+
+// (row[k], row[k + 1]) for k in [0, kCosines - 2] from a row of kCosines nodes
+// (model/energy.hpp), the upper nodes as the lower ones of the row moved by one
+PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) {
+    static_assert(energy::kCosines - 1 == 128, "a row's intervals fill four permutes of 32 nodes");
+    return {permute_lookup_128(row, k), permute_lookup_128(row + 1, k)};
 }
 #elif defined(__AVX2__)
 // Each lane's two adjacent floats as one 8-byte load, four lanes to a pair of
@@ -408,6 +437,9 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints 
     }
     return {Floats::load_aligned(below), Floats::load_aligned(above)};
 }
+#endif
+#if !defined(__AVX512F__)
+PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) { return gather_pair(row, k); }
 #endif
 
 // (sin 2πu, cos 2πu) for u in [0, 1] by the double angle, without quadrant

@@ -13,8 +13,10 @@
 // Sampling draws it by the cosine lobe, its weight the lobe's albedo at wo,
 //   ∫ f_ms cos θl dωl = lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))) (1 - E(μo))
 // (since 2 ∫ (1 - E(μ)) μ dμ = 1 - E_avg), added to the cosine lobe's w0.
-// The ops of the number type provide truncate_to_index (x >= 0), index_to_real
-// and gather_pair ((table[index], table[index + 1]) per lane).
+// The ops of the number type provide truncate_to_index (x >= 0), index_to_real,
+// gather_pair ((table[index], table[index + 1]) per lane) and gather_pair_in_row
+// (the same from one row of kCosines nodes that every lane shares, which the
+// AVX-512 kernel reads by register permutes instead of gathers).
 #pragma once  // (per namespace that includes the model)
 
 // The nodes' spacings are powers of two, so that μ (kCosines - 1) and
@@ -48,7 +50,7 @@ struct MultipleScatteringLobe {
         const IndexOf<F> k = min(truncate_to_index(x), IndexOf<F>(energy::kCosines - 2));
         const F t = x - index_to_real(k);
         if (single_row) {
-            const auto [at_k, at_next] = gather_pair(missing, k);
+            const auto [at_k, at_next] = gather_pair_in_row(missing, k);
             return mix(at_k, at_next, t);
         }
         const IndexOf<F> at = row.offset + k;
@@ -61,6 +63,11 @@ struct MultipleScatteringLobe {
     PB_MODEL_INLINE F value(const Geometry<F>& g, F missing_wo) const { return missing_energy(g.wi.z) * missing_wo; }
 
     Rgb<F> rgb(F value) const { return value * color; }
+
+    // f + f_ms, one rounding a channel
+    PB_MODEL_INLINE Rgb<F> added_to(const Rgb<F>& f, F value) const {
+        return {mul_add(value, color.r, f.r), mul_add(value, color.g, f.g), mul_add(value, color.b, f.b)};
+    }
 
     // w3 at wo, from 1 - E(μo)
     PB_MODEL_INLINE F weight(F missing_wo) const { return albedo_scale * missing_wo; }

@@ -42,3 +42,4 @@ inline int min(int a, int b) { return a < b ? a : b; }
 inline std::pair<double, double> gather_pair(const float* table, int i) {
     return {static_cast<double>(table[i]), static_cast<double>(table[i + 1])};
 }
+inline std::pair<double, double> gather_pair_in_row(const float* row, int i) { return gather_pair(row, i); }
