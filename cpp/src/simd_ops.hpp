@@ -261,13 +261,16 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
 // element, which block 0 writes afterwards. Only the batch's last element
 // stores its partial block in pieces (a masked store costs a dozen cycles on
 // some cores, and there would be one per element).
-#if defined(__AVX2__) && !defined(__AVX512F__)
-inline constexpr int kTransposeBlock = 8;  // 8 x 8 blocks in registers
+#if defined(__AVX2__)
+// 8 x 8 blocks in registers; AVX-512's 16 lanes as two groups of 8 (both halves
+// of a row are aligned loads)
+inline constexpr int kTransposeBlock = 8;
 
-// The 8 x 8 block of rows b to b + 7 as columns: column[lane] holds those rows of element `lane`.
-PB_KERNEL_INLINE void transpose_block(const float (*rows)[kLanes], int b, __m256 (&column)[8]) {
+// The 8 x 8 block of rows b to b + 7, lanes group to group + 7, as columns:
+// column[lane] holds those rows of element group + lane.
+PB_KERNEL_INLINE void transpose_block(const float (*rows)[kLanes], int b, int group, __m256 (&column)[8]) {
     __m256 r[8], t[8], u[8];
-    for (int k = 0; k < 8; ++k) r[k] = _mm256_load_ps(rows[b + k]);
+    for (int k = 0; k < 8; ++k) r[k] = _mm256_load_ps(rows[b + k] + group);
     for (int k = 0; k < 8; k += 2) {
         t[k] = _mm256_unpacklo_ps(r[k], r[k + 1]);
         t[k + 1] = _mm256_unpackhi_ps(r[k], r[k + 1]);
@@ -308,14 +311,22 @@ PB_KERNEL_INLINE void store_rows_by_element(const float (*rows)[kLanes], float* 
     static_assert(width >= 8, "the partial block's overrun must land in a block written after it");
     constexpr int full_blocks = width / 8, partial = width % 8;
     __m256 column[8];
-    if constexpr (partial != 0) {
-        transpose_block(rows, 8 * full_blocks, column);
-        for (int lane = 0; lane < 7; ++lane) _mm256_storeu_ps(out + width * lane + 8 * full_blocks, column[lane]);
-        store_first(out + width * 7 + 8 * full_blocks, column[7], partial);
-    }
-    for (int b = 0; b < 8 * full_blocks; b += 8) {
-        transpose_block(rows, b, column);
-        for (int lane = 0; lane < 8; ++lane) _mm256_storeu_ps(out + width * lane + b, column[lane]);
+    // a group's last element overruns into the next group's first, which that group writes afterwards
+    for (int group = 0; group < kLanes; group += 8) {
+        float* const first = out + width * group;
+        if constexpr (partial != 0) {
+            transpose_block(rows, 8 * full_blocks, group, column);
+            for (int lane = 0; lane < 7; ++lane) _mm256_storeu_ps(first + width * lane + 8 * full_blocks, column[lane]);
+            if (group + 8 < kLanes) {
+                _mm256_storeu_ps(first + width * 7 + 8 * full_blocks, column[7]);
+            } else {
+                store_first(first + width * 7 + 8 * full_blocks, column[7], partial);
+            }
+        }
+        for (int b = 0; b < 8 * full_blocks; b += 8) {
+            transpose_block(rows, b, group, column);
+            for (int lane = 0; lane < 8; ++lane) _mm256_storeu_ps(first + width * lane + b, column[lane]);
+        }
     }
 }
 #elif defined(__SSE2__) && !defined(__AVX512F__)
