@@ -2,9 +2,9 @@
 without them (specular alone for metallic 1 without clearcoat; diffuse and
 specular without sheen, subsurface and clearcoat), chosen once per call for a
 uniform material and per batch, when all its lanes agree, for a per-element
-one. Such a kernel leaves out only terms that are exactly 0, so its f must be
-the same bits as the full kernel's, which a batch runs when one of its lanes
-has a clearcoat."""
+one; `eval` and `eval_pdf` have them. Such a kernel leaves out only terms that
+are exactly 0, so its f must be the same bits as the full kernel's, which a
+batch runs when one of its lanes has a clearcoat."""
 
 import numpy as np
 import pytest
@@ -41,16 +41,19 @@ def pairs():
     return wi.astype(np.float32), wo.astype(np.float32)
 
 
-def full_kernel(material: pb.Material, wi: np.ndarray, wo: np.ndarray, **options) -> np.ndarray:
-    """f by the full kernel: each element beside one with a clearcoat, so that no batch
-    of any width has all its lanes in a smaller LobeSet (the elements are independent)."""
+def full_kernel(material: pb.Material, wi: np.ndarray, wo: np.ndarray, evaluate=pb.eval, **options):
+    """f (or `evaluate`'s result) by the full kernel: each element beside one with a clearcoat,
+    so that no batch of any width has all its lanes in a smaller LobeSet (the elements are
+    independent)."""
     n = len(wi)
     values = {k: np.broadcast_to(np.asarray(v, np.float64), (n, 3) if k == "base_color" else (n,))
               for k, v in material.as_dict().items()}
     breaker = {**values, "clearcoat": np.full(n, 0.5)}
     pairs = {k: np.stack([values[k], breaker[k]], axis=1).reshape((2 * n,) + values[k].shape[1:]) for k in values}
-    f = pb.eval(pb.Material(**pairs), np.repeat(wi, 2, axis=0), np.repeat(wo, 2, axis=0), **options)
-    return f[0::2]
+    result = evaluate(pb.Material(**pairs), np.repeat(wi, 2, axis=0), np.repeat(wo, 2, axis=0), **options)
+    if evaluate is pb.eval_pdf:
+        return result.value[0::2], result.pdf[0::2]
+    return result[0::2]
 
 
 def bits(x: np.ndarray) -> np.ndarray:
@@ -75,6 +78,22 @@ def test_the_kernel_of_a_lobe_set_has_the_full_kernels_bits(pairs, isa, model, n
 
 @pytest.mark.parametrize("isa", ISAS)
 @pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("name", sorted(MATERIALS))
+def test_eval_pdf_of_a_lobe_set_has_the_full_kernels_bits(pairs, isa, model, name):
+    """f with the sampling pdf in one pass (eval_pdf) takes the same lobe sets."""
+    wi, wo = pairs
+    material = pb.Material(**MATERIALS[name])
+    for cosine in (False, True):
+        value, pdf = full_kernel(material, wi, wo, evaluate=pb.eval_pdf, model=model, isa=isa, cosine=cosine)
+        got = pb.eval_pdf(material, wi, wo, model=model, isa=isa, cosine=cosine)
+        np.testing.assert_array_equal(bits(got.value), bits(value), err_msg=f"{name} cosine={cosine}")
+        np.testing.assert_array_equal(bits(got.pdf), bits(pdf), err_msg=f"{name} cosine={cosine}")
+        np.testing.assert_array_equal(bits(got.value), bits(pb.eval(material, wi, wo, model=model, isa=isa,
+                                                                     cosine=cosine)))
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", MODELS)
 def test_a_textures_batches_take_their_lobe_set(pairs, isa, model):
     """Per element: runs of one material (metal, plastic, a coated one) of random
     lengths, so that some batches agree on a smaller set and some straddle two."""
@@ -91,3 +110,7 @@ def test_a_textures_batches_take_their_lobe_set(pairs, isa, model):
     texture = pb.Material(**{k: np.array([table[k] for table in tables], np.float64)[choice] for k in tables[0]})
     got = pb.eval(texture, wi, wo, model=model, isa=isa)
     np.testing.assert_array_equal(bits(got), bits(full_kernel(texture, wi, wo, model=model, isa=isa)))
+    value, pdf = full_kernel(texture, wi, wo, evaluate=pb.eval_pdf, model=model, isa=isa)
+    got_pair = pb.eval_pdf(texture, wi, wo, model=model, isa=isa)
+    np.testing.assert_array_equal(bits(got_pair.value), bits(value))
+    np.testing.assert_array_equal(bits(got_pair.pdf), bits(pdf))

@@ -135,7 +135,7 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
     } else if constexpr (output == Output::kValuePdf) {
         const Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
-        const Rgb<Floats> f = eval_lobes<model>(g, s, view).total(s);
+        const Rgb<Floats> f = eval_lobes<model, lobes>(g, s, view).template total<lobes>(s);
         auto masked = [&](Floats x) { return select(above, job.cosine ? wi.z * x : x, Floats(0.0f)); };
         store_rgb<layouts>(job.out[0], i, {masked(f.r), masked(f.g), masked(f.b)});
     } else {
@@ -153,6 +153,10 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
         }
     }
 }
+
+// The outputs compiled per LobeSet: f alone, and f with the pdf (which needs no
+// lobe's value; the mixture's weights come from the material).
+constexpr bool has_lobe_sets(Output output) { return output == Output::kTotal || output == Output::kValuePdf; }
 
 // The lobes a material needs, from its values (LobeSet's conditions): a
 // uniform one's once per call, a batch's when all its lanes agree. The
@@ -185,7 +189,7 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
         const RawMaterial m = load_material(job.params, i);
         const Shading<Floats> s = shading_of(m);
         eval_compensated_batch<model, output, layouts>(job, i, wi, wo, s, multiple_scattering_of(m.slot, s, model));
-    } else if constexpr (per_element && output == Output::kTotal) {
+    } else if constexpr (per_element && has_lobe_sets(output)) {
         // the batch's LobeSet, when all its lanes agree (a texture's metal or plastic regions)
         const RawMaterial m = load_material(job.params, i);
         switch (lobe_set_of(m)) {
@@ -289,11 +293,11 @@ std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t
     }
 }
 
-// f alone (Output::kTotal) of a uniform material gets the loop of its LobeSet.
+// f alone and f with the pdf of a uniform material get the loop of its LobeSet.
 template <Model model, Output output, bool compensated = false>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     if (!job.uniform_material()) return eval_range_for<model, output, true, compensated>(job, begin, end);
-    if constexpr (output == Output::kTotal && !compensated) {
+    if constexpr (has_lobe_sets(output) && !compensated) {
         switch (lobe_set_of(job.params)) {
             case LobeSet::kSpecular: return eval_range_for<model, output, false, false, LobeSet::kSpecular>(job, begin, end);
             case LobeSet::kPlain: return eval_range_for<model, output, false, false, LobeSet::kPlain>(job, begin, end);
