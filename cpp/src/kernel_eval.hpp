@@ -86,7 +86,7 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
     const Mask above = above_surface(g);
     const View<Floats> view = view_of<model>(wo, s);
     const Floats missing_wo = ms.missing_energy(wo.z);
-    // (1 - E(μl)) (1 - E(μo)), the lookups read before the lobes need their registers
+    // (1 - E(μl)) (1 - E(μo)): both lookups first, f_ms joins f by one FMA a channel (added_to)
     const Floats multiple_scattering = ms.missing_energy(wi.z) * missing_wo;
     const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
     auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };

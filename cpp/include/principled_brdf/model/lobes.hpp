@@ -18,6 +18,7 @@ struct Geometry : HalfVector<F> {
 template <class F>
 PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
     Geometry<F> g;
+    // by component: after an aggregate copy GCC kept the directions on the stack in the kernels' loops
     g.wi.x = wi.x; g.wi.y = wi.y; g.wi.z = wi.z;
     g.wo.x = wo.x; g.wo.y = wo.y; g.wo.z = wo.z;
     const F hx = wi.x + wo.x, hy = wi.y + wo.y;
