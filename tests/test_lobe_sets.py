@@ -71,25 +71,15 @@ def test_the_kernel_of_a_lobe_set_has_the_full_kernels_bits(pairs, isa, model, n
         got = pb.eval(material, wi, wo, model=model, isa=isa, cosine=cosine)
         np.testing.assert_array_equal(bits(got), bits(expected), err_msg=f"{name} cosine={cosine}")
         assert np.all(np.isfinite(got))
+        # f with the sampling pdf in one pass (eval_pdf) takes the same lobe sets
+        value, pdf = full_kernel(material, wi, wo, evaluate=pb.eval_pdf, model=model, isa=isa, cosine=cosine)
+        got_pair = pb.eval_pdf(material, wi, wo, model=model, isa=isa, cosine=cosine)
+        np.testing.assert_array_equal(bits(got_pair.value), bits(value), err_msg=f"{name} cosine={cosine}")
+        np.testing.assert_array_equal(bits(got_pair.pdf), bits(pdf), err_msg=f"{name} cosine={cosine}")
+        np.testing.assert_array_equal(bits(got_pair.value), bits(got))
     rows = pb.eval(material, np.ascontiguousarray(wi.T), np.ascontiguousarray(wo.T), layout="soa", model=model,
                    isa=isa)
     np.testing.assert_array_equal(bits(rows.T), bits(full_kernel(material, wi, wo, model=model, isa=isa)))
-
-
-@pytest.mark.parametrize("isa", ISAS)
-@pytest.mark.parametrize("model", MODELS)
-@pytest.mark.parametrize("name", sorted(MATERIALS))
-def test_eval_pdf_of_a_lobe_set_has_the_full_kernels_bits(pairs, isa, model, name):
-    """f with the sampling pdf in one pass (eval_pdf) takes the same lobe sets."""
-    wi, wo = pairs
-    material = pb.Material(**MATERIALS[name])
-    for cosine in (False, True):
-        value, pdf = full_kernel(material, wi, wo, evaluate=pb.eval_pdf, model=model, isa=isa, cosine=cosine)
-        got = pb.eval_pdf(material, wi, wo, model=model, isa=isa, cosine=cosine)
-        np.testing.assert_array_equal(bits(got.value), bits(value), err_msg=f"{name} cosine={cosine}")
-        np.testing.assert_array_equal(bits(got.pdf), bits(pdf), err_msg=f"{name} cosine={cosine}")
-        np.testing.assert_array_equal(bits(got.value), bits(pb.eval(material, wi, wo, model=model, isa=isa,
-                                                                     cosine=cosine)))
 
 
 @pytest.mark.parametrize("isa", ISAS)
