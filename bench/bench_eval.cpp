@@ -118,13 +118,15 @@ void simd_eval_compensated(benchmark::State& state, std::string isa, bool soa, b
 }
 
 // The material set (materials.hpp): f of material `index`, or of the random
-// per-element materials at index -1, (N, 3), the direction check on or off.
-void simd_eval_material(benchmark::State& state, std::string isa, int index, bool checked) {
+// per-element materials at index -1, (N, 3), the direction check on or off,
+// with or without the energy compensation.
+void simd_eval_material(benchmark::State& state, std::string isa, int index, bool checked, bool energy_compensation) {
     Data& d = data_for(state.range(0));
     pb::EvalJob job = make_job(d, false, index < 0);
     if (index >= 0)
         for (int s = 0; s < pb::kParamSlots; ++s) job.params[s].value = bench::kMaterials[index].slots[s];
     if (checked) job.check = pb::direction_check(1e-3);
+    job.energy_compensation = energy_compensation;
     const int threads = threads_of(state);
     for (auto _ : state) {
         pb::eval(job, d.n, threads, isa);
@@ -279,11 +281,16 @@ void register_all() {
         for (int index = -1; index < count; ++index) {
             const std::string material = index < 0 ? "random_per_element" : bench::kMaterials[index].name;
             const std::string name = "eval_material/" + isa + "/aos/" + material;
-            benchmark::RegisterBenchmark(name.c_str(), simd_eval_material, isa, index, false)
+            benchmark::RegisterBenchmark(name.c_str(), simd_eval_material, isa, index, false, false)
                 ->Args({kSizes[0], 1})
                 ->UseRealTime()
                 ->Unit(benchmark::kMicrosecond);
-            benchmark::RegisterBenchmark((name + "/checked").c_str(), simd_eval_material, isa, index, true)
+            const std::string compensated_name = "eval_material_compensated/" + isa + "/aos/" + material;
+            benchmark::RegisterBenchmark(compensated_name.c_str(), simd_eval_material, isa, index, false, true)
+                ->Args({kSizes[0], 1})
+                ->UseRealTime()
+                ->Unit(benchmark::kMicrosecond);
+            benchmark::RegisterBenchmark((name + "/checked").c_str(), simd_eval_material, isa, index, true, false)
                 ->Args({kSizes[2], all})
                 ->UseRealTime()
                 ->Unit(benchmark::kMicrosecond);

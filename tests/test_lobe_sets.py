@@ -4,7 +4,10 @@ specular without sheen, subsurface and clearcoat), chosen once per call for a
 uniform material and per batch, when all its lanes agree, for a per-element
 one; `eval` and `eval_pdf` have them. Such a kernel leaves out only terms that
 are exactly 0, so its f must be the same bits as the full kernel's, which a
-batch runs when one of its lanes has a clearcoat."""
+batch runs when one of its lanes has a clearcoat. With the energy compensation
+a uniform material's kernels take the lobe sets too; they read the tables by
+the material's blended row, which rounds apart from the per-element lookup of
+the full kernel here, so they agree to float32 roundings."""
 
 import numpy as np
 import pytest
@@ -104,3 +107,21 @@ def test_a_textures_batches_take_their_lobe_set(pairs, isa, model):
     got_pair = pb.eval_pdf(texture, wi, wo, model=model, isa=isa)
     np.testing.assert_array_equal(bits(got_pair.value), bits(value))
     np.testing.assert_array_equal(bits(got_pair.pdf), bits(pdf))
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", MODELS)
+def test_the_compensated_kernels_of_the_lobe_sets_agree_with_the_full_kernel(pairs, isa, model):
+    wi, wo = pairs
+    for name in sorted(MATERIALS):
+        material = pb.Material(**MATERIALS[name])
+        options = dict(model=model, isa=isa, energy_compensation=True)
+        expected = full_kernel(material, wi, wo, **options)
+        got = pb.eval(material, wi, wo, **options)
+        np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-30, err_msg=name)
+        value, pdf = full_kernel(material, wi, wo, evaluate=pb.eval_pdf, **options)
+        got_pair = pb.eval_pdf(material, wi, wo, **options)
+        np.testing.assert_array_equal(bits(got_pair.value), bits(got), err_msg=name)
+        np.testing.assert_allclose(got_pair.pdf, pdf, rtol=1e-5, atol=1e-30, err_msg=name)
+        # and they differ from the single-scattering f where the lobe has energy to give back
+        assert np.any(got > pb.eval(material, wi, wo, model=model, isa=isa) * (1 + 1e-4)) or material.roughness < 0.05

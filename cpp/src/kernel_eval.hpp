@@ -77,14 +77,14 @@ struct JacobianStore {
 
 // eval_batch with the energy compensation: f_ms joins f (and is its own lobe),
 // its weight w3 the cosine lobe's in the pdf (model/energy.hpp).
-template <Model model, Output output, Layouts layouts>
+template <Model model, Output output, Layouts layouts, LobeSet lobes = LobeSet::kAll>
 PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi,
                                              const Vec3<Floats>& wo, const Shading<Floats>& s,
                                              const MultipleScatteringLobe<Floats>& ms) {
     static_assert(output != Output::kGradient, "the energy compensation has no gradient");
     const Geometry<Floats> g = geometry_of(wi, wo);
     const Mask above = above_surface(g);
-    const View<Floats> view = view_of<model>(wo, s);
+    const View<Floats> view = view_of<model, lobes>(wo, s);
     const Floats missing_wo = ms.missing_energy(wo.z);
     // (1 - E(μl)) (1 - E(μo)): both lookups first, f_ms joins f by one FMA a channel (added_to)
     const Floats multiple_scattering = ms.missing_energy(wi.z) * missing_wo;
@@ -96,15 +96,15 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     }
     if constexpr (output == Output::kPdf) return;
-    const LobeValues<Floats> lobes = eval_lobes<model>(g, s, view);
+    const LobeValues<Floats> values = eval_lobes<model, lobes>(g, s, view);
     if constexpr (output == Output::kLobes) {
-        store_rgb<layouts>(job.out[0], i, masked(lobes.diffuse_rgb(s)));
-        store_rgb<layouts>(job.out[1], i, masked(lobes.sheen_rgb(s)));
-        store_rgb<layouts>(job.out[2], i, masked(lobes.specular_rgb(s)));
-        store_rgb<layouts>(job.out[3], i, masked(lobes.clearcoat_rgb()));
+        store_rgb<layouts>(job.out[0], i, masked(values.diffuse_rgb(s)));
+        store_rgb<layouts>(job.out[1], i, masked(values.sheen_rgb(s)));
+        store_rgb<layouts>(job.out[2], i, masked(values.specular_rgb(s)));
+        store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
         store_rgb<layouts>(job.out[4], i, masked(ms.rgb(multiple_scattering)));
     } else if constexpr (output != Output::kPdf) {
-        store_rgb<layouts>(job.out[0], i, masked(ms.added_to(lobes.total(s), multiple_scattering)));
+        store_rgb<layouts>(job.out[0], i, masked(ms.added_to(values.template total<lobes>(s), multiple_scattering)));
     }
 }
 
@@ -112,7 +112,7 @@ template <Model model, Output output, Layouts layouts, bool compensated, LobeSet
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
                                  const PreparedOf<output, compensated>& material) {
     if constexpr (compensated) {
-        eval_compensated_batch<model, output, layouts>(job, i, wi, wo, material.shading, material.ms);
+        eval_compensated_batch<model, output, layouts, lobes>(job, i, wi, wo, material.shading, material.ms);
         return;
     }
     const Shading<Floats>& s = material.shading;
@@ -280,8 +280,8 @@ template <Model model, Output output, bool per_element, bool compensated, LobeSe
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     if constexpr (compensated) {  // (N, 3) arrays, or any layout through the mixed loads and stores
         return layouts_of(job) == Layouts::kInterleaved
-                       ? eval_checked<model, output, per_element, Layouts::kInterleaved, true>(job, begin, end)
-                       : eval_checked<model, output, per_element, Layouts::kMixed, true>(job, begin, end);
+                       ? eval_checked<model, output, per_element, Layouts::kInterleaved, true, lobes>(job, begin, end)
+                       : eval_checked<model, output, per_element, Layouts::kMixed, true, lobes>(job, begin, end);
     }
     switch (layouts_of(job)) {
         case Layouts::kInterleaved:
@@ -293,14 +293,15 @@ std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t
     }
 }
 
-// f alone and f with the pdf of a uniform material get the loop of its LobeSet.
+// f alone and f with the pdf of a uniform material get the loop of its LobeSet
+// (with the energy compensation or without).
 template <Model model, Output output, bool compensated = false>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     if (!job.uniform_material()) return eval_range_for<model, output, true, compensated>(job, begin, end);
-    if constexpr (has_lobe_sets(output) && !compensated) {
+    if constexpr (has_lobe_sets(output)) {
         switch (lobe_set_of(job.params)) {
-            case LobeSet::kSpecular: return eval_range_for<model, output, false, false, LobeSet::kSpecular>(job, begin, end);
-            case LobeSet::kPlain: return eval_range_for<model, output, false, false, LobeSet::kPlain>(job, begin, end);
+            case LobeSet::kSpecular: return eval_range_for<model, output, false, compensated, LobeSet::kSpecular>(job, begin, end);
+            case LobeSet::kPlain: return eval_range_for<model, output, false, compensated, LobeSet::kPlain>(job, begin, end);
             default: break;
         }
     }

@@ -398,25 +398,36 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints 
     return {_mm512_permutex2var_ps(low, even, high), _mm512_permutex2var_ps(low, odd, high)};
 }
 
-// nodes[k] per lane for k in [0, 128): four two-register permutes of 32 nodes
-// each (index bits 0-4), then bits 5 and 6 choose among them. No gather: a
-// row that every lane shares fits in eight registers.
-PB_KERNEL_INLINE Floats permute_lookup_128(const float* nodes, Ints k) {
-    const __m512i index = k;
-    auto quarter = [&](int q) {
-        return _mm512_permutex2var_ps(_mm512_loadu_ps(nodes + 32 * q), index, _mm512_loadu_ps(nodes + 32 * q + 16));
-    };
-    const __mmask16 bit5 = _mm512_test_epi32_mask(index, _mm512_set1_epi32(32));
-    const __mmask16 bit6 = _mm512_test_epi32_mask(index, _mm512_set1_epi32(64));
-    return _mm512_mask_blend_ps(bit6, _mm512_mask_blend_ps(bit5, quarter(0), quarter(1)),
-                                _mm512_mask_blend_ps(bit5, quarter(2), quarter(3)));
+// nodes[k] per lane for k in [0, 128), from the 32 nodes of k's quarter: four
+// two-register permutes (index bits 0-4), each written only to the lanes whose
+// k lies in its quarter (mask2: the other lanes keep what they hold, at first
+// the index itself), so that no blend is needed. No gather: a row that every
+// lane shares fits in eight registers.
+struct Quarters {
+    __mmask16 of[4];  // lanes whose k lies in [32 q, 32 q + 32)
+};
+
+PB_KERNEL_INLINE Quarters quarters_of(__m512i k) {
+    const __m512i quarter = _mm512_srli_epi32(k, 5);
+    Quarters q;
+    for (int j = 0; j < 4; ++j) q.of[j] = _mm512_cmpeq_epi32_mask(quarter, _mm512_set1_epi32(j));
+    return q;
+}
+
+PB_KERNEL_INLINE Floats permute_lookup_128(const float* nodes, __m512i k, const Quarters& quarters) {
+    __m512 value = _mm512_castsi512_ps(k);
+    for (int q = 0; q < 4; ++q)
+        value = _mm512_mask2_permutex2var_ps(_mm512_loadu_ps(nodes + 32 * q), _mm512_castps_si512(value), quarters.of[q],
+                                             _mm512_loadu_ps(nodes + 32 * q + 16));
+    return value;
 }
 
 // (row[k], row[k + 1]) for k in [0, kCosines - 2] from a row of kCosines nodes
 // (model/energy.hpp), the upper nodes as the lower ones of the row moved by one
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) {
     static_assert(energy::kCosines - 1 == 128, "a row's intervals fill four permutes of 32 nodes");
-    return {permute_lookup_128(row, k), permute_lookup_128(row + 1, k)};
+    const Quarters quarters = quarters_of(k);
+    return {permute_lookup_128(row, k, quarters), permute_lookup_128(row + 1, k, quarters)};
 }
 #elif defined(__AVX2__)
 // Each lane's two adjacent floats as one 8-byte load, four lanes to a pair of
