@@ -12,6 +12,7 @@
 // at the narrow GTR peaks, where 1 - cos²θh would cancel.
 #include <xsimd/xsimd.hpp>
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <type_traits>
@@ -22,7 +23,7 @@
 #endif
 
 #include "kernel_api.hpp"
-#include "principled_brdf/energy_tables.hpp"
+#include "principled_brdf/energy_corners.hpp"
 
 namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS {
 

@@ -386,48 +386,42 @@ PB_KERNEL_INLINE Floats index_to_real(Ints i) { return xsimd::to_float(i); }
 PB_KERNEL_INLINE Ints min(Ints a, Ints b) { return xsimd::min(a, b); }
 // (the intrinsics: xsimd 8.1's batch::gather for fma3<avx2> falls back to an out-of-line element loop)
 #if defined(__AVX512F__)
-// Each lane's two adjacent floats as one 8-byte element of two 8-lane gathers,
-// then split into the nodes below and above: half the gathered elements of two
-// 16-lane float gathers, which cost about twice as much on Zen 5 (bench/RESULTS.md).
-PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints i) {
-    const __m512i index = i;
-    const __m512 low = _mm512_castpd_ps(_mm512_i32gather_pd(_mm512_castsi512_si256(index), table, 4));
-    const __m512 high = _mm512_castpd_ps(_mm512_i32gather_pd(_mm512_extracti64x4_epi64(index, 1), table, 4));
-    const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
-    const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
-    return {_mm512_permutex2var_ps(low, even, high), _mm512_permutex2var_ps(low, odd, high)};
-}
-
-// nodes[k] per lane for k in [0, 128), from the 32 nodes of k's quarter: four
-// two-register permutes (index bits 0-4), each written only to the lanes whose
-// k lies in its quarter (mask2: the other lanes keep what they hold, at first
-// the index itself), so that no blend is needed. No gather: a row that every
-// lane shares fits in eight registers.
+// nodes[k] per lane for k in [0, 32 quarters), from the 32 nodes of k's
+// quarter: a two-register permute a quarter (index bits 0-4), each written
+// only to the lanes whose k lies in its quarter (mask2: the other lanes keep
+// what they hold, at first the index itself), so that no blend is needed. No
+// gather: a row that every lane shares fits in a few registers.
+template <int quarters>
 struct Quarters {
-    __mmask16 of[4];  // lanes whose k lies in [32 q, 32 q + 32)
+    __mmask16 of[quarters];  // lanes whose k lies in [32 q, 32 q + 32)
 };
 
-PB_KERNEL_INLINE Quarters quarters_of(__m512i k) {
+template <int quarters>
+PB_KERNEL_INLINE Quarters<quarters> quarters_of(__m512i k) {
     const __m512i quarter = _mm512_srli_epi32(k, 5);
-    Quarters q;
-    for (int j = 0; j < 4; ++j) q.of[j] = _mm512_cmpeq_epi32_mask(quarter, _mm512_set1_epi32(j));
+    Quarters<quarters> q;
+    for (int j = 0; j < quarters; ++j) q.of[j] = _mm512_cmpeq_epi32_mask(quarter, _mm512_set1_epi32(j));
     return q;
 }
 
-PB_KERNEL_INLINE Floats permute_lookup_128(const float* nodes, __m512i k, const Quarters& quarters) {
+template <int quarters>
+PB_KERNEL_INLINE Floats permute_lookup(const float* nodes, __m512i k, const Quarters<quarters>& in) {
     __m512 value = _mm512_castsi512_ps(k);
-    for (int q = 0; q < 4; ++q)
-        value = _mm512_mask2_permutex2var_ps(_mm512_loadu_ps(nodes + 32 * q), _mm512_castps_si512(value), quarters.of[q],
+    for (int q = 0; q < quarters; ++q)
+        value = _mm512_mask2_permutex2var_ps(_mm512_loadu_ps(nodes + 32 * q), _mm512_castps_si512(value), in.of[q],
                                              _mm512_loadu_ps(nodes + 32 * q + 16));
     return value;
 }
 
-// (row[k], row[k + 1]) for k in [0, kCosines - 2] from a row of kCosines nodes
-// (model/energy.hpp), the upper nodes as the lower ones of the row moved by one
+// (row[k], row[k + 1]) for k in [0, intervals) from a row of intervals + 1
+// nodes that every lane shares (model/energy.hpp), the upper nodes as the
+// lower ones of the row moved by one
+template <int intervals>
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) {
-    static_assert(energy::kCosines - 1 == 128, "a row's intervals fill four permutes of 32 nodes");
-    const Quarters quarters = quarters_of(k);
-    return {permute_lookup_128(row, k, quarters), permute_lookup_128(row + 1, k, quarters)};
+    static_assert(intervals % 32 == 0 && intervals <= 128, "a row's intervals fill permutes of 32 nodes");
+    constexpr int quarters = intervals / 32;
+    const Quarters<quarters> in = quarters_of<quarters>(k);
+    return {permute_lookup<quarters>(row, k, in), permute_lookup<quarters>(row + 1, k, in)};
 }
 #elif defined(__AVX2__)
 // Each lane's two adjacent floats as one 8-byte load, four lanes to a pair of
@@ -461,7 +455,53 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints 
 }
 #endif
 #if !defined(__AVX512F__)
+template <int intervals>
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) { return gather_pair(row, k); }
+#endif
+
+// The four nodes about each lane's point of a corner table (energy_corners.hpp:
+// row j at k and k + 1, row j + 1 at both), one 16-byte load a lane. On AVX2
+// and AVX-512 the loads fill the 128-bit blocks of four registers, block b of
+// register r with lane 4 b + r, and a 4x4 transpose within the blocks leaves
+// corner c of lanes 4 b .. 4 b + 3 in block b of register c: on Zen 4 a third
+// of the time of gathering two pairs from two rows (bench/RESULTS.md).
+#if defined(__AVX512F__)
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
+    alignas(64) std::int32_t index[kLanes];
+    at.store_aligned(index);
+    auto corners_of = [&](int lane) { return _mm_load_ps(corners + energy::kCorners * std::int64_t(index[lane])); };
+    auto blocks = [&](int r) {
+        const __m512 low = _mm512_insertf32x4(_mm512_castps128_ps512(corners_of(r)), corners_of(4 + r), 1);
+        return _mm512_insertf32x4(_mm512_insertf32x4(low, corners_of(8 + r), 2), corners_of(12 + r), 3);
+    };
+    const __m512 r0 = blocks(0), r1 = blocks(1), r2 = blocks(2), r3 = blocks(3);
+    const __m512d low01 = _mm512_castps_pd(_mm512_unpacklo_ps(r0, r1)), high01 = _mm512_castps_pd(_mm512_unpackhi_ps(r0, r1));
+    const __m512d low23 = _mm512_castps_pd(_mm512_unpacklo_ps(r2, r3)), high23 = _mm512_castps_pd(_mm512_unpackhi_ps(r2, r3));
+    return {_mm512_castpd_ps(_mm512_unpacklo_pd(low01, low23)), _mm512_castpd_ps(_mm512_unpackhi_pd(low01, low23)),
+            _mm512_castpd_ps(_mm512_unpacklo_pd(high01, high23)), _mm512_castpd_ps(_mm512_unpackhi_pd(high01, high23))};
+}
+#elif defined(__AVX2__)
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
+    alignas(32) std::int32_t index[kLanes];
+    at.store_aligned(index);
+    auto corners_of = [&](int lane) { return _mm_load_ps(corners + energy::kCorners * std::int64_t(index[lane])); };
+    auto blocks = [&](int r) { return _mm256_set_m128(corners_of(4 + r), corners_of(r)); };
+    const __m256 r0 = blocks(0), r1 = blocks(1), r2 = blocks(2), r3 = blocks(3);
+    const __m256d low01 = _mm256_castps_pd(_mm256_unpacklo_ps(r0, r1)), high01 = _mm256_castps_pd(_mm256_unpackhi_ps(r0, r1));
+    const __m256d low23 = _mm256_castps_pd(_mm256_unpacklo_ps(r2, r3)), high23 = _mm256_castps_pd(_mm256_unpackhi_ps(r2, r3));
+    return {_mm256_castpd_ps(_mm256_unpacklo_pd(low01, low23)), _mm256_castpd_ps(_mm256_unpackhi_pd(low01, low23)),
+            _mm256_castpd_ps(_mm256_unpacklo_pd(high01, high23)), _mm256_castpd_ps(_mm256_unpackhi_pd(high01, high23))};
+}
+#else
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
+    alignas(64) std::int32_t index[kLanes];
+    alignas(64) float corner[4][kLanes];
+    at.store_aligned(index);
+    for (std::int64_t j = 0; j < kLanes; ++j)
+        for (int c = 0; c < 4; ++c) corner[c][j] = corners[energy::kCorners * index[j] + c];
+    return {Floats::load_aligned(corner[0]), Floats::load_aligned(corner[1]), Floats::load_aligned(corner[2]),
+            Floats::load_aligned(corner[3])};
+}
 #endif
 
 // (sin 2πu, cos 2πu) for u in [0, 1] by the double angle, without quadrant

@@ -14,9 +14,11 @@
 //   ∫ f_ms cos θl dωl = lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))) (1 - E(μo))
 // (since 2 ∫ (1 - E(μ)) μ dμ = 1 - E_avg), added to the cosine lobe's w0.
 // The ops of the number type provide truncate_to_index (x >= 0), index_to_real,
-// gather_pair ((table[index], table[index + 1]) per lane) and gather_pair_in_row
-// (the same from one row of kCosines nodes that every lane shares, which the
-// AVX-512 kernel reads by register permutes instead of gathers).
+// gather_pair_in_row ((row[index], row[index + 1]) per lane from a row of
+// intervals + 1 nodes that every lane shares, a blended row of 1 - E or the
+// table of 1 - E_avg, which the AVX-512 kernel reads by register permutes
+// instead of gathers) and gather_corners (the four nodes about a point of
+// the 1 - E table, energy_corners.hpp).
 #pragma once  // (per namespace that includes the model)
 
 // The nodes' spacings are powers of two, so that μ (kCosines - 1) and
@@ -39,6 +41,7 @@ struct EnergyRow {
 template <class F>
 struct MultipleScatteringLobe {
     const float* missing;  // the model's 1 - E table, or one row of it (single_row)
+    const float* corners;  // the same table by corners (energy_corners.hpp), which the lookup reads otherwise
     EnergyRow<F> row;
     bool single_row = false;  // missing is 1 - E at r_eff already, blended between the rows (a uniform material)
     Rgb<F> color;          // F_avg² E_avg / (1 - F_avg (1 - E_avg)) / (π (1 - E_avg))
@@ -50,12 +53,10 @@ struct MultipleScatteringLobe {
         const IndexOf<F> k = min(truncate_to_index(x), IndexOf<F>(energy::kCosines - 2));
         const F t = x - index_to_real(k);
         if (single_row) {
-            const auto [at_k, at_next] = gather_pair_in_row(missing, k);
+            const auto [at_k, at_next] = gather_pair_in_row<energy::kCosines - 1>(missing, k);
             return mix(at_k, at_next, t);
         }
-        const IndexOf<F> at = row.offset + k;
-        const auto [below_k, below_next] = gather_pair(missing, at);
-        const auto [above_k, above_next] = gather_pair(missing + energy::kCosines, at);  // (the same indices)
+        const auto [below_k, below_next, above_k, above_next] = gather_corners(corners, row.offset + k);
         return mix(mix(below_k, below_next, t), mix(above_k, above_next, t), row.fraction);
     }
 
@@ -79,12 +80,13 @@ PB_MODEL_INLINE MultipleScatteringLobe<F> multiple_scattering_of(const F* p, con
     const F one(1.0);
     MultipleScatteringLobe<F> ms;
     ms.missing = energy::kMissing[static_cast<int>(model)];
+    ms.corners = energy::kMissingCorners[static_cast<int>(model)];
     // r_eff clamped to the tables' [0, 1]
     const F y = min(max(p[kRoughness], F(0.0)), one) * F(energy::kRoughnesses - 1);
     const IndexOf<F> j = min(truncate_to_index(y), IndexOf<F>(energy::kRoughnesses - 2));
     ms.row = {truncate_to_index(index_to_real(j) * F(energy::kCosines)), y - index_to_real(j)};
     const float* average = energy::kMissingAverage[static_cast<int>(model)];
-    const auto [average_j, average_next] = gather_pair(average, j);
+    const auto [average_j, average_next] = gather_pair_in_row<energy::kRoughnesses - 1>(average, j);
     const F missing_average = mix(average_j, average_next, ms.row.fraction);
     const F e_average = one - missing_average;
     // F_avg = (20 Cspec0 + 1) / 21 per channel, at most 1 (Cspec0 > 1 for a base_color or

@@ -35,11 +35,16 @@ inline std::pair<double, double> sincos_turns(double u) {
     return {std::sin(phi), std::cos(phi)};
 }
 
-// table lookups (model/energy.hpp): the integer part of x >= 0, back to a real, (table[i], table[i + 1])
+// table lookups (model/energy.hpp): the integer part of x >= 0, back to a real, (row[i], row[i + 1])
 inline int truncate_to_index(double x) { return static_cast<int>(x); }
 inline double index_to_real(int i) { return static_cast<double>(i); }
 inline int min(int a, int b) { return a < b ? a : b; }
-inline std::pair<double, double> gather_pair(const float* table, int i) {
-    return {static_cast<double>(table[i]), static_cast<double>(table[i + 1])};
+template <int intervals>
+inline std::pair<double, double> gather_pair_in_row(const float* row, int i) {
+    return {static_cast<double>(row[i]), static_cast<double>(row[i + 1])};
 }
-inline std::pair<double, double> gather_pair_in_row(const float* row, int i) { return gather_pair(row, i); }
+// the four nodes about a point of a corner table (energy_corners.hpp)
+inline std::array<double, 4> gather_corners(const float* corners, int i) {
+    const float* c = corners + energy::kCorners * i;
+    return {c[0], c[1], c[2], c[3]};
+}
