@@ -386,30 +386,30 @@ PB_KERNEL_INLINE Floats index_to_real(Ints i) { return xsimd::to_float(i); }
 PB_KERNEL_INLINE Ints min(Ints a, Ints b) { return xsimd::min(a, b); }
 // (the intrinsics: xsimd 8.1's batch::gather for fma3<avx2> falls back to an out-of-line element loop)
 #if defined(__AVX512F__)
-// nodes[k] per lane for k in [0, 32 quarters), from the 32 nodes of k's
-// quarter: a two-register permute a quarter (index bits 0-4), each written
-// only to the lanes whose k lies in its quarter (mask2: the other lanes keep
-// what they hold, at first the index itself), so that no blend is needed. No
-// gather: a row that every lane shares fits in a few registers.
-template <int quarters>
-struct Quarters {
-    __mmask16 of[quarters];  // lanes whose k lies in [32 q, 32 q + 32)
+// nodes[k] per lane for k in [0, 32 parts), from the 32 nodes of k's part: a
+// two-register permute a part (index bits 0-4), each written only to the
+// lanes whose k lies in its part (mask2: the other lanes keep what they hold,
+// at first the index itself), so that no blend is needed. No gather: a row
+// that every lane shares fits in a few registers.
+template <int parts>
+struct Parts {
+    __mmask16 of[parts];  // lanes whose k lies in [32 p, 32 p + 32)
 };
 
-template <int quarters>
-PB_KERNEL_INLINE Quarters<quarters> quarters_of(__m512i k) {
-    const __m512i quarter = _mm512_srli_epi32(k, 5);
-    Quarters<quarters> q;
-    for (int j = 0; j < quarters; ++j) q.of[j] = _mm512_cmpeq_epi32_mask(quarter, _mm512_set1_epi32(j));
-    return q;
+template <int parts>
+PB_KERNEL_INLINE Parts<parts> parts_of(__m512i k) {
+    const __m512i part = _mm512_srli_epi32(k, 5);
+    Parts<parts> lanes;
+    for (int p = 0; p < parts; ++p) lanes.of[p] = _mm512_cmpeq_epi32_mask(part, _mm512_set1_epi32(p));
+    return lanes;
 }
 
-template <int quarters>
-PB_KERNEL_INLINE Floats permute_lookup(const float* nodes, __m512i k, const Quarters<quarters>& in) {
+template <int parts>
+PB_KERNEL_INLINE Floats permute_lookup(const float* nodes, __m512i k, const Parts<parts>& lanes) {
     __m512 value = _mm512_castsi512_ps(k);
-    for (int q = 0; q < quarters; ++q)
-        value = _mm512_mask2_permutex2var_ps(_mm512_loadu_ps(nodes + 32 * q), _mm512_castps_si512(value), in.of[q],
-                                             _mm512_loadu_ps(nodes + 32 * q + 16));
+    for (int p = 0; p < parts; ++p)
+        value = _mm512_mask2_permutex2var_ps(_mm512_loadu_ps(nodes + 32 * p), _mm512_castps_si512(value), lanes.of[p],
+                                             _mm512_loadu_ps(nodes + 32 * p + 16));
     return value;
 }
 
@@ -419,9 +419,9 @@ PB_KERNEL_INLINE Floats permute_lookup(const float* nodes, __m512i k, const Quar
 template <int intervals>
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) {
     static_assert(intervals % 32 == 0 && intervals <= 128, "a row's intervals fill permutes of 32 nodes");
-    constexpr int quarters = intervals / 32;
-    const Quarters<quarters> in = quarters_of<quarters>(k);
-    return {permute_lookup<quarters>(row, k, in), permute_lookup<quarters>(row + 1, k, in)};
+    constexpr int parts = intervals / 32;
+    const Parts<parts> lanes = parts_of<parts>(k);
+    return {permute_lookup<parts>(row, k, lanes), permute_lookup<parts>(row + 1, k, lanes)};
 }
 #elif defined(__AVX2__)
 // Each lane's two adjacent floats as one 8-byte load, four lanes to a pair of
@@ -463,8 +463,8 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, 
 // row j at k and k + 1, row j + 1 at both), one 16-byte load a lane. On AVX2
 // and AVX-512 the loads fill the 128-bit blocks of four registers, block b of
 // register r with lane 4 b + r, and a 4x4 transpose within the blocks leaves
-// corner c of lanes 4 b .. 4 b + 3 in block b of register c: on Zen 4 a third
-// of the time of gathering two pairs from two rows (bench/RESULTS.md).
+// corner c of lanes 4 b .. 4 b + 3 in block b of register c. No gathers: on
+// Zen 4 eight lanes' pairs by vgatherdpd cost about 17 cycles (bench/RESULTS.md).
 #if defined(__AVX512F__)
 PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
     alignas(64) std::int32_t index[kLanes];
