@@ -5,9 +5,10 @@ uniform material and per batch, when all its lanes agree, for a per-element
 one; `eval` and `eval_pdf` have them. Such a kernel leaves out only terms that
 are exactly 0, so its f must be the same bits as the full kernel's, which a
 batch runs when one of its lanes has a clearcoat. With the energy compensation
-a uniform material's kernels take the lobe sets too; they read the tables by
-the material's blended row, which rounds apart from the per-element lookup of
-the full kernel here, so they agree to float32 roundings."""
+the kernels take the lobe sets too: per element with the same bits again; a
+uniform material's read the tables by its blended row, which rounds apart
+from the per-element lookup of the full kernel here, so they agree to float32
+roundings."""
 
 import numpy as np
 import pytest
@@ -101,12 +102,14 @@ def test_a_textures_batches_take_their_lobe_set(pairs, isa, model):
     choice = np.concatenate([[names.index(name)] * length for name, length in runs])[:len(wi)]
     tables = [pb.Material(**MATERIALS[name]).as_dict() for name in names]
     texture = pb.Material(**{k: np.array([table[k] for table in tables], np.float64)[choice] for k in tables[0]})
-    got = pb.eval(texture, wi, wo, model=model, isa=isa)
-    np.testing.assert_array_equal(bits(got), bits(full_kernel(texture, wi, wo, model=model, isa=isa)))
-    value, pdf = full_kernel(texture, wi, wo, evaluate=pb.eval_pdf, model=model, isa=isa)
-    got_pair = pb.eval_pdf(texture, wi, wo, model=model, isa=isa)
-    np.testing.assert_array_equal(bits(got_pair.value), bits(value))
-    np.testing.assert_array_equal(bits(got_pair.pdf), bits(pdf))
+    for compensation in (False, True):  # per element, the compensated kernels read the same corners: the same bits
+        options = dict(model=model, isa=isa, energy_compensation=compensation)
+        got = pb.eval(texture, wi, wo, **options)
+        np.testing.assert_array_equal(bits(got), bits(full_kernel(texture, wi, wo, **options)))
+        value, pdf = full_kernel(texture, wi, wo, evaluate=pb.eval_pdf, **options)
+        got_pair = pb.eval_pdf(texture, wi, wo, **options)
+        np.testing.assert_array_equal(bits(got_pair.value), bits(value))
+        np.testing.assert_array_equal(bits(got_pair.pdf), bits(pdf))
 
 
 @pytest.mark.parametrize("isa", ISAS)

@@ -188,7 +188,20 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
         // the lobes' constants as locals: a CompensatedPrepared built per batch was copied whole (rep movs)
         const RawMaterial m = load_material(job.params, i);
         const Shading<Floats> s = shading_of(m);
-        eval_compensated_batch<model, output, layouts>(job, i, wi, wo, s, multiple_scattering_of(m.slot, s, model));
+        const MultipleScatteringLobe<Floats> ms = multiple_scattering_of(m.slot, s, model);
+        if constexpr (has_lobe_sets(output)) {  // the batch's LobeSet, as below
+            switch (lobe_set_of(m)) {
+                case LobeSet::kSpecular:
+                    eval_compensated_batch<model, output, layouts, LobeSet::kSpecular>(job, i, wi, wo, s, ms);
+                    return true;
+                case LobeSet::kPlain:
+                    eval_compensated_batch<model, output, layouts, LobeSet::kPlain>(job, i, wi, wo, s, ms);
+                    return true;
+                default:
+                    break;
+            }
+        }
+        eval_compensated_batch<model, output, layouts>(job, i, wi, wo, s, ms);
     } else if constexpr (per_element && has_lobe_sets(output)) {
         // the batch's LobeSet, when all its lanes agree (a texture's metal or plastic regions)
         const RawMaterial m = load_material(job.params, i);
