@@ -35,7 +35,12 @@ int resolve_threads(int threads) { return threads > 0 ? threads : hardware_threa
 
 }  // namespace
 
-int hardware_threads() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+// Read once: the C library counts the CPUs from /sys on each call, which costs
+// more than evaluating a small call.
+int hardware_threads() {
+    static const int count = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    return count;
+}
 
 std::vector<std::string> available_isas() {
     std::vector<std::string> names;

@@ -13,6 +13,7 @@ Input handling, once per call:
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, NamedTuple, overload
 
 import numpy as np
@@ -157,7 +158,7 @@ class _Directions:
         if self.leading != leading:
             target = leading + (3,) if self.layout == "aos" else (3,) + leading
             array = np.ascontiguousarray(np.broadcast_to(array, target))
-        n = int(np.prod(leading, dtype=np.int64))
+        n = _size(leading)
         return (array.reshape(n, 3), _INTERLEAVED) if self.layout == "aos" else (array.reshape(3, n), _ROWS)
 
     def _own_index(self, element: int, leading: tuple[int, ...]) -> tuple[int, ...]:
@@ -201,16 +202,30 @@ def _require_float32_range(name: str, value: FloatArray) -> None:
                          f"float32 kernels represent (<= {limit:g}); pb.reference evaluates it in float64")
 
 
+def _kernel_numbers(material: Material) -> list[float | tuple[float, ...] | None]:
+    """Per parameter: its number (base_color's three) when uniform, else None;
+    checked against FLOAT32_LIMITS and kept on the (immutable) material."""
+    numbers = material._kernel_numbers
+    if numbers is None:
+        numbers = []
+        for name, info in PARAMETERS.items():
+            value = getattr(material, name)
+            _require_float32_range(name, value)
+            if value.shape != (() if info.slots == 1 else (3,)):
+                numbers.append(None)
+            else:
+                numbers.append(tuple(float(v) for v in value) if info.slots == 3 else float(value))
+        object.__setattr__(material, "_kernel_numbers", numbers)
+    return numbers
+
+
 def _params(material: Material, leading: tuple[int, ...]) -> list[float | tuple[float, ...] | Float32Array]:
     """One entry per parameter: a number (uniform) or a float32 per-element array."""
-    n = int(np.prod(leading, dtype=np.int64))
+    n = _size(leading)
     entries: list[float | tuple[float, ...] | Float32Array] = []
-    for name, info in PARAMETERS.items():
-        value = getattr(material, name)
-        _require_float32_range(name, value)
-        uniform = value.shape == (() if info.slots == 1 else (3,))
-        if uniform:
-            entries.append(tuple(float(v) for v in value) if info.slots == 3 else float(value))
+    for (name, info), number in zip(PARAMETERS.items(), _kernel_numbers(material)):
+        if number is not None:
+            entries.append(number)
         else:
             per_element = material._float32(name, leading)
             entries.append(per_element.reshape((n, 3) if info.slots == 3 else (n,)))
@@ -253,7 +268,7 @@ def _require_material(material: object) -> None:
 
 
 def _size(leading: tuple[int, ...]) -> int:
-    return int(np.prod(leading, dtype=np.int64))
+    return math.prod(leading)
 
 
 def _vec3_shape(leading: tuple[int, ...], layout: str) -> tuple[int, ...]:

@@ -6,6 +6,7 @@ Every check names the argument and the first offending element, e.g.
 
 from __future__ import annotations
 
+import math
 import numbers
 import operator
 from typing import TYPE_CHECKING
@@ -74,6 +75,8 @@ def first_true(mask: NDArray[np.bool_]) -> int:
 
 def as_real_array(name: str, value: object) -> Float64Array:
     """A float64 array from a number or array of real numbers; TypeError otherwise."""
+    if type(value) is float:  # the common case, without numpy's dtype inspection
+        return np.array(value)
     if isinstance(value, (str, bytes)) or value is None:
         raise TypeError(f"{name}: expected a real number or an array of them, got {type(value).__name__}")
     if isinstance(value, numbers.Number) and not isinstance(value, numbers.Real):
@@ -115,6 +118,10 @@ def require_finite(name: str, array: FloatArray) -> None:
 
 
 def require_in_domain(name: str, array: FloatArray, lower: float, upper: float) -> None:
+    if array.ndim == 0:  # a number inside the domain passes without array operations
+        number = float(array)
+        if math.isfinite(number) and lower <= number <= upper:
+            return
     not_finite = ~np.isfinite(array)
     with np.errstate(invalid="ignore"):
         bad = not_finite | (array < lower) | (array > upper)
@@ -175,6 +182,9 @@ def sampler_index(specular_sampler: object) -> int:
 
 def broadcast_leading(**shapes: tuple[int, ...]) -> tuple[int, ...]:
     """The common leading shape of several arguments, or a ValueError naming them."""
+    distinct = {shape for shape in shapes.values() if shape != ()}
+    if len(distinct) <= 1:  # the common case, without numpy's general rule
+        return distinct.pop() if distinct else ()
     try:
         return np.broadcast_shapes(*shapes.values())
     except ValueError:

@@ -47,7 +47,7 @@ class Material:
     raise ``ValueError`` naming the parameter and the first bad element.
     """
 
-    __slots__ = tuple(PARAMETERS) + ("_float32_cache",)
+    __slots__ = tuple(PARAMETERS) + ("_shape", "_float32_cache", "_kernel_numbers")
 
     # The parameters as given, float64 and read-only: base_color (3,) or (..., 3), the others () or (...).
     base_color: Float64Array
@@ -61,7 +61,11 @@ class Material:
     sheen_tint: Float64Array
     clearcoat: Float64Array
     clearcoat_gloss: Float64Array
+    _shape: tuple[int, ...]
     _float32_cache: dict[tuple[str, tuple[int, ...]], Float32Array]
+    # the SIMD kernels' per-parameter entry (a number, base_color's three, or None
+    # when per element), set by the first SIMD call after its float32 range check
+    _kernel_numbers: list[float | tuple[float, ...] | None] | None
 
     def __init__(
         self,
@@ -92,7 +96,9 @@ class Material:
             array.flags.writeable = False
             object.__setattr__(self, name, array)
         object.__setattr__(self, "_float32_cache", {})
-        self.shape  # raises now if the parameters' shapes do not broadcast
+        object.__setattr__(self, "_kernel_numbers", None)
+        # raises now if the parameters' shapes do not broadcast; kept, as the parameters never change
+        object.__setattr__(self, "_shape", broadcast_leading(**{name: self._leading_shape(name) for name in PARAMETERS}))
         if not flag("bright_base_color", bright_base_color) and self.base_color.size and self.base_color.max() > 1.0:
             warnings.warn(f"base_color: {self.base_color.max():g} > 1 reflects more than it receives (a 0-255 or "
                           "display-encoded colour?); pass bright_base_color=True if it is meant", BrightColorWarning,
@@ -107,7 +113,7 @@ class Material:
     @property
     def shape(self) -> tuple[int, ...]:
         """Leading shape the per-element parameters broadcast to (``()`` if all uniform)."""
-        return broadcast_leading(**{name: self._leading_shape(name) for name in PARAMETERS})
+        return self._shape
 
     @property
     def is_uniform(self) -> bool:
