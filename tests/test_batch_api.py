@@ -50,6 +50,35 @@ def test_results_do_not_depend_on_threads(isa):
         np.testing.assert_array_equal(pb.eval(material, wi, wo, threads=threads, isa=isa), one)
 
 
+def test_calls_from_several_python_threads_and_a_forked_child_share_the_pool_safely():
+    """The pool runs one call at a time, its workers polling between calls: calls
+    racing from Python threads, back to back, each get their own exact result,
+    and a child forked after the pool started makes its own."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    rng = seeded_rng("pool")
+    n = 70_001  # several chunks, so that every call wakes a worker
+    wi, wo = (w.astype(np.float32) for w in random_direction_pairs(rng, n))
+    materials = [pb.Material(roughness=r, clearcoat=0.5, sheen=0.3) for r in (0.1, 0.4, 0.7, 1.0)]
+    expected = [pb.eval(m, wi, wo, threads=1) for m in materials]
+    with ThreadPoolExecutor(max_workers=4) as callers:
+        for _ in range(10):
+            results = list(callers.map(lambda m: pb.eval(m, wi, wo, threads=2), materials))
+            for got, want in zip(results, expected):
+                np.testing.assert_array_equal(got, want)
+    code = ("import os, numpy as np, principled_brdf as pb\n"
+            "wi = np.tile(np.float32([0.6, 0, 0.8]), (70001, 1))\n"
+            "m = pb.Material(roughness=0.4)\n"
+            "want = pb.eval(m, wi, wi, threads=2)\n"
+            "pid = os.fork()\n"
+            "if pid == 0:\n"
+            "    os._exit(0 if np.array_equal(pb.eval(m, wi, wi, threads=2), want) else 3)\n"
+            "_, status = os.waitpid(pid, 0)\n"
+            "raise SystemExit(os.waitstatus_to_exitcode(status))\n")
+    child = subprocess.run([sys.executable, "-c", code], timeout=60)
+    assert child.returncode == 0
+
+
 @pytest.mark.parametrize("isa", ISAS)
 def test_uniform_and_per_element_materials_agree_bitwise(isa):
     rng = seeded_rng("uniform", isa)
