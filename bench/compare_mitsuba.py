@@ -8,7 +8,8 @@ whose JIT folds the uniform material's constants into the kernel. Its `wi`
 is this library's `wo` (towards the viewer) and its `eval` includes the
 cosine, so it is timed against `pb.eval(..., cosine=True)`; its `sample`
 against `pb.sample` with given uniforms. Each figure is the best of
-`--repeats` timed runs after a warm-up (which compiles Mitsuba's kernel);
+`--repeats` timed runs (and of at least 0.2 s of runs) after a warm-up (which
+compiles Mitsuba's kernel) and a pause that lets the other library's threads sleep;
 Dr.Jit runs asynchronously, so its timer stops after `dr.sync_thread()`.
 "One core" pins the process to CPU 0 (sched_setaffinity) and runs both on
 one thread; "all" uses every core. `--material` takes a preset instead of
@@ -39,13 +40,19 @@ def material_named(name: str) -> pb.Material:
     return pb.Material(**MATERIAL) if name == "benchmark" else pb.presets.get(name)
 
 
-def best_seconds(run, repeats: int) -> float:
-    run()  # warm-up: page faults, Mitsuba's JIT
-    best = np.inf
-    for _ in range(repeats):
+def best_seconds(run, repeats: int, min_seconds: float = 0.2) -> float:
+    """The fastest of at least `repeats` runs and `min_seconds` of runs, after a
+    warm-up (page faults, Mitsuba's JIT) and a pause: either library's worker
+    threads spin for a while after a call before they sleep, and would take the
+    other's second core."""
+    run()
+    time.sleep(0.05)
+    best, total, count = np.inf, 0.0, 0
+    while count < repeats or total < min_seconds:
         start = time.perf_counter()
         run()
-        best = min(best, time.perf_counter() - start)
+        elapsed = time.perf_counter() - start
+        best, total, count = min(best, elapsed), total + elapsed, count + 1
     return best
 
 

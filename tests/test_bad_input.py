@@ -335,3 +335,26 @@ def test_failed_calls_leave_inputs_untouched():
         pb.reference.eval(pb.Material(), wi, wo)
     np.testing.assert_array_equal(wi, wi_copy)
     np.testing.assert_array_equal(wo, wo_copy)
+
+
+SPECIAL_VALUES = (0.0, -0.0, 0.5, 1.0, -1.0, 2.0, 1e300, -1e300, np.inf, -np.inf, np.nan, 3.4028234663852886e38, 3.5e38)
+BOUNDS = ((0.0, 1.0), (0.0, np.inf), (-np.inf, np.inf), (1.5, 100.0), (-3.4028234663852886e38, 3.4028234663852886e38))
+
+
+@pytest.mark.parametrize("lower, upper", BOUNDS)
+def test_the_checks_fast_path_accepts_exactly_what_the_elementwise_rule_accepts(lower, upper):
+    # all_within (two reductions) decides every call that passes; it must agree with
+    # "finite and lower <= x <= upper" element by element, infinite bounds included
+    from principled_brdf._validate import all_within
+
+    rng = np.random.default_rng(17)
+    arrays = [np.array(SPECIAL_VALUES), np.empty(0), np.array([True, False]), np.arange(5, dtype=np.uint8)]
+    arrays += [rng.choice(SPECIAL_VALUES, size=(4, 3)) for _ in range(200)]
+    arrays += [np.full((2, 2), v) for v in SPECIAL_VALUES]
+    for array in arrays:
+        with np.errstate(invalid="ignore"):
+            expected = bool(np.all(np.isfinite(array) & (array >= lower) & (array <= upper)))
+        assert all_within(array, lower, upper) == expected, (array, lower, upper)
+        assert all_within(array.astype(np.float32), lower, upper) == bool(
+            np.all(np.isfinite(array.astype(np.float32)) & (array.astype(np.float32) >= lower)
+                   & (array.astype(np.float32) <= upper))), (array, lower, upper)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import numbers
 import operator
+import sys
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -98,8 +99,23 @@ def _not_finite_message(name: str, flat_index: int, array: FloatArray) -> str:
     return f"{element_name(name, flat_index, array.shape)}: {float(array.ravel()[flat_index])!r} is not a finite number"
 
 
+def all_within(array: FloatArray, lower: float, upper: float) -> bool:
+    """Every value finite and within [lower, upper]: two reductions and no
+    temporary arrays, several times faster than an elementwise mask (min and
+    max propagate NaN, which fails both comparisons). The checks below take it
+    as their fast path and build a mask only to name an offending element."""
+    if array.size == 0:
+        return True
+    lowest, highest = max(lower, -sys.float_info.max), min(upper, sys.float_info.max)
+    # as Python floats: compared with a float32 reduction, a float64 bound would be
+    # rounded to float32 (numpy's promotion), sys.float_info.max to infinity
+    return lowest <= float(array.min()) and float(array.max()) <= highest
+
+
 def require_float32(name: str, array: FloatArray) -> None:
     """Every value finite and within float32's range (for the float32 kernels)."""
+    if all_within(array, -FLOAT32_MAX, FLOAT32_MAX):
+        return
     with np.errstate(invalid="ignore"):
         bad = ~(np.abs(array) <= FLOAT32_MAX)
     if bad.any():
@@ -112,6 +128,8 @@ def require_float32(name: str, array: FloatArray) -> None:
 
 
 def require_finite(name: str, array: FloatArray) -> None:
+    if all_within(array, -np.inf, np.inf):
+        return
     bad = ~np.isfinite(array)
     if bad.any():
         raise ValueError(_not_finite_message(name, first_true(bad), array))
@@ -122,6 +140,8 @@ def require_in_domain(name: str, array: FloatArray, lower: float, upper: float) 
         number = float(array)
         if math.isfinite(number) and lower <= number <= upper:
             return
+    elif all_within(array, lower, upper):
+        return
     not_finite = ~np.isfinite(array)
     with np.errstate(invalid="ignore"):
         bad = not_finite | (array < lower) | (array > upper)
