@@ -384,15 +384,15 @@ constexpr float kLn2High = 0.693145751953125f, kLn2Low = 1.42860682030941723e-6f
 // ln x as e ln 2 + ln m for x = 2^e m, m in [0.75, 1.5), taken exactly by
 // getexp and getmant (zeros, subnormals, infinities and NaN included: ln 0 is
 // -inf), and ln m = 2 atanh(s) = 2 s (1 + s²/3 + s⁴/5 + s⁶/7 + s⁸/9) with
-// s = (m - 1) / (m + 1), |s| <= 0.2 (the series' remainder < 1e-8 relative). About
-// 20 instructions against xsimd's 40-odd: the per-element loops take it of
-// every batch's clearcoat a².
+// s = (m - 1) / (m + 1), |s| <= 0.2 (the series' remainder < 1e-8 relative).
+// About 20 instructions: the per-element loops, which take it of every batch's
+// clearcoat a², shrank by 32 against xsimd's log (bench/RESULTS.md, run 12).
 PB_KERNEL_INLINE Floats log(Floats x) {
     const __m512 m = _mm512_getmant_ps(x, _MM_MANT_NORM_p75_1p5, _MM_MANT_SIGN_nan);
     const __m512 one = _mm512_set1_ps(1.0f);
     // getmant halves a mantissa of 1.5 or more, so that its exponent is getexp's plus one
-    const __m512 e = _mm512_mask_add_ps(_mm512_getexp_ps(x), _mm512_cmp_ps_mask(m, one, _CMP_LT_OQ),
-                                        _mm512_getexp_ps(x), one);
+    const __m512 exponent = _mm512_getexp_ps(x);
+    const __m512 e = _mm512_mask_add_ps(exponent, _mm512_cmp_ps_mask(m, one, _CMP_LT_OQ), exponent, one);
     const Floats s = Floats(_mm512_sub_ps(m, one)) * reciprocal(Floats(_mm512_add_ps(m, one)));
     const Floats s2 = s * s;
     Floats series(1.0f / 9.0f);
