@@ -338,7 +338,7 @@ def test_failed_calls_leave_inputs_untouched():
     np.testing.assert_array_equal(wo, wo_copy)
 
 
-SPECIAL_VALUES = (0.0, -0.0, 0.5, 1.0, -1.0, 2.0, 1e300, -1e300, np.inf, -np.inf, np.nan, 3.4028234663852886e38, 3.5e38)
+EDGE_VALUES = (0.0, -0.0, 0.5, 1.0, -1.0, 2.0, 1e300, -1e300, np.inf, -np.inf, np.nan, 3.4028234663852886e38, 3.5e38)
 BOUNDS = ((0.0, 1.0), (0.0, np.inf), (-np.inf, np.inf), (1.5, 100.0), (-3.4028234663852886e38, 3.4028234663852886e38))
 
 
@@ -347,9 +347,9 @@ def test_the_checks_fast_path_accepts_exactly_what_the_elementwise_rule_accepts(
     # all_within (two reductions) decides every call that passes; it must agree with
     # "finite and lower <= x <= upper" element by element, infinite bounds included
     rng = np.random.default_rng(17)
-    arrays = [np.array(SPECIAL_VALUES), np.empty(0), np.array([True, False]), np.arange(5, dtype=np.uint8)]
-    arrays += [rng.choice(SPECIAL_VALUES, size=(4, 3)) for _ in range(200)]
-    arrays += [np.full((2, 2), v) for v in SPECIAL_VALUES]
+    arrays = [np.array(EDGE_VALUES), np.empty(0), np.array([True, False]), np.arange(5, dtype=np.uint8)]
+    arrays += [rng.choice(EDGE_VALUES, size=(4, 3)) for _ in range(200)]
+    arrays += [np.full((2, 2), v) for v in EDGE_VALUES]
     for array in arrays:
         with np.errstate(over="ignore", invalid="ignore"):
             both = (array, array.astype(np.float32))  # in float32, 1e300 is infinite
