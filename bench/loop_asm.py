@@ -59,13 +59,14 @@ def blocks_of(body):
     for b, block in enumerate(blocks):
         _, op, operands = block[-1]
         target = re.match(r"([0-9a-f]+) <", operands)
+        # (an indirect jump, e.g. through a switch's table, leaves no edge here)
+        jumped = [index_of[int(target.group(1), 16)]] if target and int(target.group(1), 16) in index_of else []
         following = [b + 1] if b + 1 < len(blocks) else []
         if op.startswith("ret") or op.startswith("ud2"):
             successors.append([])
-        elif op.startswith("jmp") or op == "notrack":  # an indirect jump (a switch's table) leaves no edge here
-            successors.append([index_of[int(target.group(1), 16)]] if target and int(target.group(1), 16) in index_of else [])
+        elif op.startswith("jmp") or op == "notrack":
+            successors.append(jumped)
         elif op.startswith("j"):
-            jumped = [index_of[int(target.group(1), 16)]] if target and int(target.group(1), 16) in index_of else []
             successors.append(jumped + following)
         else:
             successors.append(following)
