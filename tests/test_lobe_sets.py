@@ -102,7 +102,7 @@ def test_a_textures_batches_take_their_lobe_set(pairs, isa, model):
     choice = np.concatenate([[names.index(name)] * length for name, length in runs])[:len(wi)]
     tables = [pb.Material(**MATERIALS[name]).as_dict() for name in names]
     texture = pb.Material(**{k: np.array([table[k] for table in tables], np.float64)[choice] for k in tables[0]})
-    for compensation in (False, True):  # per element, the compensated kernels read the same row pairs: the same bits
+    for compensation in (False, True):  # per element, the compensated kernels read the same corners: the same bits
         options = dict(model=model, isa=isa, energy_compensation=compensation)
         got = pb.eval(texture, wi, wo, **options)
         np.testing.assert_array_equal(bits(got), bits(full_kernel(texture, wi, wo, **options)))

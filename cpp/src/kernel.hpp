@@ -23,7 +23,7 @@
 #endif
 
 #include "kernel_api.hpp"
-#include "principled_brdf/energy_row_pairs.hpp"
+#include "principled_brdf/energy_tables.hpp"
 
 namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS {
 

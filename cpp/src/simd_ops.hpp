@@ -534,51 +534,6 @@ PB_KERNEL_INLINE std::array<Floats, 4> gather_cubic(const float* table, Ints at)
 }
 #endif
 
-// A row pair's two cubics per lane (energy_row_pairs.hpp): rows j's
-// coefficients, then row j + 1's, from pairs + kPairWidth i.
-#if defined(__AVX512F__)
-// One 32-byte load a lane, lanes q and q + 8 in the halves of register q;
-// then an 8x8 transpose within each half: unpacks and shuffles within the
-// 128-bit blocks leave (lanes 0-3, 4-7, 8-11 or 12-15) of coefficients c and
-// c + 4 in the blocks of one register, and a two-register permute of blocks
-// gathers each coefficient's four. 48 instructions for 16 lanes, against 72
-// for two 16-byte loads a lane (gather_cubic twice).
-PB_KERNEL_INLINE std::pair<std::array<Floats, 4>, std::array<Floats, 4>> gather_cubic_pair(const float* pairs, Ints at) {
-    static_assert(energy::kPairWidth == 8, "a row pair is one 256-bit load");
-    alignas(64) std::int32_t index[kLanes];
-    at.store_aligned(index);
-    auto pair_of = [&](int lane) {
-        return _mm256_load_pd(reinterpret_cast<const double*>(pairs + energy::kPairWidth * std::int64_t(index[lane])));
-    };
-    __m512 rows[8], pairs_of_lanes[8], quads[8];
-    for (int q = 0; q < 8; ++q)
-        rows[q] = _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castpd256_pd512(pair_of(q)), pair_of(q + 8), 1));
-    for (int q = 0; q < 8; q += 2) {  // per block: (lane q, lane q + 1) of coefficients (0, 1 | 4, 5), then (2, 3 | 6, 7)
-        pairs_of_lanes[q] = _mm512_unpacklo_ps(rows[q], rows[q + 1]);
-        pairs_of_lanes[q + 1] = _mm512_unpackhi_ps(rows[q], rows[q + 1]);
-    }
-    for (int g = 0; g < 8; g += 4)  // per block: lanes g .. g + 3 of coefficient c | c + 4 in quads[g + c]
-        for (int h = 0; h < 2; ++h) {
-            quads[g + 2 * h] = _mm512_shuffle_ps(pairs_of_lanes[g + h], pairs_of_lanes[g + 2 + h], _MM_SHUFFLE(1, 0, 1, 0));
-            quads[g + 2 * h + 1] = _mm512_shuffle_ps(pairs_of_lanes[g + h], pairs_of_lanes[g + 2 + h], _MM_SHUFFLE(3, 2, 3, 2));
-        }
-    const __m512i low = _mm512_setr_epi32(0, 1, 2, 3, 16, 17, 18, 19, 8, 9, 10, 11, 24, 25, 26, 27);
-    const __m512i high = _mm512_setr_epi32(4, 5, 6, 7, 20, 21, 22, 23, 12, 13, 14, 15, 28, 29, 30, 31);
-    std::array<Floats, 4> below, above;
-    for (int c = 0; c < 4; ++c) {
-        below[c] = _mm512_permutex2var_ps(quads[c], low, quads[4 + c]);
-        above[c] = _mm512_permutex2var_ps(quads[c], high, quads[4 + c]);
-    }
-    return {below, above};
-}
-#else
-// two 16-byte loads a lane, the halves of its 32 bytes
-PB_KERNEL_INLINE std::pair<std::array<Floats, 4>, std::array<Floats, 4>> gather_cubic_pair(const float* pairs, Ints at) {
-    const Ints half = at + at;
-    return {gather_cubic(pairs, half), gather_cubic(pairs, half + Ints(1))};
-}
-#endif
-
 // A cubic of a row that every lane shares (a uniform material's blended row,
 // BlendedEnergyRow), coefficient c of interval k at row[cubic_row_position(k, c)].
 // On AVX-512 the row lies by coefficient, each of its kIntervals = 32 values

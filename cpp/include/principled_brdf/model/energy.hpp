@@ -16,11 +16,10 @@
 // The ops of the number type provide square_root_for_index, truncate_to_index
 // (x >= 0), index_to_real, gather_pair_in_row ((row[index], row[index + 1])
 // per lane from a row of intervals + 1 nodes that every lane shares: the
-// table of 1 - E_avg), gather_cubic_pair (the two cubics of a row pair per
-// lane, from table + kPairWidth index, energy_row_pairs.hpp) and
-// gather_cubic_in_row (a cubic of one blended row that every lane shares, in
-// the layout of cubic_row_position: the AVX-512 kernel reads it by register
-// permutes).
+// table of 1 - E_avg), gather_cubic (the kCoefficients floats of a cubic per
+// lane, from table + kCoefficients index) and gather_cubic_in_row (a cubic of
+// one blended row that every lane shares, in the layout of
+// cubic_row_position: the AVX-512 kernel reads it by register permutes).
 #pragma once  // (per namespace that includes the model)
 
 // The nodes μ_k = (k / kIntervals)² and r_j = j / (kRoughnesses - 1) are at
@@ -47,7 +46,6 @@ struct EnergyRow {
 template <class F>
 struct MultipleScatteringLobe {
     const float* missing;  // the model's table of cubics, or one row of it (single_row)
-    const float* row_pairs;  // the same table by row pairs (energy_row_pairs.hpp), which the lookup reads otherwise
     EnergyRow<F> row;
     bool single_row = false;  // missing is the row at r_eff already, blended between the rows (a uniform material)
     Rgb<F> color;          // F_avg² E_avg / (1 - F_avg (1 - E_avg)) / (π (1 - E_avg))
@@ -61,8 +59,9 @@ struct MultipleScatteringLobe {
         const F upper = index_to_real(k) + F(1.0);
         const F s = neg_mul_add(upper, upper * F(1.0 / (energy::kIntervals * energy::kIntervals)), clamped);
         if (single_row) return cubic(gather_cubic_in_row(missing, k), s);
-        const auto [below, above] = gather_cubic_pair(row_pairs, row.offset + k);
-        return mix(cubic(below, s), cubic(above, s), row.fraction);
+        const IndexOf<F> below = row.offset + k;
+        return mix(cubic(gather_cubic(missing, below), s),
+                   cubic(gather_cubic(missing, below + IndexOf<F>(energy::kIntervals)), s), row.fraction);
     }
 
     // c0 + c1 s + c2 s² + c3 s³ (Horner)
@@ -90,7 +89,6 @@ PB_MODEL_INLINE MultipleScatteringLobe<F> multiple_scattering_of(const F* p, con
     const F one(1.0);
     MultipleScatteringLobe<F> ms;
     ms.missing = energy::kMissing[static_cast<int>(model)];
-    ms.row_pairs = energy::kMissingRowPairs[static_cast<int>(model)];
     // r_eff clamped to the tables' [0, 1]
     const F y = min(max(p[kRoughness], F(0.0)), one) * F(energy::kRoughnesses - 1);
     const IndexOf<F> j = min(truncate_to_index(y), IndexOf<F>(energy::kRoughnesses - 2));

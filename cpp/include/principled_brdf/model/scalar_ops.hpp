@@ -44,13 +44,9 @@ template <int intervals>
 inline std::pair<double, double> gather_pair_in_row(const float* row, int i) {
     return {static_cast<double>(row[i]), static_cast<double>(row[i + 1])};
 }
-// a cubic's coefficients (model/energy.hpp) from a row, and a row pair's two cubics (energy_row_pairs.hpp)
-inline std::array<double, energy::kCoefficients> gather_cubic_in_row(const float* row, int k) {
-    const float* c = row + energy::kCoefficients * k;
+// a cubic's coefficients (model/energy.hpp), from a table or from a row laid out alike
+inline std::array<double, energy::kCoefficients> gather_cubic(const float* table, int i) {
+    const float* c = table + energy::kCoefficients * i;
     return {c[0], c[1], c[2], c[3]};
 }
-inline std::pair<std::array<double, energy::kCoefficients>, std::array<double, energy::kCoefficients>> gather_cubic_pair(
-    const float* pairs, int i) {
-    const float* c = pairs + energy::kPairWidth * i;
-    return {{c[0], c[1], c[2], c[3]}, {c[4], c[5], c[6], c[7]}};
-}
+inline std::array<double, energy::kCoefficients> gather_cubic_in_row(const float* row, int k) { return gather_cubic(row, k); }
