@@ -22,25 +22,14 @@ horizon crossing, cos φ = -μ cos 2θh / (sin θv sin 2θh), and y is clustered
 at both ends, where that range opens and closes like a square root; the
 integrand is smooth on every piece (converged to 1e-8 at 64 points a side).
 
-The lookup is a cubic in μ between nodes equally spaced in u = √μ,
-μ_k = (k / INTERVALS)² (a Hermite spline: the nodes' values are the
-quadrature's, the nodes' slopes fitted by least squares to the quadrature at
-three more points inside every interval, equally spaced in u), linear in r
-between the rows. The nodes crowd towards the horizon, where E bends fastest
-at low roughness: 33 of them err 25x less than the 129 of an interpolant
-linear in μ (about 1e-5 for θv up to 87°). The cubic's variable is
-s = μ - μ_k+1 <= 0, exact in float32, so that the float32 lookup differs from
-the float64 one by the cubic's roundings alone (√μ only picks the interval);
-about the upper node, where 1 - E is the smaller as it falls with μ, so that
-Horner's terms do not cancel where 1 - E reaches ~1e-7 towards μ = 1.
-
-E_avg is the exact integral of the table's own interpolant, so that
-∫ f_ms cos θl over the hemisphere is exactly (1 - E(μo)) times the F_avg
-factor at every roughness node, and linear in r between them like the
-lookup: the white furnace then errs only by the interpolation error of E at μo.
+E_avg is the exact integral of the table's own interpolant (linear in μ
+between nodes), so that ∫ f_ms cos θl over the hemisphere is exactly
+(1 - E(μo)) times the F_avg factor at every roughness node, and linear in r
+between them like the lookup: the white furnace then errs only by the
+interpolation error of E at μo.
 
 Usage: python scripts/energy_tables.py [--points 64] [--output-dir DIR]
-(needs the installed package; two processes; about a minute).
+(needs the installed package; two processes; about 8 minutes).
 """
 
 from __future__ import annotations
@@ -50,15 +39,11 @@ import pathlib
 from multiprocessing import Pool
 
 import numpy as np
-import numpy.polynomial as P
 
-# Nodes: μ_k = (k / INTERVALS)², r_j = j / (ROUGHNESSES - 1), at power-of-two spacings:
-# μ_k and r (ROUGHNESSES - 1) are then exact in float32, and so are μ - μ_k+1 and the
-# fractional part of the latter. The quadrature runs at √μ = p / (INTERVALS SAMPLES_PER_INTERVAL)
-# (μ = 0 evaluated at MU_FLOOR): the nodes and three points inside each interval.
-INTERVALS = 32
-SAMPLES_PER_INTERVAL = 4
-COEFFICIENTS = 4  # of a cubic
+# Nodes: μ_k = k / (COSINES - 1) (μ_0 = 0 evaluated at MU_FLOOR), r_j = j / (ROUGHNESSES - 1),
+# at power-of-two spacings: the lookup's μ (COSINES - 1) and r (ROUGHNESSES - 1) are then
+# exact in float32, and so are their fractional parts, the interpolation weights.
+COSINES = 129
 ROUGHNESSES = 65
 MU_FLOOR = 1e-4
 SPAN = 16.0  # the y range either side of ln alpha: the measure beyond is below 1e-13
@@ -126,98 +111,40 @@ def directional_albedo(mu: float, roughness: float, model: str, points: int = 96
     return total
 
 
-def cosine_samples() -> np.ndarray:
-    """μ at the quadrature's points √μ = p / (INTERVALS SAMPLES_PER_INTERVAL)."""
-    return np.linspace(0.0, 1.0, INTERVALS * SAMPLES_PER_INTERVAL + 1) ** 2
-
-
 def cosine_nodes() -> np.ndarray:
-    """μ_k = (k / INTERVALS)², k = 0 .. INTERVALS"""
-    return (np.arange(INTERVALS + 1) / INTERVALS) ** 2
+    return np.linspace(0.0, 1.0, COSINES)
 
 
 def roughness_nodes() -> np.ndarray:
     return np.linspace(0.0, 1.0, ROUGHNESSES)
 
 
-def interval_of(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(k, s = μ - μ_k+1): the lookup's interval, picked by √μ, and the cubic's variable"""
-    k = np.minimum((np.sqrt(mu) * INTERVALS).astype(int), INTERVALS - 1)
-    return k, mu - cosine_nodes()[k + 1]
-
-
-def _hermite_basis(t: np.ndarray) -> np.ndarray:
-    """(h00, h10, h01, h11): value at 0, slope at 0, value at 1, slope at 1."""
-    return np.stack([2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t, -2 * t**3 + 3 * t**2, t**3 - t**2])
-
-
-def cubic_coefficients(samples: np.ndarray) -> np.ndarray:
-    """(INTERVALS, COEFFICIENTS): c with 1 - E = c0 + c1 s + c2 s² + c3 s³ on interval k,
-    s = μ - μ_k+1, from 1 - E at cosine_samples(): the Hermite spline through the nodes'
-    values whose slopes fit all samples by least squares."""
-    mu = cosine_samples()
-    k, s = interval_of(mu)
-    k[-1] = INTERVALS - 1  # (√1 INTERVALS picks interval INTERVALS - 1 already; explicit for the last sample)
-    width = np.diff(cosine_nodes())
-    h00, h10, h01, h11 = _hermite_basis(1.0 + s / width[k])
-    values = samples[::SAMPLES_PER_INTERVAL]
-    design = np.zeros((len(samples), INTERVALS + 1))
-    rows = np.arange(len(samples))
-    design[rows, k] += h10 * width[k]
-    design[rows, k + 1] += h11 * width[k]
-    slopes = np.linalg.lstsq(design, samples - h00 * values[k] - h01 * values[k + 1], rcond=None)[0]
-    y0, y1, m0, m1 = values[:-1], values[1:], slopes[:-1] * width, slopes[1:] * width
-    in_t = np.stack([y0, m0, 3 * (y1 - y0) - 2 * m0 - m1, 2 * (y0 - y1) + m0 + m1], axis=-1)
-    # t = 1 + s / width: the cubic in t composed with that line
-    return np.array([(P.Polynomial(c) (P.Polynomial([1.0, 1.0 / w]))).coef for c, w in zip(in_t, width)])
-
-
-def evaluate_cubic(coefficients: np.ndarray, mu: np.ndarray) -> np.ndarray:
-    """The lookup of one row (float64), μ in [0, 1]."""
-    k, s = interval_of(np.asarray(mu, np.float64))
-    c = coefficients[k].astype(np.float64)
-    return c[..., 0] + s * (c[..., 1] + s * (c[..., 2] + s * c[..., 3]))
-
-
-def average_of_cubic(coefficients: np.ndarray) -> float:
-    """2 ∫0^1 g(μ) μ dμ for g the row's spline, exactly: degree 4 on each interval (3 Gauss points)."""
-    x, w = np.polynomial.legendre.leggauss(3)
-    nodes = cosine_nodes()
-    total = 0.0
-    for k, c in enumerate(coefficients.astype(np.float64)):
-        mu, weight = nodes[k] + (x + 1.0) / 2.0 * (nodes[k + 1] - nodes[k]), w * (nodes[k + 1] - nodes[k]) / 2.0
-        s = mu - nodes[k + 1]
-        total += float(np.sum(weight * mu * (c[0] + s * (c[1] + s * (c[2] + s * c[3])))))
-    return 2.0 * total
+def average_of_linear(mu: np.ndarray, e: np.ndarray) -> float:
+    """2 ∫0^1 E(μ) μ dμ for E linear between the nodes (exact)."""
+    h = np.diff(mu)
+    return float(2.0 * np.sum(h * (e[:-1] * (mu[:-1] / 2 + h / 6) + e[1:] * (mu[:-1] / 2 + h / 3))))
 
 
 def _row(job: tuple[str, float, int]) -> np.ndarray:
     model, roughness, points = job
-    mus = cosine_samples()
+    mus = cosine_nodes().copy()
     mus[0] = MU_FLOOR
     return np.array([directional_albedo(m, roughness, model, points) for m in mus])
 
 
 def tables(points: int = 96, processes: int = 2) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """{model: (coefficients (ROUGHNESSES, INTERVALS, COEFFICIENTS) as float32, 1 - E_avg)}"""
     out = {}
     with Pool(processes) as pool:
         for model in MODELS:
-            e = np.minimum(np.array(pool.map(_row, [(model, float(r), points) for r in roughness_nodes()])), 1.0)
-            rows = np.array([cubic_coefficients(1.0 - row) for row in e]).astype(np.float32)
-            fine = np.linspace(0.0, 1.0, 100_001)
-            lowest = min(float(evaluate_cubic(row.astype(np.float64), fine).min()) for row in rows)
-            assert lowest >= 0.0, f"{model}: the cubic lookup goes below 0 ({lowest})"
-            out[model] = (rows, np.array([average_of_cubic(row) for row in rows]))
+            e = np.array(pool.map(_row, [(model, float(r), points) for r in roughness_nodes()]))
+            e = np.minimum(e, 1.0)
+            average = np.array([average_of_linear(cosine_nodes(), row) for row in e])
+            out[model] = (1.0 - e, 1.0 - average)
     return out
 
 
 def _floats(values: np.ndarray, per_line: int = 8) -> str:
-    def literal(v: float) -> str:  # a float literal needs a point or an exponent before its suffix
-        text = f"{float(np.float32(v)):.9g}"
-        return (text if any(c in text for c in ".e") else text + ".0") + "f"
-
-    items = [literal(v) for v in values.reshape(-1)]
+    items = [f"{float(np.float32(v)):.9g}f" for v in values.reshape(-1)]
     return ",\n".join("        " + ", ".join(items[i:i + per_line]) for i in range(0, len(items), per_line))
 
 
@@ -228,21 +155,18 @@ def write_tables(data: dict[str, tuple[np.ndarray, np.ndarray]], root: pathlib.P
 // Generated by scripts/energy_tables.py; do not edit.
 // The primary specular lobe's missing energy for the multiple-scattering
 // compensation (Kulla & Conty 2017; docs/model.md "Energy compensation"):
-//   1 - E(μ; r_j) = c0 + c1 s + c2 s² + c3 s³,  c = kMissing[model][kCoefficients (j kIntervals + k) + 0..3],
-//   s = μ - μ_k+1 on interval k, μ_k <= μ < μ_k+1, μ_k = (k / kIntervals)² (a cubic Hermite spline),
-//   r_j = j / (kRoughnesses - 1);
-//   kMissingAverage[model][j] = 1 - E_avg(r_j), the exact 2 ∫ E μ dμ of that spline;
-//   model in Model's order (2014, 2012).
+//   kMissing[model][j kCosines + k] = 1 - E(μ_k; r_j),  kMissingAverage[model][j] = 1 - E_avg(r_j),
+//   μ_k = k / (kCosines - 1), r_j = j / (kRoughnesses - 1), model in Model's order (2014, 2012).
+// E_avg is the exact 2 ∫ E μ dμ of the interpolant linear in μ between the nodes.
 // The values are in cpp/src/energy_tables.cpp (so that a new table recompiles one file).
 #pragma once
 
 namespace principled_brdf::energy {{
 
-inline constexpr int kIntervals = {INTERVALS};
-inline constexpr int kCoefficients = {COEFFICIENTS};
+inline constexpr int kCosines = {COSINES};
 inline constexpr int kRoughnesses = {ROUGHNESSES};
 
-extern const float kMissing[2][kRoughnesses * kIntervals * kCoefficients];
+extern const float kMissing[2][kRoughnesses * kCosines];
 extern const float kMissingAverage[2][kRoughnesses];
 
 }}  // namespace principled_brdf::energy
@@ -254,7 +178,7 @@ extern const float kMissingAverage[2][kRoughnesses];
 
 namespace principled_brdf::energy {{
 
-alignas(64) const float kMissing[2][kRoughnesses * kIntervals * kCoefficients] = {{
+alignas(64) const float kMissing[2][kRoughnesses * kCosines] = {{
 {missing}
 }};
 

@@ -23,7 +23,7 @@
 #endif
 
 #include "kernel_api.hpp"
-#include "principled_brdf/energy_tables.hpp"
+#include "principled_brdf/energy_corners.hpp"
 
 namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS {
 

@@ -30,25 +30,20 @@ PB_KERNEL_INLINE RawMaterial load_material(const ParamSlot* params, std::int64_t
 PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shading_of(m.slot); }
 
 // For a uniform material, once per call (model/energy.hpp): the energy
-// table's two rows about its r_eff blended into one, laid out for
-// gather_cubic_in_row, so that a lookup reads one cubic instead of two. The
-// lobe reads `values` from then on.
+// tables' two rows about its r_eff blended into one, so that a lookup reads
+// one pair of nodes instead of two. The lobe reads `values` from then on.
 struct BlendedEnergyRow {
-    alignas(64) float values[energy::kIntervals * energy::kCoefficients];
+    alignas(64) float values[energy::kCosines];
 
     void use_for(MultipleScatteringLobe<Floats>& ms) {
         alignas(64) std::int32_t offset[kLanes];
         alignas(64) float fraction[kLanes];
         ms.row.offset.store_aligned(offset);
         ms.row.fraction.store_aligned(fraction);
-        const float* below = ms.missing + energy::kCoefficients * offset[0];
-        const float* above = below + energy::kCoefficients * energy::kIntervals;
+        const float* below = ms.missing + offset[0];
+        const float* above = below + energy::kCosines;
         const float t = fraction[0];
-        for (int k = 0; k < energy::kIntervals; ++k)
-            for (int c = 0; c < energy::kCoefficients; ++c) {
-                const int at = energy::kCoefficients * k + c;
-                values[cubic_row_position(k, c)] = below[at] * (1.0f - t) + above[at] * t;
-            }
+        for (int k = 0; k < energy::kCosines; ++k) values[k] = below[k] * (1.0f - t) + above[k] * t;
         ms.missing = values;
         ms.single_row = true;
     }

@@ -405,9 +405,6 @@ PB_KERNEL_INLINE Floats log(Floats x) {
 PB_KERNEL_INLINE Floats log(Floats x) { return xsimd::log(x); }
 #endif
 PB_KERNEL_INLINE Floats exp(Floats x) { return xsimd::exp(x); }
-// √x (x >= 0) where it only picks a table's interval (model/energy.hpp, whose
-// spline is continuous across the nodes): one vsqrtps
-PB_KERNEL_INLINE Floats square_root_for_index(Floats x) { return xsimd::sqrt(x); }
 PB_KERNEL_INLINE Floats largest_finite(Floats) { return Floats(std::numeric_limits<float>::max()); }
 // table lookups (model/energy.hpp): the integer part of x >= 0 (truncation), back to
 // floats, and (table[i], table[i + 1]) per lane, the two nodes of a linear interpolation
@@ -489,20 +486,20 @@ template <int intervals>
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) { return gather_pair(row, k); }
 #endif
 
-// The kCoefficients floats of a cubic (model/energy.hpp) at table +
-// kCoefficients i per lane, one 16-byte load a lane. On AVX2 and AVX-512 the
-// loads fill the 128-bit blocks of four registers, block b of register r with
-// lane 4 b + r, and a 4x4 transpose within the blocks leaves coefficient c of
-// lanes 4 b .. 4 b + 3 in block b of register c. No gathers: on
+// The four nodes about each lane's point of a corner table (energy_corners.hpp:
+// row j at k and k + 1, row j + 1 at both), one 16-byte load a lane. On AVX2
+// and AVX-512 the loads fill the 128-bit blocks of four registers, block b of
+// register r with lane 4 b + r, and a 4x4 transpose within the blocks leaves
+// corner c of lanes 4 b .. 4 b + 3 in block b of register c. No gathers: on
 // Zen 4 eight lanes' pairs by vgatherdpd cost about 17 cycles (bench/RESULTS.md).
 #if defined(__AVX512F__)
-PB_KERNEL_INLINE std::array<Floats, 4> gather_cubic(const float* table, Ints at) {
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
     alignas(64) std::int32_t index[kLanes];
     at.store_aligned(index);
-    auto cubic_of = [&](int lane) { return _mm_load_ps(table + energy::kCoefficients * std::int64_t(index[lane])); };
+    auto corners_of = [&](int lane) { return _mm_load_ps(corners + energy::kCorners * std::int64_t(index[lane])); };
     auto blocks = [&](int r) {
-        const __m512 low = _mm512_insertf32x4(_mm512_castps128_ps512(cubic_of(r)), cubic_of(4 + r), 1);
-        return _mm512_insertf32x4(_mm512_insertf32x4(low, cubic_of(8 + r), 2), cubic_of(12 + r), 3);
+        const __m512 low = _mm512_insertf32x4(_mm512_castps128_ps512(corners_of(r)), corners_of(4 + r), 1);
+        return _mm512_insertf32x4(_mm512_insertf32x4(low, corners_of(8 + r), 2), corners_of(12 + r), 3);
     };
     const __m512 r0 = blocks(0), r1 = blocks(1), r2 = blocks(2), r3 = blocks(3);
     const __m512d low01 = _mm512_castps_pd(_mm512_unpacklo_ps(r0, r1)), high01 = _mm512_castps_pd(_mm512_unpackhi_ps(r0, r1));
@@ -511,11 +508,11 @@ PB_KERNEL_INLINE std::array<Floats, 4> gather_cubic(const float* table, Ints at)
             _mm512_castpd_ps(_mm512_unpacklo_pd(high01, high23)), _mm512_castpd_ps(_mm512_unpackhi_pd(high01, high23))};
 }
 #elif defined(__AVX2__)
-PB_KERNEL_INLINE std::array<Floats, 4> gather_cubic(const float* table, Ints at) {
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
     alignas(32) std::int32_t index[kLanes];
     at.store_aligned(index);
-    auto cubic_of = [&](int lane) { return _mm_load_ps(table + energy::kCoefficients * std::int64_t(index[lane])); };
-    auto blocks = [&](int r) { return _mm256_set_m128(cubic_of(4 + r), cubic_of(r)); };
+    auto corners_of = [&](int lane) { return _mm_load_ps(corners + energy::kCorners * std::int64_t(index[lane])); };
+    auto blocks = [&](int r) { return _mm256_set_m128(corners_of(4 + r), corners_of(r)); };
     const __m256 r0 = blocks(0), r1 = blocks(1), r2 = blocks(2), r3 = blocks(3);
     const __m256d low01 = _mm256_castps_pd(_mm256_unpacklo_ps(r0, r1)), high01 = _mm256_castps_pd(_mm256_unpackhi_ps(r0, r1));
     const __m256d low23 = _mm256_castps_pd(_mm256_unpacklo_ps(r2, r3)), high23 = _mm256_castps_pd(_mm256_unpackhi_ps(r2, r3));
@@ -523,36 +520,15 @@ PB_KERNEL_INLINE std::array<Floats, 4> gather_cubic(const float* table, Ints at)
             _mm256_castpd_ps(_mm256_unpacklo_pd(high01, high23)), _mm256_castpd_ps(_mm256_unpackhi_pd(high01, high23))};
 }
 #else
-PB_KERNEL_INLINE std::array<Floats, 4> gather_cubic(const float* table, Ints at) {
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
     alignas(64) std::int32_t index[kLanes];
-    alignas(64) float coefficient[4][kLanes];
+    alignas(64) float corner[4][kLanes];
     at.store_aligned(index);
     for (std::int64_t j = 0; j < kLanes; ++j)
-        for (int c = 0; c < 4; ++c) coefficient[c][j] = table[energy::kCoefficients * index[j] + c];
-    return {Floats::load_aligned(coefficient[0]), Floats::load_aligned(coefficient[1]),
-            Floats::load_aligned(coefficient[2]), Floats::load_aligned(coefficient[3])};
+        for (int c = 0; c < 4; ++c) corner[c][j] = corners[energy::kCorners * index[j] + c];
+    return {Floats::load_aligned(corner[0]), Floats::load_aligned(corner[1]), Floats::load_aligned(corner[2]),
+            Floats::load_aligned(corner[3])};
 }
-#endif
-
-// A cubic of a row that every lane shares (a uniform material's blended row,
-// BlendedEnergyRow), coefficient c of interval k at row[cubic_row_position(k, c)].
-// On AVX-512 the row lies by coefficient, each of its kIntervals = 32 values
-// one two-register permute (vpermt2ps reads index bits 0-4: no memory read by
-// index); elsewhere by interval, as the table, for gather_cubic.
-#if defined(__AVX512F__)
-constexpr int cubic_row_position(int k, int c) { return c * energy::kIntervals + k; }
-
-PB_KERNEL_INLINE std::array<Floats, 4> gather_cubic_in_row(const float* row, Ints k) {
-    static_assert(energy::kIntervals == 32 && energy::kCoefficients == 4, "a coefficient's row is one permute");
-    std::array<Floats, 4> c;
-    for (int q = 0; q < 4; ++q)
-        c[q] = _mm512_permutex2var_ps(_mm512_load_ps(row + 32 * q), k, _mm512_load_ps(row + 32 * q + 16));
-    return c;
-}
-#else
-constexpr int cubic_row_position(int k, int c) { return k * energy::kCoefficients + c; }
-
-PB_KERNEL_INLINE std::array<Floats, 4> gather_cubic_in_row(const float* row, Ints k) { return gather_cubic(row, k); }
 #endif
 
 // (sin 2πu, cos 2πu) for u in [0, 1] by the double angle, without quadrant

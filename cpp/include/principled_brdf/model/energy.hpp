@@ -1,8 +1,8 @@
 // Part of the model (docs/model.md "Energy compensation"): the multiple-
 // scattering lobe of the primary specular (Kulla & Conty 2017), over a number
 // type F. The tables of principled_brdf/energy_tables.hpp hold the lobe's
-// missing energy 1 - E(μ; r), as a cubic spline in μ per row, and 1 - E_avg(r) per
-// model (2014 and 2012 differ in Gs); with F_avg = (20 Cspec0 + 1) / 21 (the hemispherical average of
+// missing energy 1 - E(μ; r) and 1 - E_avg(r) per model (2014 and 2012 differ
+// in Gs); with F_avg = (20 Cspec0 + 1) / 21 (the hemispherical average of
 // Schlick's Fresnel with F90 = 1, exact) per channel,
 //   f_ms = F_avg² E_avg / (1 - F_avg (1 - E_avg)) · (1 - E(μl)) (1 - E(μo)) / (π (1 - E_avg))
 // (Kulla & Conty 2017, "Revisiting Physically Based Shading at Imageworks":
@@ -13,24 +13,19 @@
 // Sampling draws it by the cosine lobe, its weight the lobe's albedo at wo,
 //   ∫ f_ms cos θl dωl = lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))) (1 - E(μo))
 // (since 2 ∫ (1 - E(μ)) μ dμ = 1 - E_avg), added to the cosine lobe's w0.
-// The ops of the number type provide square_root_for_index, truncate_to_index
-// (x >= 0), index_to_real, gather_pair_in_row ((row[index], row[index + 1])
-// per lane from a row of intervals + 1 nodes that every lane shares: the
-// table of 1 - E_avg), gather_cubic (the kCoefficients floats of a cubic per
-// lane, from table + kCoefficients index) and gather_cubic_in_row (a cubic of
-// one blended row that every lane shares, in the layout of
-// cubic_row_position: the AVX-512 kernel reads it by register permutes).
+// The ops of the number type provide truncate_to_index (x >= 0), index_to_real,
+// gather_pair_in_row ((row[index], row[index + 1]) per lane from a row of
+// intervals + 1 nodes that every lane shares, a blended row of 1 - E or the
+// table of 1 - E_avg, which the AVX-512 kernel reads by register permutes
+// instead of gathers) and gather_corners (the four nodes about a point of
+// the 1 - E table, energy_corners.hpp).
 #pragma once  // (per namespace that includes the model)
 
-// The nodes μ_k = (k / kIntervals)² and r_j = j / (kRoughnesses - 1) are at
-// power-of-two spacings, so that μ_k, s = μ - μ_k+1 and the fraction of
-// r (kRoughnesses - 1) are exact in float32: the float32 lookup then differs
-// from the float64 one by the cubic's and the blend's roundings alone, also
-// where 1 - E is ~1e-7 and falls steeply towards μ = 1 (√μ, which is rounded,
-// only picks the interval, and the spline is continuous across the nodes).
-// About the upper node, where 1 - E, which falls with μ, is the smaller:
-// Horner's terms then do not cancel.
-static_assert((energy::kIntervals & (energy::kIntervals - 1)) == 0, "kIntervals is a power of two");
+// The nodes' spacings are powers of two, so that μ (kCosines - 1) and
+// r (kRoughnesses - 1) are exact in float32 and so are the interpolation weights:
+// the float32 lookup then differs from the float64 one by the blend's roundings
+// alone, also where 1 - E is small and steep between nodes.
+static_assert(((energy::kCosines - 1) & (energy::kCosines - 2)) == 0, "kCosines - 1 is a power of two");
 static_assert(((energy::kRoughnesses - 1) & (energy::kRoughnesses - 2)) == 0, "kRoughnesses - 1 is a power of two");
 
 template <class F>
@@ -39,34 +34,30 @@ using IndexOf = decltype(truncate_to_index(F()));
 // Where a material's roughness falls between the tables' rows.
 template <class F>
 struct EnergyRow {
-    IndexOf<F> offset;  // j kIntervals: the first cubic of the row below r_eff
+    IndexOf<F> offset;  // j kCosines: the row below r_eff
     F fraction;         // r_eff's position between rows j and j + 1
 };
 
 template <class F>
 struct MultipleScatteringLobe {
-    const float* missing;  // the model's table of cubics, or one row of it (single_row)
+    const float* missing;  // the model's 1 - E table, or one row of it (single_row)
+    const float* corners;  // the same table by corners (energy_corners.hpp), which the lookup reads otherwise
     EnergyRow<F> row;
-    bool single_row = false;  // missing is the row at r_eff already, blended between the rows (a uniform material)
+    bool single_row = false;  // missing is 1 - E at r_eff already, blended between the rows (a uniform material)
     Rgb<F> color;          // F_avg² E_avg / (1 - F_avg (1 - E_avg)) / (π (1 - E_avg))
     F albedo_scale;        // lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))): w3 = albedo_scale (1 - E(μo))
 
-    // 1 - E(μ) at r_eff: the cubic of interval k, μ_k <= μ < μ_k+1, at s = μ - μ_k+1; linear in r between the rows
+    // 1 - E(μ) at r_eff: bilinear, linear in μ between the nodes μ_k = k / (kCosines - 1)
     PB_MODEL_INLINE F missing_energy(F mu) const {
-        const F clamped = min(max(mu, F(0.0)), F(1.0));
-        const IndexOf<F> k =
-            min(truncate_to_index(square_root_for_index(clamped) * F(energy::kIntervals)), IndexOf<F>(energy::kIntervals - 1));
-        const F upper = index_to_real(k) + F(1.0);
-        const F s = neg_mul_add(upper, upper * F(1.0 / (energy::kIntervals * energy::kIntervals)), clamped);
-        if (single_row) return cubic(gather_cubic_in_row(missing, k), s);
-        const IndexOf<F> below = row.offset + k;
-        return mix(cubic(gather_cubic(missing, below), s),
-                   cubic(gather_cubic(missing, below + IndexOf<F>(energy::kIntervals)), s), row.fraction);
-    }
-
-    // c0 + c1 s + c2 s² + c3 s³ (Horner)
-    static PB_MODEL_INLINE F cubic(const std::array<F, energy::kCoefficients>& c, F s) {
-        return mul_add(mul_add(mul_add(c[3], s, c[2]), s, c[1]), s, c[0]);
+        const F x = min(max(mu, F(0.0)), F(1.0)) * F(energy::kCosines - 1);
+        const IndexOf<F> k = min(truncate_to_index(x), IndexOf<F>(energy::kCosines - 2));
+        const F t = x - index_to_real(k);
+        if (single_row) {
+            const auto [at_k, at_next] = gather_pair_in_row<energy::kCosines - 1>(missing, k);
+            return mix(at_k, at_next, t);
+        }
+        const auto [below_k, below_next, above_k, above_next] = gather_corners(corners, row.offset + k);
+        return mix(mix(below_k, below_next, t), mix(above_k, above_next, t), row.fraction);
     }
 
     // the scalar factor of color: (1 - E(μl)) (1 - E(μo)), 1 - E(μo) given
@@ -89,10 +80,11 @@ PB_MODEL_INLINE MultipleScatteringLobe<F> multiple_scattering_of(const F* p, con
     const F one(1.0);
     MultipleScatteringLobe<F> ms;
     ms.missing = energy::kMissing[static_cast<int>(model)];
+    ms.corners = energy::kMissingCorners[static_cast<int>(model)];
     // r_eff clamped to the tables' [0, 1]
     const F y = min(max(p[kRoughness], F(0.0)), one) * F(energy::kRoughnesses - 1);
     const IndexOf<F> j = min(truncate_to_index(y), IndexOf<F>(energy::kRoughnesses - 2));
-    ms.row = {truncate_to_index(index_to_real(j) * F(energy::kIntervals)), y - index_to_real(j)};
+    ms.row = {truncate_to_index(index_to_real(j) * F(energy::kCosines)), y - index_to_real(j)};
     const float* average = energy::kMissingAverage[static_cast<int>(model)];
     const auto [average_j, average_next] = gather_pair_in_row<energy::kRoughnesses - 1>(average, j);
     const F missing_average = mix(average_j, average_next, ms.row.fraction);

@@ -9,7 +9,7 @@
 #include <limits>
 #include <utility>
 
-#include "principled_brdf/energy_tables.hpp"
+#include "principled_brdf/energy_corners.hpp"
 #include "principled_brdf/params.hpp"
 
 namespace principled_brdf::f64 {

@@ -13,7 +13,6 @@ inline double neg_mul_add(double a, double b, double c) { return c - a * b; }
 inline double reciprocal(double x) { return 1.0 / x; }
 inline double reciprocal_sqrt(double x) { return 1.0 / std::sqrt(x); }
 inline double square_root(double x) { return std::sqrt(std::max(x, 0.0)); }
-inline double square_root_for_index(double x) { return std::sqrt(x); }
 inline double select(bool mask, double a, double b) { return mask ? a : b; }
 // as x86's minps and maxps: the second operand where either is NaN
 inline double min(double a, double b) { return a < b ? a : b; }
@@ -44,9 +43,8 @@ template <int intervals>
 inline std::pair<double, double> gather_pair_in_row(const float* row, int i) {
     return {static_cast<double>(row[i]), static_cast<double>(row[i + 1])};
 }
-// a cubic's coefficients (model/energy.hpp), from a table or from a row laid out alike
-inline std::array<double, energy::kCoefficients> gather_cubic(const float* table, int i) {
-    const float* c = table + energy::kCoefficients * i;
+// the four nodes about a point of a corner table (energy_corners.hpp)
+inline std::array<double, 4> gather_corners(const float* corners, int i) {
+    const float* c = corners + energy::kCorners * i;
     return {c[0], c[1], c[2], c[3]};
 }
-inline std::array<double, energy::kCoefficients> gather_cubic_in_row(const float* row, int k) { return gather_cubic(row, k); }
