@@ -321,6 +321,30 @@ def test_simd_matches_reference(accuracy_case, isa):
 
 
 @pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("regime", REGIMES)
+def test_simd_matches_reference_for_uniform_materials(isa, regime):
+    # a uniform material's kernels read one row blended per call (by register permutes
+    # on AVX-512), not the table's two rows per lane: the presets, and white metals at
+    # roughnesses on, near and between the rows, the low ones where 1 - E is steepest
+    min_cos, grazing, percentile_bound, max_bound = REGIMES[regime]
+    rng = seeded_rng("energy-compensation-uniform", isa, regime)
+    wi, wo = random_direction_pairs(rng, 20_000, min_cos=min_cos, grazing_fraction=grazing)
+    wi, wo = wi.astype(np.float32), wo.astype(np.float32)
+    materials = [pb.presets.get(name) for name in pb.presets.names()]
+    materials += [pb.Material(**WHITE, roughness=r) for r in (0.0, 0.01, 1 / 64, 0.03, 0.0781, 0.15, 0.5, 0.77, 1.0)]
+    for model in MODELS:
+        for material in materials:
+            options = dict(model=model, energy_compensation=True)
+            ref = pb.reference.eval_lobes(material, wi.astype(np.float64), wo.astype(np.float64), **options)
+            got = pb.eval_lobes(material, wi, wo, isa=isa, **options)
+            for name, simd, expected in (("multiple_scattering", got.multiple_scattering, ref.multiple_scattering),
+                                         ("total", got.total(), ref.total())):
+                errors = relative_errors(simd, expected)
+                assert np.percentile(errors, 99.99) <= percentile_bound, (model, material, name, np.percentile(errors, 99.99))
+                assert errors.max() <= max_bound, (model, material, name, errors.max())
+
+
+@pytest.mark.parametrize("isa", ISAS)
 @pytest.mark.parametrize("model", MODELS)
 def test_simd_sample_matches_reference(isa, model):
     rng = seeded_rng("energy-compensation-sample", isa, model)
