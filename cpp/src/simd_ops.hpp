@@ -385,8 +385,8 @@ constexpr float kLn2High = 0.693145751953125f, kLn2Low = 1.42860682030941723e-6f
 // getexp and getmant (zeros, subnormals, infinities and NaN included: ln 0 is
 // -inf), and ln m = 2 atanh(s) = 2 s (1 + s²/3 + s⁴/5 + s⁶/7 + s⁸/9) with
 // s = (m - 1) / (m + 1), |s| <= 0.2 (the series' remainder < 1e-8 relative).
-// About 20 instructions: the per-element loops, which take it of every batch's
-// clearcoat a², shrank by 32 against xsimd's log (bench/RESULTS.md, run 12).
+// About 20 instructions, fewer than xsimd's log: the per-element loops take it
+// of every batch's clearcoat a².
 PB_KERNEL_INLINE Floats log(Floats x) {
     const __m512 m = _mm512_getmant_ps(x, _MM_MANT_NORM_p75_1p5, _MM_MANT_SIGN_nan);
     const __m512 one = _mm512_set1_ps(1.0f);
