@@ -22,14 +22,24 @@ horizon crossing, cos φ = -μ cos 2θh / (sin θv sin 2θh), and y is clustered
 at both ends, where that range opens and closes like a square root; the
 integrand is smooth on every piece (converged to 1e-8 at 64 points a side).
 
-E_avg is the exact integral of the table's own interpolant (linear in μ
-between nodes), so that ∫ f_ms cos θl over the hemisphere is exactly
+The lookup is linear in μ on intervals spaced geometrically in ν = μ + 1/8,
+16 an octave of ν from 1/8: μ steps of 1/128 below μ = 1/8, 1/64 to 3/8, 1/32
+to 7/8, then 1/16 to μ = 1, which starts an interval of its own (slope 0).
+The interval of ν and its bounds are ν's float32 exponent and top 4 mantissa
+bits, so a lookup needs no division and μ less a bound is exact. Each
+interval stores 1 - E at its end and the slope from its start: the line is
+written from the end because 1 - E falls towards 0 as μ -> 1 at low
+roughness, where from the start it would be the difference of two nearly
+equal terms, rounded relative to them rather than to itself.
+
+E_avg is the exact integral of that interpolant (from the stored float32
+values and slopes), so that ∫ f_ms cos θl over the hemisphere is exactly
 (1 - E(μo)) times the F_avg factor at every roughness node, and linear in r
 between them like the lookup: the white furnace then errs only by the
 interpolation error of E at μo.
 
 Usage: python scripts/energy_tables.py [--points 64] [--output-dir DIR]
-(needs the installed package; two processes; about 8 minutes).
+(needs the installed package; two processes; under a minute).
 """
 
 from __future__ import annotations
@@ -40,12 +50,14 @@ from multiprocessing import Pool
 
 import numpy as np
 
-# Nodes: μ_k = k / (COSINES - 1) (μ_0 = 0 evaluated at MU_FLOOR), r_j = j / (ROUGHNESSES - 1),
-# at power-of-two spacings: the lookup's μ (COSINES - 1) and r (ROUGHNESSES - 1) are then
-# exact in float32, and so are their fractional parts, the interpolation weights.
-COSINES = 129
+# Nodes in ν = μ + OFFSET: ν_b = 2^(b // 16 - 3) (1 + (b % 16) / 16), each an interval's
+# start, the last at μ = 1 (ν = 1 + OFFSET, slope 0); roughness rows
+# r_j = j / (ROUGHNESSES - 1), so that r (ROUGHNESSES - 1) and its fraction are exact in float32.
+INTERVALS = 51  # 3 octaves of ν from 1/8, [1, 1 + 1/8], then μ = 1
+PER_OCTAVE = 16
+OFFSET = 2.0 ** -3
 ROUGHNESSES = 65
-MU_FLOOR = 1e-4
+MU_FLOOR = 1e-6  # μ = 0 evaluated here (the quadrature degenerates at 0; E's limit is reached)
 SPAN = 16.0  # the y range either side of ln alpha: the measure beyond is below 1e-13
 MODELS = ("disney2014", "disney2012")
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -111,18 +123,51 @@ def directional_albedo(mu: float, roughness: float, model: str, points: int = 96
     return total
 
 
+def interval_starts() -> np.ndarray:
+    """ν_b, the start of each interval of ν."""
+    b = np.arange(INTERVALS)
+    return 2.0 ** (b // PER_OCTAVE - 3.0) * (1.0 + (b % PER_OCTAVE) / PER_OCTAVE)
+
+
+def cosine_of(nu: np.ndarray) -> np.ndarray:
+    return nu - OFFSET
+
+
 def cosine_nodes() -> np.ndarray:
-    return np.linspace(0.0, 1.0, COSINES)
+    """The μ at which E is computed: every interval's start, the last μ = 1."""
+    return cosine_of(interval_starts())
 
 
 def roughness_nodes() -> np.ndarray:
     return np.linspace(0.0, 1.0, ROUGHNESSES)
 
 
-def average_of_linear(mu: np.ndarray, e: np.ndarray) -> float:
-    """2 ∫0^1 E(μ) μ dμ for E linear between the nodes (exact)."""
-    h = np.diff(mu)
-    return float(2.0 * np.sum(h * (e[:-1] * (mu[:-1] / 2 + h / 6) + e[1:] * (mu[:-1] / 2 + h / 3))))
+def interval_ends() -> np.ndarray:
+    """μ at the end of each interval (the next one's start; 1 + 1/16 for the last)."""
+    return np.append(cosine_nodes()[1:], 1.0 + 1.0 / PER_OCTAVE)
+
+
+def row_of(missing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per interval, 1 - E at its end and the slope from its start (the last: μ = 1, slope 0)."""
+    return np.append(missing[1:], missing[-1]), np.append(np.diff(missing) / np.diff(cosine_nodes()), 0.0)
+
+
+def lookup(values: np.ndarray, slopes: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """1 - E(μ) of one row from its intervals' values and slopes, as the library reads it."""
+    mu = np.clip(mu, 0.0, 1.0)
+    b = np.clip(np.searchsorted(interval_starts(), mu + OFFSET, side="right") - 1, 0, INTERVALS - 1)
+    return values[b] + (mu - interval_ends()[b]) * slopes[b]
+
+
+def average_of_lookup(values: np.ndarray, slopes: np.ndarray) -> float:
+    """2 ∫0^1 (1 - E(μ)) μ dμ of lookup() (exact: 2-point Gauss-Legendre on each
+    interval, where the integrand is quadratic)."""
+    edges = cosine_nodes()
+    x, w = np.polynomial.legendre.leggauss(2)
+    half = np.diff(edges)[:, None] / 2.0
+    mu = edges[:-1, None] + (x[None, :] + 1.0) * half
+    missing = values[:-1, None] + (mu - edges[1:, None]) * slopes[:-1, None]
+    return float(2.0 * np.sum(missing * mu * w[None, :] * half))
 
 
 def _row(job: tuple[str, float, int]) -> np.ndarray:
@@ -133,18 +178,27 @@ def _row(job: tuple[str, float, int]) -> np.ndarray:
 
 
 def tables(points: int = 96, processes: int = 2) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Per model: (value, slope) of 1 - E per row and interval as float32, and 1 - E_avg per row."""
     out = {}
     with Pool(processes) as pool:
         for model in MODELS:
             e = np.array(pool.map(_row, [(model, float(r), points) for r in roughness_nodes()]))
-            e = np.minimum(e, 1.0)
-            average = np.array([average_of_linear(cosine_nodes(), row) for row in e])
-            out[model] = (1.0 - e, 1.0 - average)
+            missing = np.maximum(1.0 - e, 0.0)
+            rows = [row_of(row) for row in missing]
+            values = np.array([v for v, _ in rows]).astype(np.float32)
+            slopes = np.array([s for _, s in rows]).astype(np.float32)
+            average = np.array([average_of_lookup(v.astype(np.float64), s.astype(np.float64))
+                                for v, s in zip(values, slopes)])
+            out[model] = (np.stack([values, slopes], axis=-1), average)
     return out
 
 
 def _floats(values: np.ndarray, per_line: int = 8) -> str:
-    items = [f"{float(np.float32(v)):.9g}f" for v in values.reshape(-1)]
+    def literal(v: float) -> str:  # a C++ float literal: "0" needs its point
+        text = f"{float(np.float32(v)):.9g}"
+        return (text if any(c in text for c in ".e") else text + ".0") + "f"
+
+    items = [literal(v) for v in values.reshape(-1)]
     return ",\n".join("        " + ", ".join(items[i:i + per_line]) for i in range(0, len(items), per_line))
 
 
@@ -155,18 +209,24 @@ def write_tables(data: dict[str, tuple[np.ndarray, np.ndarray]], root: pathlib.P
 // Generated by scripts/energy_tables.py; do not edit.
 // The primary specular lobe's missing energy for the multiple-scattering
 // compensation (Kulla & Conty 2017; docs/model.md "Energy compensation"):
-//   kMissing[model][j kCosines + k] = 1 - E(μ_k; r_j),  kMissingAverage[model][j] = 1 - E_avg(r_j),
-//   μ_k = k / (kCosines - 1), r_j = j / (kRoughnesses - 1), model in Model's order (2014, 2012).
-// E_avg is the exact 2 ∫ E μ dμ of the interpolant linear in μ between the nodes.
+//   kMissing[model][2 (j kIntervals + b)] = 1 - E(μ_b+1; r_j), and [... + 1] the slope in μ from μ_b,
+//   kMissingAverage[model][j] = 1 - E_avg(r_j),
+// on intervals b of ν = μ + kCosineOffset starting at ν_b = 2^(b / 16 - 3) (1 + (b % 16) / 16)
+// (16 an octave; μ_b = ν_b - kCosineOffset; the last is μ = 1 alone, slope 0),
+// r_j = j / (kRoughnesses - 1), model in Model's order (2014, 2012): within interval b,
+// 1 - E = value + (μ - μ_b+1) slope, from its end (μ_51 = 1 + 1/16).
+// E_avg is the exact 2 ∫ E μ dμ of that interpolant.
 // The values are in cpp/src/energy_tables.cpp (so that a new table recompiles one file).
 #pragma once
 
 namespace principled_brdf::energy {{
 
-inline constexpr int kCosines = {COSINES};
+inline constexpr int kIntervals = {INTERVALS};
+inline constexpr int kIntervalsPerOctave = {PER_OCTAVE};
+inline constexpr float kCosineOffset = {OFFSET!r}f;  // 1/8
 inline constexpr int kRoughnesses = {ROUGHNESSES};
 
-extern const float kMissing[2][kRoughnesses * kCosines];
+extern const float kMissing[2][kRoughnesses * kIntervals * 2];
 extern const float kMissingAverage[2][kRoughnesses];
 
 }}  // namespace principled_brdf::energy
@@ -178,7 +238,7 @@ extern const float kMissingAverage[2][kRoughnesses];
 
 namespace principled_brdf::energy {{
 
-alignas(64) const float kMissing[2][kRoughnesses * kCosines] = {{
+alignas(64) const float kMissing[2][kRoughnesses * kIntervals * 2] = {{
 {missing}
 }};
 

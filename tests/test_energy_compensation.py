@@ -48,7 +48,9 @@ def _header_array(name: str) -> np.ndarray:
     return np.array([float(x.rstrip("f")) for x in re.findall(r"[-+0-9.e]+f", body)])
 
 
-MISSING = _header_array("kMissing[2][kRoughnesses * kCosines] =").reshape(2, energy_tables.ROUGHNESSES, energy_tables.COSINES)
+# (value, slope) of 1 - E per model, roughness row and interval of ν
+MISSING = _header_array("kMissing[2][kRoughnesses * kIntervals * 2] =").reshape(
+    2, energy_tables.ROUGHNESSES, energy_tables.INTERVALS, 2)
 MISSING_AVERAGE = _header_array("kMissingAverage[2][kRoughnesses] =").reshape(2, energy_tables.ROUGHNESSES)
 
 
@@ -64,8 +66,8 @@ def gauss(n: int, a: float, b: float):
 
 def multiple_scattering_albedo(material: pb.Material, wo: np.ndarray, model: str) -> np.ndarray:
     """∫ f_ms cos θl dωl by quadrature: f_ms depends on cos θl alone, linearly
-    between the tables' nodes, so 4 Gauss points per node interval are exact."""
-    edges = np.linspace(0.0, 1.0, energy_tables.COSINES)
+    within the tables' intervals, so 4 Gauss points an interval are exact."""
+    edges = energy_tables.cosine_nodes()
     mus, weights = zip(*(gauss(4, a, b) for a, b in zip(edges[:-1], edges[1:])))
     mu, w = np.concatenate(mus), np.concatenate(weights)
     wi = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=-1)
@@ -93,21 +95,32 @@ def independent_albedo(mu: float, roughness: float, model: str, n_theta: int = 4
 @pytest.mark.parametrize("model", MODELS)
 def test_table_entries_match_an_independent_quadrature(model):
     m = MODELS.index(model)
-    mus = np.linspace(0, 1, energy_tables.COSINES)
+    mus = energy_tables.cosine_nodes()
     rs = np.linspace(0, 1, energy_tables.ROUGHNESSES)
     for j in (40, 63):  # rough enough for the plain product rule over wi
-        for k in (30, 70):
-            expected = 1 - independent_albedo(mus[k], rs[j], model)
-            assert abs(MISSING[m, j, k] - expected) <= 2e-4, (model, rs[j], mus[k], MISSING[m, j, k], expected)
+        for b in (21, 40):  # μ 0.203 and 0.625, the ends of intervals b - 1
+            expected = 1 - independent_albedo(mus[b], rs[j], model)
+            stored = MISSING[m, j, b - 1, 0]
+            assert abs(stored - expected) <= 2e-4, (model, rs[j], mus[b], stored, expected)
 
 
 @pytest.mark.parametrize("model", MODELS)
-def test_table_average_is_the_interpolants_integral(model):
+def test_table_is_continuous_and_its_average_the_integral(model):
     m = MODELS.index(model)
-    mus = np.linspace(0, 1, energy_tables.COSINES)
+    edges = energy_tables.cosine_nodes()
+    x, w = np.polynomial.legendre.leggauss(3)
     for j in range(energy_tables.ROUGHNESSES):
-        expected = 1 - energy_tables.average_of_linear(mus, 1 - MISSING[m, j].astype(np.float64))
-        assert abs(MISSING_AVERAGE[m, j] - expected) <= 1e-6
+        values, slopes = MISSING[m, j, :, 0].astype(np.float64), MISSING[m, j, :, 1].astype(np.float64)
+        # each interval's line (from its end) starts where the one before ends, to the
+        # float32 roundings; the last, μ = 1 alone, is flat
+        line_starts = values[:-1] - np.diff(edges) * slopes[:-1]
+        np.testing.assert_allclose(line_starts[1:], values[:-2], rtol=1e-6, atol=1e-7)
+        assert values[-1] == values[-2] and slopes[-1] == 0
+        # 1 - E_avg = 2 ∫ (1 - E) μ dμ of the lookup, by Gauss points within each interval
+        mu = edges[:-1, None] + (x[None, :] + 1) * np.diff(edges)[:, None] / 2
+        missing = energy_tables.lookup(values, slopes, mu)
+        expected = float(np.sum(2 * missing * mu * w[None, :] * np.diff(edges)[:, None] / 2))
+        assert abs(MISSING_AVERAGE[m, j] - expected) <= 1e-6, (model, j, MISSING_AVERAGE[m, j], expected)
 
 
 def test_generator_quadrature_is_converged():

@@ -6,16 +6,13 @@ namespace principled_brdf::energy {
 namespace {
 
 struct CornerTables {
-    alignas(64) float values[2][kRoughnesses * kCosines * kCorners] = {};
+    alignas(64) float values[2][kRoughnesses * kIntervals * kCorners] = {};
 
     CornerTables() {
         for (int model = 0; model < 2; ++model)
-            for (int j = 0; j + 1 < kRoughnesses; ++j)
-                for (int k = 0; k + 1 < kCosines; ++k) {
-                    const int at = j * kCosines + k;
-                    for (int c = 0; c < kCorners; ++c)
-                        values[model][kCorners * at + c] = kMissing[model][at + (c & 1) + (c >> 1) * kCosines];
-                }
+            for (int at = 0; at < (kRoughnesses - 1) * kIntervals; ++at)
+                for (int c = 0; c < kCorners; ++c)
+                    values[model][kCorners * at + c] = kMissing[model][2 * at + (c & 1) + (c >> 1) * 2 * kIntervals];
     }
 };
 

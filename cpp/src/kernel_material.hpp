@@ -30,20 +30,28 @@ PB_KERNEL_INLINE RawMaterial load_material(const ParamSlot* params, std::int64_t
 PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shading_of(m.slot); }
 
 // For a uniform material, once per call (model/energy.hpp): the energy
-// tables' two rows about its r_eff blended into one, so that a lookup reads
-// one pair of nodes instead of two. The lobe reads `values` from then on.
+// table's two rows about its r_eff blended into one (values and slopes, so
+// linear in r like the lookup of two rows), so that a lookup reads one
+// interval instead of two. The lobe reads `values` from then on.
 struct BlendedEnergyRow {
-    alignas(64) float values[energy::kCosines];
+    alignas(64) float values[2 * 64];  // (the AVX-512 permutes read 64 values, then 64 slopes)
 
     void use_for(MultipleScatteringLobe<Floats>& ms) {
         alignas(64) std::int32_t offset[kLanes];
         alignas(64) float fraction[kLanes];
         ms.row.offset.store_aligned(offset);
         ms.row.fraction.store_aligned(fraction);
-        const float* below = ms.missing + offset[0];
-        const float* above = below + energy::kCosines;
+        const float* below = ms.missing + 2 * offset[0];  // (value, slope) an interval
+        const float* above = below + 2 * energy::kIntervals;
         const float t = fraction[0];
-        for (int k = 0; k < energy::kCosines; ++k) values[k] = below[k] * (1.0f - t) + above[k] * t;
+        auto blend = [&](int at) { return below[at] * (1.0f - t) + above[at] * t; };
+        for (int b = energy::kIntervals; b < 64; ++b) values[b] = values[64 + b] = 0.0f;  // (never read)
+        for (int b = 0; b < energy::kIntervals; ++b) {
+            const int value_at = kRowSlopesAfterValues ? b : 2 * b;
+            const int slope_at = kRowSlopesAfterValues ? 64 + b : 2 * b + 1;
+            values[value_at] = blend(2 * b);
+            values[slope_at] = blend(2 * b + 1);
+        }
         ms.missing = values;
         ms.single_row = true;
     }

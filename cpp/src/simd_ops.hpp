@@ -411,44 +411,48 @@ PB_KERNEL_INLINE Floats largest_finite(Floats) { return Floats(std::numeric_limi
 PB_KERNEL_INLINE Ints truncate_to_index(Floats x) { return xsimd::to_int(x); }
 PB_KERNEL_INLINE Floats index_to_real(Ints i) { return xsimd::to_float(i); }
 PB_KERNEL_INLINE Ints min(Ints a, Ints b) { return xsimd::min(a, b); }
+// the interval of ν >= 1/8, 16 an octave, and its end: ν's exponent and top four mantissa bits, plus one
+PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
+    constexpr int shift = 23 - 4;
+    constexpr std::int32_t first = 0x3E000000 >> shift;  // 1/8's bits
+    static_assert(energy::kCosineOffset == 0.125f, "the first interval starts at 1/8");
+    const Ints bits = xsimd::bitwise_cast<Ints>(nu);
+    return {(bits >> shift) - Ints(first), xsimd::bitwise_cast<Floats>((bits & Ints(-(1 << shift))) + Ints(1 << shift))};
+}
 // (the intrinsics: xsimd 8.1's batch::gather for fma3<avx2> falls back to an out-of-line element loop)
 #if defined(__AVX512F__)
-// nodes[k] per lane for k in [0, 32 parts), from the 32 nodes of k's part: a
-// two-register permute a part (index bits 0-4), each written only to the
-// lanes whose k lies in its part (mask2: the other lanes keep what they hold,
-// at first the index itself), so that no blend is needed. No gather: a row
-// that every lane shares fits in a few registers.
-template <int parts>
-struct Parts {
-    __mmask16 of[parts];  // lanes whose k lies in [32 p, 32 p + 32)
-};
+// nodes[k] per lane for k in [0, 64): a two-register permute for each half of
+// the nodes (index bits 0-4), each written only to the lanes whose k lies in
+// its half (mask2: the other lanes keep what they hold, at first the index
+// itself), so that no blend is needed. No gather: a row that every lane
+// shares fits in four registers.
+PB_KERNEL_INLINE __mmask16 upper_half(__m512i k) { return _mm512_test_epi32_mask(k, _mm512_set1_epi32(32)); }
 
-template <int parts>
-PB_KERNEL_INLINE Parts<parts> parts_of(__m512i k) {
-    const __m512i part = _mm512_srli_epi32(k, 5);
-    Parts<parts> lanes;
-    for (int p = 0; p < parts; ++p) lanes.of[p] = _mm512_cmpeq_epi32_mask(part, _mm512_set1_epi32(p));
-    return lanes;
+PB_KERNEL_INLINE Floats permute_lookup(const float* nodes, __m512i k, __mmask16 upper) {
+    const __m512 lower = _mm512_mask2_permutex2var_ps(_mm512_loadu_ps(nodes), k, _knot_mask16(upper), _mm512_loadu_ps(nodes + 16));
+    return _mm512_mask2_permutex2var_ps(_mm512_loadu_ps(nodes + 32), _mm512_castps_si512(lower), upper,
+                                        _mm512_loadu_ps(nodes + 48));
 }
 
-template <int parts>
-PB_KERNEL_INLINE Floats permute_lookup(const float* nodes, __m512i k, const Parts<parts>& lanes) {
-    __m512 value = _mm512_castsi512_ps(k);
-    for (int p = 0; p < parts; ++p)
-        value = _mm512_mask2_permutex2var_ps(_mm512_loadu_ps(nodes + 32 * p), _mm512_castps_si512(value), lanes.of[p],
-                                             _mm512_loadu_ps(nodes + 32 * p + 16));
-    return value;
-}
-
-// (row[k], row[k + 1]) for k in [0, intervals) from a row of intervals + 1
-// nodes that every lane shares (model/energy.hpp), the upper nodes as the
-// lower ones of the row moved by one
+// (row[k], row[k + 1]) for k in [0, 64) from a row of 65 nodes that every
+// lane shares (the table of 1 - E_avg), the upper nodes as the lower ones of
+// the row moved by one
 template <int intervals>
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) {
-    static_assert(intervals % 32 == 0 && intervals <= 128, "a row's intervals fill permutes of 32 nodes");
-    constexpr int parts = intervals / 32;
-    const Parts<parts> lanes = parts_of<parts>(k);
-    return {permute_lookup<parts>(row, k, lanes), permute_lookup<parts>(row + 1, k, lanes)};
+    static_assert(intervals == 64, "a row's intervals fill two permutes of 32 nodes");
+    const __mmask16 upper = upper_half(k);
+    return {permute_lookup(row, k, upper), permute_lookup(row + 1, k, upper)};
+}
+
+// A blended row of the 1 - E table (kernel_material.hpp), as the lookups read
+// it: the permutes read the intervals' values from 64 floats, then their
+// slopes from the next 64.
+inline constexpr bool kRowSlopesAfterValues = true;
+
+PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* row, Ints interval) {
+    static_assert(energy::kIntervals <= 64, "a row fills two permutes of 32 nodes");
+    const __mmask16 upper = upper_half(interval);
+    return {permute_lookup(row, interval, upper), permute_lookup(row + 64, interval, upper)};
 }
 #elif defined(__AVX2__)
 // Each lane's two adjacent floats as one 8-byte load, four lanes to a pair of
@@ -484,10 +488,18 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints 
 #if !defined(__AVX512F__)
 template <int intervals>
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, Ints k) { return gather_pair(row, k); }
+
+// A blended row of the 1 - E table (kernel_material.hpp), as the lookups read
+// it: each interval's value and slope side by side, one pair a lane.
+inline constexpr bool kRowSlopesAfterValues = false;
+
+PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* row, Ints interval) {
+    return gather_pair(row, interval + interval);
+}
 #endif
 
-// The four nodes about each lane's point of a corner table (energy_corners.hpp:
-// row j at k and k + 1, row j + 1 at both), one 16-byte load a lane. On AVX2
+// An interval's value and slope in two adjacent rows, for each lane, from a
+// corner table (energy_corners.hpp), one 16-byte load a lane. On AVX2
 // and AVX-512 the loads fill the 128-bit blocks of four registers, block b of
 // register r with lane 4 b + r, and a 4x4 transpose within the blocks leaves
 // corner c of lanes 4 b .. 4 b + 3 in block b of register c. No gathers: on

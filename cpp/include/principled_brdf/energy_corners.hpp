@@ -1,9 +1,10 @@
 // The tables of energy_tables.hpp rearranged for lookups whose row differs
-// from lane to lane (a per-element roughness): the four nodes about a point,
-//   kMissingCorners[model][4 (j kCosines + k) + c] = kMissing[model][j kCosines + k + (c & 1) + (c >> 1) kCosines],
-// (row j at nodes k and k + 1, then row j + 1 at both), for j < kRoughnesses - 1
-// and k < kCosines - 1 (0 elsewhere): one 16-byte load a lane instead of two
-// pairs gathered from two rows (model/energy.hpp).
+// from lane to lane (a per-element roughness): an interval's value and slope
+// in two adjacent rows,
+//   kMissingCorners[model][4 (j kIntervals + b) + c] = kMissing[model][2 (j kIntervals + b) + (c & 1) + (c >> 1) 2 kIntervals],
+// (row j's value and slope, then row j + 1's), for j < kRoughnesses - 1 (0
+// beyond): one 16-byte load a lane instead of two pairs from two rows
+// (model/energy.hpp).
 #pragma once
 
 #include "principled_brdf/energy_tables.hpp"

@@ -14,19 +14,27 @@
 //   ∫ f_ms cos θl dωl = lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))) (1 - E(μo))
 // (since 2 ∫ (1 - E(μ)) μ dμ = 1 - E_avg), added to the cosine lobe's w0.
 // The ops of the number type provide truncate_to_index (x >= 0), index_to_real,
-// gather_pair_in_row ((row[index], row[index + 1]) per lane from a row of
-// intervals + 1 nodes that every lane shares, a blended row of 1 - E or the
-// table of 1 - E_avg, which the AVX-512 kernel reads by register permutes
-// instead of gathers) and gather_corners (the four nodes about a point of
-// the 1 - E table, energy_corners.hpp).
+// energy_interval (the interval of ν = μ + 1/8 that holds a lane, 16 an
+// octave from 1/8, and that interval's end: ν's exponent and top four
+// mantissa bits, plus one; no division), value_and_slope_in_row (an interval's
+// value and slope from a blended row that every lane shares, which the AVX-512
+// kernel reads by register permutes instead of gathers), gather_pair_in_row
+// ((row[index], row[index + 1]) from a row of intervals + 1 nodes, the table
+// of 1 - E_avg) and gather_corners (an interval's value and slope in two
+// adjacent rows of the 1 - E table at once, energy_corners.hpp).
 #pragma once  // (per namespace that includes the model)
 
-// The nodes' spacings are powers of two, so that μ (kCosines - 1) and
-// r (kRoughnesses - 1) are exact in float32 and so are the interpolation weights:
-// the float32 lookup then differs from the float64 one by the blend's roundings
-// alone, also where 1 - E is small and steep between nodes.
-static_assert(((energy::kCosines - 1) & (energy::kCosines - 2)) == 0, "kCosines - 1 is a power of two");
+// The roughness rows' spacing is a power of two, so that r (kRoughnesses - 1)
+// is exact in float32 and so is the interpolation weight between rows; within
+// an interval, μ - μ_b+1 is exact (μ_b+1 = ν_b+1 - 1/8 has few bits; ν's own
+// rounding only picks the interval, where the lines meet): the float32 lookup
+// then differs from the float64 one by its roundings alone, also where 1 - E
+// is small and steep (near μ = 1 at low roughness in the 2012 model, where a
+// rounded μ would move it by 1e-4 of itself). Each line is written from its
+// interval's end, where 1 - E is the smaller near μ = 1: from the start, it
+// would there be the difference of nearly equal terms.
 static_assert(((energy::kRoughnesses - 1) & (energy::kRoughnesses - 2)) == 0, "kRoughnesses - 1 is a power of two");
+static_assert(energy::kIntervalsPerOctave == 16 && energy::kIntervals == 51, "3 octaves of ν from 1/8, [1, 1 + 1/8], then μ = 1");
 
 template <class F>
 using IndexOf = decltype(truncate_to_index(F()));
@@ -34,30 +42,31 @@ using IndexOf = decltype(truncate_to_index(F()));
 // Where a material's roughness falls between the tables' rows.
 template <class F>
 struct EnergyRow {
-    IndexOf<F> offset;  // j kCosines: the row below r_eff
+    IndexOf<F> offset;  // j kIntervals: the row below r_eff
     F fraction;         // r_eff's position between rows j and j + 1
 };
 
 template <class F>
 struct MultipleScatteringLobe {
-    const float* missing;  // the model's 1 - E table, or one row of it (single_row)
+    const float* missing;  // the model's 1 - E table, or one blended row of it (single_row)
     const float* corners;  // the same table by corners (energy_corners.hpp), which the lookup reads otherwise
     EnergyRow<F> row;
     bool single_row = false;  // missing is 1 - E at r_eff already, blended between the rows (a uniform material)
     Rgb<F> color;          // F_avg² E_avg / (1 - F_avg (1 - E_avg)) / (π (1 - E_avg))
     F albedo_scale;        // lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))): w3 = albedo_scale (1 - E(μo))
 
-    // 1 - E(μ) at r_eff: bilinear, linear in μ between the nodes μ_k = k / (kCosines - 1)
+    // 1 - E(μ) at r_eff: linear in μ within each interval, linear in r between the rows
     PB_MODEL_INLINE F missing_energy(F mu) const {
-        const F x = min(max(mu, F(0.0)), F(1.0)) * F(energy::kCosines - 1);
-        const IndexOf<F> k = min(truncate_to_index(x), IndexOf<F>(energy::kCosines - 2));
-        const F t = x - index_to_real(k);
+        const F cosine = min(max(mu, F(0.0)), F(1.0));
+        const F offset(energy::kCosineOffset);
+        const auto [interval, end] = energy_interval(cosine + offset);
+        const F along = cosine - (end - offset);  // <= 0
         if (single_row) {
-            const auto [at_k, at_next] = gather_pair_in_row<energy::kCosines - 1>(missing, k);
-            return mix(at_k, at_next, t);
+            const auto [value, slope] = value_and_slope_in_row(missing, interval);
+            return mul_add(along, slope, value);
         }
-        const auto [below_k, below_next, above_k, above_next] = gather_corners(corners, row.offset + k);
-        return mix(mix(below_k, below_next, t), mix(above_k, above_next, t), row.fraction);
+        const auto [below, below_slope, above, above_slope] = gather_corners(corners, row.offset + interval);
+        return mix(mul_add(along, below_slope, below), mul_add(along, above_slope, above), row.fraction);
     }
 
     // the scalar factor of color: (1 - E(μl)) (1 - E(μo)), 1 - E(μo) given
@@ -84,7 +93,7 @@ PB_MODEL_INLINE MultipleScatteringLobe<F> multiple_scattering_of(const F* p, con
     // r_eff clamped to the tables' [0, 1]
     const F y = min(max(p[kRoughness], F(0.0)), one) * F(energy::kRoughnesses - 1);
     const IndexOf<F> j = min(truncate_to_index(y), IndexOf<F>(energy::kRoughnesses - 2));
-    ms.row = {truncate_to_index(index_to_real(j) * F(energy::kCosines)), y - index_to_real(j)};
+    ms.row = {truncate_to_index(index_to_real(j) * F(energy::kIntervals)), y - index_to_real(j)};
     const float* average = energy::kMissingAverage[static_cast<int>(model)];
     const auto [average_j, average_next] = gather_pair_in_row<energy::kRoughnesses - 1>(average, j);
     const F missing_average = mix(average_j, average_next, ms.row.fraction);

@@ -35,15 +35,32 @@ inline std::pair<double, double> sincos_turns(double u) {
     return {std::sin(phi), std::cos(phi)};
 }
 
-// table lookups (model/energy.hpp): the integer part of x >= 0, back to a real, (row[i], row[i + 1])
+// table lookups (model/energy.hpp): the integer part of x >= 0, back to a real
 inline int truncate_to_index(double x) { return static_cast<int>(x); }
 inline double index_to_real(int i) { return static_cast<double>(i); }
 inline int min(int a, int b) { return a < b ? a : b; }
+// the interval of ν >= 1/8, 16 an octave, and its end: ν's exponent and top four mantissa bits, plus one
+inline std::pair<int, double> energy_interval(double nu) {
+    constexpr int shift = 52 - 4;
+    auto bits_of = [](double x) {
+        std::uint64_t bits;
+        std::memcpy(&bits, &x, sizeof bits);
+        return bits;
+    };
+    const std::uint64_t bits = bits_of(nu), end_bits = (bits & ~((std::uint64_t(1) << shift) - 1)) + (std::uint64_t(1) << shift);
+    double end;
+    std::memcpy(&end, &end_bits, sizeof end);
+    return {static_cast<int>((bits >> shift) - (bits_of(energy::kCosineOffset) >> shift)), end};
+}
+// an interval's (value, slope) from a row of them
+inline std::pair<double, double> value_and_slope_in_row(const float* row, int interval) {
+    return {static_cast<double>(row[2 * interval]), static_cast<double>(row[2 * interval + 1])};
+}
 template <int intervals>
 inline std::pair<double, double> gather_pair_in_row(const float* row, int i) {
     return {static_cast<double>(row[i]), static_cast<double>(row[i + 1])};
 }
-// the four nodes about a point of a corner table (energy_corners.hpp)
+// an interval's value and slope in two adjacent rows of a corner table (energy_corners.hpp)
 inline std::array<double, 4> gather_corners(const float* corners, int i) {
     const float* c = corners + energy::kCorners * i;
     return {c[0], c[1], c[2], c[3]};
