@@ -34,7 +34,7 @@ PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shadi
 // linear in r like the lookup of two rows), so that a lookup reads one
 // interval instead of two. The lobe reads `values` from then on.
 struct BlendedEnergyRow {
-    alignas(64) float values[2 * 64];  // (the AVX-512 permutes read 64 values, then 64 slopes)
+    alignas(64) float values[2 * 64];  // laid out by row_value_at and row_slope_at (simd_ops.hpp)
 
     void use_for(MultipleScatteringLobe<Floats>& ms) {
         alignas(64) std::int32_t offset[kLanes];
@@ -45,12 +45,9 @@ struct BlendedEnergyRow {
         const float* above = below + 2 * energy::kIntervals;
         const float t = fraction[0];
         auto blend = [&](int at) { return below[at] * (1.0f - t) + above[at] * t; };
-        for (int b = energy::kIntervals; b < 64; ++b) values[b] = values[64 + b] = 0.0f;  // (never read)
-        for (int b = 0; b < energy::kIntervals; ++b) {
-            const int value_at = kRowSlopesAfterValues ? b : 2 * b;
-            const int slope_at = kRowSlopesAfterValues ? 64 + b : 2 * b + 1;
-            values[value_at] = blend(2 * b);
-            values[slope_at] = blend(2 * b + 1);
+        for (int b = 0; b < 64; ++b) {  // (the intervals past kIntervals are never read)
+            values[row_value_at(b)] = b < energy::kIntervals ? blend(2 * b) : 0.0f;
+            values[row_slope_at(b)] = b < energy::kIntervals ? blend(2 * b + 1) : 0.0f;
         }
         ms.missing = values;
         ms.single_row = true;

@@ -447,12 +447,13 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, 
 // A blended row of the 1 - E table (kernel_material.hpp), as the lookups read
 // it: the permutes read the intervals' values from 64 floats, then their
 // slopes from the next 64.
-inline constexpr bool kRowSlopesAfterValues = true;
+constexpr int row_value_at(int interval) { return interval; }
+constexpr int row_slope_at(int interval) { return 64 + interval; }
 
 PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* row, Ints interval) {
     static_assert(energy::kIntervals <= 64, "a row fills two permutes of 32 nodes");
     const __mmask16 upper = upper_half(interval);
-    return {permute_lookup(row, interval, upper), permute_lookup(row + 64, interval, upper)};
+    return {permute_lookup(row + row_value_at(0), interval, upper), permute_lookup(row + row_slope_at(0), interval, upper)};
 }
 #elif defined(__AVX2__)
 // Each lane's two adjacent floats as one 8-byte load, four lanes to a pair of
@@ -491,7 +492,8 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair_in_row(const float* row, 
 
 // A blended row of the 1 - E table (kernel_material.hpp), as the lookups read
 // it: each interval's value and slope side by side, one pair a lane.
-inline constexpr bool kRowSlopesAfterValues = false;
+constexpr int row_value_at(int interval) { return 2 * interval; }
+constexpr int row_slope_at(int interval) { return 2 * interval + 1; }
 
 PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* row, Ints interval) {
     return gather_pair(row, interval + interval);
