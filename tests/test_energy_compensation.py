@@ -358,6 +358,47 @@ def test_simd_matches_reference_for_uniform_materials(isa, regime):
 
 
 @pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("per_element", [False, True], ids=["uniform", "per-element"])
+def test_lookups_at_the_ends_of_the_hemisphere(isa, per_element):
+    # the lookups find μ's interval from ν = μ + 1/8 unclamped: μ = 1 and a
+    # float32 unit vector's z rounded past 1 read the flat last interval; below
+    # the surface (μ < 0, ν < 1/8 or ν <= 0) and for lengths past 1 with
+    # check=False they read some interval, never outside the table, and the
+    # results stay finite and zero below the surface
+    tiny = np.float32(2.0 ** -12)
+    zs = np.array([1.0, np.nextafter(np.float32(1.0), np.float32(0.0)), 0.999, 0.5, 0.05, 1e-6, 0.0, -0.0,
+                   -1e-6, -0.05, -0.125, -0.2, -0.5, -1.0], np.float32)
+    rng = seeded_rng("energy-compensation-ends", isa, per_element)
+    pairs = np.array([(a, b) for a in zs for b in zs], np.float32)
+    n = len(pairs)
+
+    def directions(z):
+        phi = rng.uniform(0, 2 * np.pi, len(z)).astype(np.float32)
+        r = np.sqrt(np.maximum(0.0, 1.0 - z.astype(np.float64) ** 2)).astype(np.float32)
+        return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+    wi, wo = directions(pairs[:, 0]), directions(pairs[:, 1])
+    wi[0] = (tiny, 0.0, 1.0)  # z = 1 with a length of 1 + 2^-25: what float32 normalisation may leave
+    wi[1] = (0.0, 0.0, np.nextafter(np.float32(1.0), np.float32(2.0)))  # z rounded past 1
+    roughness = rng.uniform(0.0, 1.0, n).astype(np.float32) if per_element else np.float32(0.3)
+    material = pb.Material(base_color=(0.9, 0.6, 0.3), metallic=0.7, roughness=roughness)
+    for model in MODELS:
+        options = dict(model=model, energy_compensation=True)
+        value, density = pb.eval_pdf(material, wi, wo, isa=isa, **options)
+        ref = pb.reference.eval(material, wi.astype(np.float64), wo.astype(np.float64), **options)
+        above = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+        assert np.all(np.isfinite(value)) and np.all(np.isfinite(density))
+        assert np.all(value[~above] == 0) and np.all(density[~above] == 0)
+        np.testing.assert_allclose(value[above], ref[above], rtol=5e-5, atol=1e-7)
+        s = pb.sample(material, wo, u=rng.random((n, 3)).astype(np.float32), isa=isa, **options)
+        assert np.all(np.isfinite(s.weight)) and np.all(np.isfinite(s.pdf)) and np.all(np.isfinite(s.wi))
+        assert np.all(s.weight[wo[:, 2] <= 0] == 0) and np.all(s.pdf[wo[:, 2] <= 0] == 0)
+        # past the unit length, unchecked: finite
+        long_wi, long_wo = wi * np.float32(1.9), wo * np.float32(3.0)
+        assert np.all(np.isfinite(pb.eval(material, long_wi, long_wo, isa=isa, check=False, **options)))
+
+
+@pytest.mark.parametrize("isa", ISAS)
 @pytest.mark.parametrize("model", MODELS)
 def test_simd_sample_matches_reference(isa, model):
     rng = seeded_rng("energy-compensation-sample", isa, model)

@@ -45,9 +45,10 @@ struct BlendedEnergyRow {
         const float* above = below + 2 * energy::kIntervals;
         const float t = fraction[0];
         auto blend = [&](int at) { return below[at] * (1.0f - t) + above[at] * t; };
-        for (int b = 0; b < 64; ++b) {  // (the intervals past kIntervals are never read)
-            values[row_value_at(b)] = b < energy::kIntervals ? blend(2 * b) : 0.0f;
-            values[row_slope_at(b)] = b < energy::kIntervals ? blend(2 * b + 1) : 0.0f;
+        for (int b = 0; b < 64; ++b) {  // the slots past the last interval (μ = 1, flat) repeat it
+            const int interval = std::min(b, energy::kIntervals - 1);
+            values[row_value_at(b)] = blend(2 * interval);
+            values[row_slope_at(b)] = blend(2 * interval + 1);
         }
         ms.missing = values;
         ms.single_row = true;

@@ -411,14 +411,36 @@ PB_KERNEL_INLINE Floats largest_finite(Floats) { return Floats(std::numeric_limi
 PB_KERNEL_INLINE Ints truncate_to_index(Floats x) { return xsimd::to_int(x); }
 PB_KERNEL_INLINE Floats index_to_real(Ints i) { return xsimd::to_float(i); }
 PB_KERNEL_INLINE Ints min(Ints a, Ints b) { return xsimd::min(a, b); }
-// the interval of ν >= 1/8, 16 an octave, and its end: ν's exponent and top four mantissa bits, plus one
-PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
-    constexpr int shift = 23 - 4;
-    constexpr std::int32_t first = 0x3E000000 >> shift;  // 1/8's bits
-    static_assert(energy::kCosineOffset == 0.125f, "the first interval starts at 1/8");
-    const Ints bits = xsimd::bitwise_cast<Ints>(nu);
-    return {(bits >> shift) - Ints(first), xsimd::bitwise_cast<Floats>((bits & Ints(-(1 << shift))) + Ints(1 << shift))};
+// The interval of ν = μ + 1/8 that holds each lane (16 an octave from 1/8,
+// the last [9/8, 9/8 + 1/16) for μ = 1, model/energy.hpp) and that interval's
+// end: ν's exponent and top four mantissa bits, plus one. Any μ in [0, 1 + 1/16)
+// (a unit vector's z, rounded up included) finds its own interval; any other ν
+// (μ < 0, where the lobe is discarded) some interval of the table, never an
+// index outside it.
+constexpr int kIntervalShift = 23 - 4;
+constexpr std::int32_t kFirstIntervalBits = 0x3E000000 >> kIntervalShift;  // 1/8's bits
+static_assert(energy::kCosineOffset == 0.125f, "the first interval starts at 1/8");
+PB_KERNEL_INLINE Floats interval_end(Ints bits) {
+    return xsimd::bitwise_cast<Floats>((bits & Ints(-(1 << kIntervalShift))) + Ints(1 << kIntervalShift));
 }
+#if defined(__AVX512F__)
+// Here the interval comes as ν's bits >> 19, the interval plus 31 · 64: the
+// permutes of a row read it modulo 64 (a row's slots past the last interval
+// repeat it, kernel_material.hpp), without a subtraction or a clamp;
+// gather_corners takes the offset off and clamps.
+static_assert(kFirstIntervalBits % 64 == 0, "1/8's bits >> 19 are 0 modulo 64");
+PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
+    const Ints bits = xsimd::bitwise_cast<Ints>(nu);
+    return {bits >> kIntervalShift, interval_end(bits)};
+}
+#else
+// ν clamped to [1/8, 9/8] first, where μ = 1 starts its interval
+PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
+    const Floats offset(energy::kCosineOffset);
+    const Ints bits = xsimd::bitwise_cast<Ints>(min(max(nu, offset), offset + Floats(1.0f)));
+    return {(bits >> kIntervalShift) - Ints(kFirstIntervalBits), interval_end(bits)};
+}
+#endif
 // (the intrinsics: xsimd 8.1's batch::gather for fma3<avx2> falls back to an out-of-line element loop)
 #if defined(__AVX512F__)
 // nodes[k] per lane for k in [0, 64): a two-register permute for each half of
@@ -507,10 +529,16 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
 // corner c of lanes 4 b .. 4 b + 3 in block b of register c. No gathers: on
 // Zen 4 eight lanes' pairs by vgatherdpd cost about 17 cycles (bench/RESULTS.md).
 #if defined(__AVX512F__)
-PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
+// (the interval as energy_interval gives it here: offset by 1/8's bits >> 19,
+// any value below the surface; clamped, and the offset taken off in the
+// addresses' displacement)
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints row_offset, Ints interval) {
+    const Ints last(kFirstIntervalBits + energy::kIntervals - 1);
     alignas(64) std::int32_t index[kLanes];
-    at.store_aligned(index);
-    auto corners_of = [&](int lane) { return _mm_load_ps(corners + energy::kCorners * std::int64_t(index[lane])); };
+    (row_offset + xsimd::min(xsimd::max(interval, Ints(kFirstIntervalBits)), last)).store_aligned(index);
+    auto corners_of = [&](int lane) {
+        return _mm_load_ps(corners + energy::kCorners * (std::int64_t(index[lane]) - kFirstIntervalBits));
+    };
     auto blocks = [&](int r) {
         const __m512 low = _mm512_insertf32x4(_mm512_castps128_ps512(corners_of(r)), corners_of(4 + r), 1);
         return _mm512_insertf32x4(_mm512_insertf32x4(low, corners_of(8 + r), 2), corners_of(12 + r), 3);
@@ -522,9 +550,9 @@ PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints
             _mm512_castpd_ps(_mm512_unpacklo_pd(high01, high23)), _mm512_castpd_ps(_mm512_unpackhi_pd(high01, high23))};
 }
 #elif defined(__AVX2__)
-PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints row_offset, Ints interval) {
     alignas(32) std::int32_t index[kLanes];
-    at.store_aligned(index);
+    (row_offset + interval).store_aligned(index);
     auto corners_of = [&](int lane) { return _mm_load_ps(corners + energy::kCorners * std::int64_t(index[lane])); };
     auto blocks = [&](int r) { return _mm256_set_m128(corners_of(4 + r), corners_of(r)); };
     const __m256 r0 = blocks(0), r1 = blocks(1), r2 = blocks(2), r3 = blocks(3);
@@ -534,10 +562,10 @@ PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints
             _mm256_castpd_ps(_mm256_unpacklo_pd(high01, high23)), _mm256_castpd_ps(_mm256_unpackhi_pd(high01, high23))};
 }
 #else
-PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints at) {
+PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints row_offset, Ints interval) {
     alignas(64) std::int32_t index[kLanes];
     alignas(64) float corner[4][kLanes];
-    at.store_aligned(index);
+    (row_offset + interval).store_aligned(index);
     for (std::int64_t j = 0; j < kLanes; ++j)
         for (int c = 0; c < 4; ++c) corner[c][j] = corners[energy::kCorners * index[j] + c];
     return {Floats::load_aligned(corner[0]), Floats::load_aligned(corner[1]), Floats::load_aligned(corner[2]),

@@ -56,16 +56,16 @@ struct MultipleScatteringLobe {
     F albedo_scale;        // lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))): w3 = albedo_scale (1 - E(μo))
 
     // 1 - E(μ) at r_eff: linear in μ within each interval, linear in r between the rows
+    // (for μ in [0, 1 + 1/16); below the surface, where the lobe is discarded, some finite value)
     PB_MODEL_INLINE F missing_energy(F mu) const {
-        const F cosine = min(max(mu, F(0.0)), F(1.0));
         const F offset(energy::kCosineOffset);
-        const auto [interval, end] = energy_interval(cosine + offset);
-        const F along = cosine - (end - offset);  // <= 0
+        const auto [interval, end] = energy_interval(mu + offset);
+        const F along = mu - (end - offset);  // <= 0
         if (single_row) {
             const auto [value, slope] = value_and_slope_in_row(missing, interval);
             return mul_add(along, slope, value);
         }
-        const auto [below, below_slope, above, above_slope] = gather_corners(corners, row.offset + interval);
+        const auto [below, below_slope, above, above_slope] = gather_corners(corners, row.offset, interval);
         return mix(mul_add(along, below_slope, below), mul_add(along, above_slope, above), row.fraction);
     }
 

@@ -39,7 +39,8 @@ inline std::pair<double, double> sincos_turns(double u) {
 inline int truncate_to_index(double x) { return static_cast<int>(x); }
 inline double index_to_real(int i) { return static_cast<double>(i); }
 inline int min(int a, int b) { return a < b ? a : b; }
-// the interval of ν >= 1/8, 16 an octave, and its end: ν's exponent and top four mantissa bits, plus one
+// the interval of ν = μ + 1/8, 16 an octave from 1/8, and its end: ν's exponent
+// and top four mantissa bits, plus one; ν clamped to [1/8, 9/8] first (NaN to 1/8)
 inline std::pair<int, double> energy_interval(double nu) {
     constexpr int shift = 52 - 4;
     auto bits_of = [](double x) {
@@ -47,10 +48,12 @@ inline std::pair<int, double> energy_interval(double nu) {
         std::memcpy(&bits, &x, sizeof bits);
         return bits;
     };
-    const std::uint64_t bits = bits_of(nu), end_bits = (bits & ~((std::uint64_t(1) << shift) - 1)) + (std::uint64_t(1) << shift);
+    const double first = energy::kCosineOffset, last = first + 1.0;
+    const double clamped = nu > first ? (nu < last ? nu : last) : first;
+    const std::uint64_t bits = bits_of(clamped), end_bits = (bits & ~((std::uint64_t(1) << shift) - 1)) + (std::uint64_t(1) << shift);
     double end;
     std::memcpy(&end, &end_bits, sizeof end);
-    return {static_cast<int>((bits >> shift) - (bits_of(energy::kCosineOffset) >> shift)), end};
+    return {static_cast<int>((bits >> shift) - (bits_of(first) >> shift)), end};
 }
 // an interval's (value, slope) from a row of them
 inline std::pair<double, double> value_and_slope_in_row(const float* row, int interval) {
@@ -61,7 +64,7 @@ inline std::pair<double, double> gather_pair_in_row(const float* row, int i) {
     return {static_cast<double>(row[i]), static_cast<double>(row[i + 1])};
 }
 // an interval's value and slope in two adjacent rows of a corner table (energy_corners.hpp)
-inline std::array<double, 4> gather_corners(const float* corners, int i) {
-    const float* c = corners + energy::kCorners * i;
+inline std::array<double, 4> gather_corners(const float* corners, int row_offset, int interval) {
+    const float* c = corners + energy::kCorners * (row_offset + interval);
     return {c[0], c[1], c[2], c[3]};
 }
