@@ -106,7 +106,8 @@ def natural_loops(successors):
     for tail, targets in enumerate(successors):
         for header in targets:
             if tail in predecessors[header] and header in dom[tail]:  # a back edge
-                members, stack = {header, tail}, [tail]
+                # (a one-block loop, tail == header, has no other member)
+                members, stack = {header, tail}, [tail] if tail != header else []
                 while stack:
                     for p in predecessors[stack.pop()]:
                         if p not in members:

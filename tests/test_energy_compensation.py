@@ -393,9 +393,17 @@ def test_lookups_at_the_ends_of_the_hemisphere(isa, per_element):
         s = pb.sample(material, wo, u=rng.random((n, 3)).astype(np.float32), isa=isa, **options)
         assert np.all(np.isfinite(s.weight)) and np.all(np.isfinite(s.pdf)) and np.all(np.isfinite(s.wi))
         assert np.all(s.weight[wo[:, 2] <= 0] == 0) and np.all(s.pdf[wo[:, 2] <= 0] == 0)
-        # past the unit length, unchecked: finite
+        # unchecked: past the unit length finite, NaN, infinite or huge z zero
         long_wi, long_wo = wi * np.float32(1.9), wo * np.float32(3.0)
         assert np.all(np.isfinite(pb.eval(material, long_wi, long_wo, isa=isa, check=False, **options)))
+        bad_wi, bad_wo = wi.copy(), wo.copy()
+        bad_wi[::3, 2], bad_wo[1::3, 2] = np.nan, -np.inf
+        bad_wi[2::3, 2] = 1e30
+        f = pb.eval(material, bad_wi, bad_wo, isa=isa, check=False, **options)
+        assert np.all(f == 0)
+        s = pb.sample(material, bad_wo, u=rng.random((n, 3)).astype(np.float32), isa=isa, check=False, **options)
+        assert all(np.all(np.isfinite(a)) for a in (s.wi, s.pdf, s.weight))
+        assert np.all(s.weight[1::3] == 0) and np.all(s.pdf[1::3] == 0)
 
 
 @pytest.mark.parametrize("isa", ISAS)

@@ -434,10 +434,16 @@ PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
     return {bits >> kIntervalShift, interval_end(bits)};
 }
 #else
-// ν clamped to [1/8, 9/8] first, where μ = 1 starts its interval
+// ν clamped to [1/8, 9/8] first, where μ = 1 starts its interval, a NaN to
+// 1/8: x86's max returns its second operand for a NaN, NEON's the NaN
 PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
     const Floats offset(energy::kCosineOffset);
-    const Ints bits = xsimd::bitwise_cast<Ints>(min(max(nu, offset), offset + Floats(1.0f)));
+#if defined(__ARM_NEON)
+    const Floats at_least_first = select(nu > offset, nu, offset);
+#else
+    const Floats at_least_first = max(nu, offset);
+#endif
+    const Ints bits = xsimd::bitwise_cast<Ints>(min(at_least_first, offset + Floats(1.0f)));
     return {(bits >> kIntervalShift) - Ints(kFirstIntervalBits), interval_end(bits)};
 }
 #endif
