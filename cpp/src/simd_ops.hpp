@@ -447,6 +447,43 @@ PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
     return {(bits >> kIntervalShift) - Ints(kFirstIntervalBits), interval_end(bits)};
 }
 #endif
+#if defined(__AVX2__)
+// Non-negative 32-bit lane indices as integers for scalar loads' addresses, two
+// lanes at a time out of the register (vmovq, vpextrq) and apart by a shift:
+// half the vector-to-integer moves of GCC's way with a stored array, one
+// vmovd or vpextrd a lane on the FP pipes these kernels are bound by. (Forcing
+// the array through memory instead waited on store forwarding: bench/RESULTS.md.)
+struct LaneIndices {
+    std::uint64_t pairs[kLanes / 2];
+    PB_KERNEL_INLINE std::int64_t operator[](int lane) const {
+        const std::uint64_t pair = pairs[lane / 2];
+        return static_cast<std::int64_t>(lane % 2 ? pair >> 32 : pair & 0xFFFFFFFFu);
+    }
+};
+PB_KERNEL_INLINE void put_pairs(std::uint64_t* pairs, __m128i block) {
+    pairs[0] = static_cast<std::uint64_t>(_mm_cvtsi128_si64(block));
+    pairs[1] = static_cast<std::uint64_t>(_mm_extract_epi64(block, 1));
+}
+#if defined(__AVX512F__)
+PB_KERNEL_INLINE LaneIndices lane_indices(Ints i) {
+    const __m512i v = i;
+    LaneIndices lanes;
+    put_pairs(lanes.pairs, _mm512_castsi512_si128(v));
+    put_pairs(lanes.pairs + 2, _mm512_extracti32x4_epi32(v, 1));
+    put_pairs(lanes.pairs + 4, _mm512_extracti32x4_epi32(v, 2));
+    put_pairs(lanes.pairs + 6, _mm512_extracti32x4_epi32(v, 3));
+    return lanes;
+}
+#else
+PB_KERNEL_INLINE LaneIndices lane_indices(Ints i) {
+    const __m256i v = i;
+    LaneIndices lanes;
+    put_pairs(lanes.pairs, _mm256_castsi256_si128(v));
+    put_pairs(lanes.pairs + 2, _mm256_extracti128_si256(v, 1));
+    return lanes;
+}
+#endif
+#endif
 // (the intrinsics: xsimd 8.1's batch::gather for fma3<avx2> falls back to an out-of-line element loop)
 #if defined(__AVX512F__)
 // nodes[k] per lane for k in [0, 64): a two-register permute for each half of
@@ -488,8 +525,7 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
 // 128-bit halves, then split into the nodes below and above. Scalar loads, not
 // gathers, which measured slower on Zen 3 (bench/RESULTS.md).
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints i) {
-    alignas(32) std::int32_t index[kLanes];
-    i.store_aligned(index);
+    const LaneIndices index = lane_indices(i);
     auto pairs = [&](int lane) {  // lanes l and l + 1: (t[i_l], t[i_l + 1], t[i_(l+1)], t[i_(l+1) + 1])
         const __m128d low = _mm_castsi128_pd(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(table + index[lane])));
         return _mm_castpd_ps(_mm_loadh_pd(low, reinterpret_cast<const double*>(table + index[lane + 1])));
@@ -540,11 +576,10 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
 // addresses' displacement)
 PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints row_offset, Ints interval) {
     const Ints last(kFirstIntervalBits + energy::kIntervals - 1);
-    alignas(64) std::int32_t index[kLanes];
-    (row_offset + xsimd::min(xsimd::max(interval, Ints(kFirstIntervalBits)), last)).store_aligned(index);
-    auto corners_of = [&](int lane) {
-        return _mm_load_ps(corners + energy::kCorners * (std::int64_t(index[lane]) - kFirstIntervalBits));
-    };
+    // in floats, kCorners a corner (addresses scale by 4 at most)
+    const LaneIndices at = lane_indices((row_offset + xsimd::min(xsimd::max(interval, Ints(kFirstIntervalBits)), last)) << 2);
+    static_assert(energy::kCorners == 4, "a corner is 4 floats");
+    auto corners_of = [&](int lane) { return _mm_load_ps(corners + (at[lane] - energy::kCorners * kFirstIntervalBits)); };
     auto blocks = [&](int r) {
         const __m512 low = _mm512_insertf32x4(_mm512_castps128_ps512(corners_of(r)), corners_of(4 + r), 1);
         return _mm512_insertf32x4(_mm512_insertf32x4(low, corners_of(8 + r), 2), corners_of(12 + r), 3);
@@ -557,9 +592,8 @@ PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints
 }
 #elif defined(__AVX2__)
 PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints row_offset, Ints interval) {
-    alignas(32) std::int32_t index[kLanes];
-    (row_offset + interval).store_aligned(index);
-    auto corners_of = [&](int lane) { return _mm_load_ps(corners + energy::kCorners * std::int64_t(index[lane])); };
+    const LaneIndices at = lane_indices((row_offset + interval) << 2);  // in floats, as above
+    auto corners_of = [&](int lane) { return _mm_load_ps(corners + at[lane]); };
     auto blocks = [&](int r) { return _mm256_set_m128(corners_of(4 + r), corners_of(r)); };
     const __m256 r0 = blocks(0), r1 = blocks(1), r2 = blocks(2), r3 = blocks(3);
     const __m256d low01 = _mm256_castps_pd(_mm256_unpacklo_ps(r0, r1)), high01 = _mm256_castps_pd(_mm256_unpackhi_ps(r0, r1));
