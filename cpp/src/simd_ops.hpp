@@ -575,10 +575,10 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
 // any value below the surface; clamped, and the offset taken off in the
 // addresses' displacement)
 PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints row_offset, Ints interval) {
+    static_assert(energy::kCorners == 4, "a corner is 4 floats");
     const Ints last(kFirstIntervalBits + energy::kIntervals - 1);
     // in floats, kCorners a corner (addresses scale by 4 at most)
     const LaneIndices at = lane_indices((row_offset + xsimd::min(xsimd::max(interval, Ints(kFirstIntervalBits)), last)) << 2);
-    static_assert(energy::kCorners == 4, "a corner is 4 floats");
     auto corners_of = [&](int lane) { return _mm_load_ps(corners + (at[lane] - energy::kCorners * kFirstIntervalBits)); };
     auto blocks = [&](int r) {
         const __m512 low = _mm512_insertf32x4(_mm512_castps128_ps512(corners_of(r)), corners_of(4 + r), 1);
