@@ -10,6 +10,8 @@
 // Its components are exact float sums where wi and wo nearly cancel, so
 // cos²θh = Hz²/|H|² and sin²θh = (Hx² + Hy²)/|H|² keep full relative precision
 // at the narrow GTR peaks, where 1 - cos²θh would cancel.
+//
+// As in the model, locals are not declared const (docs/model.md, "No const locals").
 #include <xsimd/xsimd.hpp>
 
 #include <array>

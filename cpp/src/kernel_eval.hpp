@@ -36,7 +36,7 @@ using PreparedOf = std::conditional_t<compensated, CompensatedPrepared<output>, 
 template <Model model, Output output, bool compensated>
 PB_KERNEL_INLINE PreparedOf<output, compensated> prepare_for(const RawMaterial& m) {
     if constexpr (compensated) {
-        const Shading<Floats> s = shading_of(m);
+        Shading<Floats> s = shading_of(m);
         return {{s, NoPartials{}}, multiple_scattering_of(m.slot, s, model)};
     } else {
         return prepare<output>(m);
@@ -82,21 +82,21 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
                                              const Vec3<Floats>& wo, const Shading<Floats>& s,
                                              const MultipleScatteringLobe<Floats>& ms) {
     static_assert(output != Output::kGradient, "the energy compensation has no gradient");
-    const Geometry<Floats> g = geometry_of(wi, wo);
-    const Mask above = above_surface(g);
-    const View<Floats> view = view_of<model, lobes>(wo, s);
-    const Floats missing_wo = ms.missing_energy(wo.z);
+    Geometry<Floats> g = geometry_of(wi, wo);
+    Mask above = above_surface(g);
+    View<Floats> view = view_of<model, lobes>(wo, s);
+    Floats missing_wo = ms.missing_energy(wo.z);
     // (1 - E(μl)) (1 - E(μo)): both lookups first, f_ms joins f by one FMA a channel (added_to)
-    const Floats multiple_scattering = ms.missing_energy(wi.z) * missing_wo;
-    const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+    Floats multiple_scattering = ms.missing_energy(wi.z) * missing_wo;
+    Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
     auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };
     if constexpr (output == Output::kPdf || output == Output::kValuePdf) {
-        const Shading<Floats> mixture = with_multiple_scattering_weight(s, ms.weight(missing_wo));
-        const Floats pdf = mixture_pdf(g, mixture, view, lobe_weights(view.fv, mixture), job.sampler);
+        Shading<Floats> mixture = with_multiple_scattering_weight(s, ms.weight(missing_wo));
+        Floats pdf = mixture_pdf(g, mixture, view, lobe_weights(view.fv, mixture), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     }
     if constexpr (output == Output::kPdf) return;
-    const LobeValues<Floats> values = eval_lobes<model, lobes>(g, s, view);
+    LobeValues<Floats> values = eval_lobes<model, lobes>(g, s, view);
     if constexpr (output == Output::kLobes) {
         store_rgb<layouts>(job.out[0], i, masked(values.diffuse_rgb(s)));
         store_rgb<layouts>(job.out[1], i, masked(values.sheen_rgb(s)));
@@ -116,31 +116,31 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
         return;
     }
     const Shading<Floats>& s = material.shading;
-    const Geometry<Floats> g = geometry_of(wi, wo);
+    Geometry<Floats> g = geometry_of(wi, wo);
     // select discards whatever the formulas gave below the surface (H may be 0)
-    const Mask above = above_surface(g);
-    const View<Floats> view = view_of<model, lobes>(wo, s);
+    Mask above = above_surface(g);
+    View<Floats> view = view_of<model, lobes>(wo, s);
     if constexpr (output == Output::kGradient) {
         // x cos θl or x times 1 (the same bits), then 0 below the surface
-        const Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
+        Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
         auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
         JacobianStore<layouts> store{job, i};
-        const Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked,
+        Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked,
                                                    [&](int c, int p, Floats x) { store.put(c, p, x); });
         store.finish();
         store_rgb<layouts>(job.out[0], i, {masked(f.r), masked(f.g), masked(f.b)});
     } else if constexpr (output == Output::kPdf) {
-        const Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
+        Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     } else if constexpr (output == Output::kValuePdf) {
-        const Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
+        Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
-        const Rgb<Floats> f = eval_lobes<model, lobes>(g, s, view).template total<lobes>(s);
+        Rgb<Floats> f = eval_lobes<model, lobes>(g, s, view).template total<lobes>(s);
         auto masked = [&](Floats x) { return select(above, job.cosine ? wi.z * x : x, Floats(0.0f)); };
         store_rgb<layouts>(job.out[0], i, {masked(f.r), masked(f.g), masked(f.b)});
     } else {
-        const LobeValues<Floats> values = eval_lobes<model, lobes>(g, s, view);
-        const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+        LobeValues<Floats> values = eval_lobes<model, lobes>(g, s, view);
+        Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
         auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };
         if constexpr (output == Output::kLobes) {
             store_rgb<layouts>(job.out[0], i, masked(values.diffuse_rgb(s)));
@@ -181,14 +181,14 @@ PB_KERNEL_INLINE LobeSet lobe_set_of(const RawMaterial& m) {
 // does not accept it.
 template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes>
 PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const PreparedOf<output, compensated>& uniform) {
-    const Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
-    const Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
+    Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
+    Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled && !all(surely_unit_length(wi, job.check) & surely_unit_length(wo, job.check))) return false;
     if constexpr (per_element && compensated) {
         // the lobes' constants as locals: a CompensatedPrepared built per batch was copied whole (rep movs)
-        const RawMaterial m = load_material(job.params, i);
-        const Shading<Floats> s = shading_of(m);
-        const MultipleScatteringLobe<Floats> ms = multiple_scattering_of(m.slot, s, model);
+        RawMaterial m = load_material(job.params, i);
+        Shading<Floats> s = shading_of(m);
+        MultipleScatteringLobe<Floats> ms = multiple_scattering_of(m.slot, s, model);
         if constexpr (has_lobe_sets(output)) {  // the batch's LobeSet, as below
             switch (lobe_set_of(m)) {
                 case LobeSet::kSpecular:
@@ -204,7 +204,7 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
         eval_compensated_batch<model, output, layouts>(job, i, wi, wo, s, ms);
     } else if constexpr (per_element && has_lobe_sets(output)) {
         // the batch's LobeSet, when all its lanes agree (a texture's metal or plastic regions)
-        const RawMaterial m = load_material(job.params, i);
+        RawMaterial m = load_material(job.params, i);
         switch (lobe_set_of(m)) {
             case LobeSet::kSpecular:
                 eval_batch<model, output, layouts, false, LobeSet::kSpecular>(job, i, wi, wo, prepare<output>(m));

@@ -44,7 +44,7 @@ PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const
 // The direction check (DirectionCheck in batch.hpp). The fast test: true only
 // for lanes whose length the rule accepts.
 PB_KERNEL_INLINE Mask surely_unit_length(const Vec3<Floats>& w, const DirectionCheck& check) {
-    const Floats length2 = mul_add(w.x, w.x, mul_add(w.y, w.y, w.z * w.z));
+    Floats length2 = mul_add(w.x, w.x, mul_add(w.y, w.y, w.z * w.z));
     return (length2 >= Floats(check.fast_lowest)) & (length2 <= Floats(check.fast_highest));  // false for NaN
 }
 

@@ -25,7 +25,7 @@ PB_KERNEL_INLINE bool load_inputs(const SampleJob& job, std::int64_t i, const Co
     c.wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled && !all(surely_unit_length(c.wo, job.check))) return false;
     if (job.u.data != nullptr) {
-        const Vec3<Floats> given = load_vec3<layouts>(job.u, i);
+        Vec3<Floats> given = load_vec3<layouts>(job.u, i);
         c.u = {given.x, given.y, given.z};
     } else {
         c.u = counter_uniforms(static_cast<std::uint64_t>(job.first_index) + static_cast<std::uint64_t>(i), seed);
@@ -69,14 +69,14 @@ PB_KERNEL_INLINE void store_sample(const SampleJob& job, std::int64_t i, const L
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
-    const Floats lobe_index = select(lobe.cosine, index_bits(0), select(lobe.specular, index_bits(1), index_bits(2)));
+    Floats lobe_index = select(lobe.cosine, index_bits(0), select(lobe.specular, index_bits(1), index_bits(2)));
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
 template <Model model, Layouts layouts, bool with_lobes>
 PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction<Floats>& d,
                             const Shading<Floats>& s) {
-    const Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+    Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
     store_sample<layouts, with_lobes>(job, i, c.lobe, weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler), s, zero);
 }
 
@@ -89,7 +89,7 @@ PB_KERNEL_INLINE bool sample_compensated_batch(const SampleJob& job, std::int64_
     Shading<Floats> per_batch;
     MultipleScatteringLobe<Floats> per_batch_ms;
     if constexpr (per_element) {
-        const RawMaterial m = load_material(job.params, i);
+        RawMaterial m = load_material(job.params, i);
         per_batch = shading_of(m);
         per_batch_ms = multiple_scattering_of(m.slot, per_batch, model);
     }
@@ -97,10 +97,10 @@ PB_KERNEL_INLINE bool sample_compensated_batch(const SampleJob& job, std::int64_
     const MultipleScatteringLobe<Floats>& ms = per_element ? per_batch_ms : uniform_ms;
     Chosen c;
     if (!load_inputs<layouts>(job, i, seed, c)) return false;
-    const Floats missing_wo = ms.missing_energy(c.wo.z);
-    const Shading<Floats> s = with_multiple_scattering_weight(material, ms.weight(missing_wo));
+    Floats missing_wo = ms.missing_energy(c.wo.z);
+    Shading<Floats> s = with_multiple_scattering_weight(material, ms.weight(missing_wo));
     choose_lobe_for(c, s);
-    const CompensatedWeighed<Floats> cw =
+    CompensatedWeighed<Floats> cw =
             weigh_compensated<model>(c.wo, c.fv, c.weights, draw(job, c, s), s, ms, missing_wo, job.sampler);
     store_sample<layouts, with_lobes>(job, i, c.lobe, cw.weighed, s, cw.weighed.share(cw.multiple_scattering));
     return true;
@@ -189,14 +189,14 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
     MultipleScatteringLobe<Floats> uniform_ms{};
     BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
-        const RawMaterial m = load_material(job.params, 0);
+        RawMaterial m = load_material(job.params, 0);
         uniform = shading_of(m);
         if constexpr (compensated) {
             uniform_ms = multiple_scattering_of(m.slot, uniform, model);
             row.use_for(uniform_ms);
         }
     }
-    const CounterSeed seed = counter_seed(job.seed);
+    CounterSeed seed = counter_seed(job.seed);
     const std::int64_t batches = (end - begin) / kLanes;
     auto at = [&](std::int64_t b) { return begin + b * kLanes; };
     std::int64_t b = 0;
@@ -250,7 +250,7 @@ std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int
                        : sample_checked<model, per_element, Layouts::kMixed, false, true>(job, begin, end);
     // each lobe's share as well (the albedo's split): batch after batch, any layout
     if (job.lobe_weight[0].data != nullptr) return sample_checked<model, per_element, Layouts::kMixed, true>(job, begin, end);
-    const Vec3Layout layout = job.wo.layout;
+    Vec3Layout layout = job.wo.layout;
     const bool uniform_layout = (layout == Vec3Layout::kInterleaved || layout == Vec3Layout::kRows) &&
                                 job.wi.layout == layout && job.weight.layout == layout &&
                                 (job.u.data == nullptr || job.u.layout == layout);

@@ -48,11 +48,11 @@ PB_KERNEL_INLINE Floats unit_interval(UInts x) {
 // the key's part is one scalar and the rest fuses into one op on AVX-512.
 PB_KERNEL_INLINE Uniforms<Floats> counter_uniforms(std::uint64_t first, const CounterSeed& seed) {
     const std::uint32_t key = counter_key(seed, static_cast<std::uint32_t>(first >> 32));
-    const UInts key_shifted_in(key ^ (key >> 16));
-    const UInts first_spread(spread_counter(static_cast<std::uint32_t>(first)));
+    UInts key_shifted_in(key ^ (key >> 16));
+    UInts first_spread(spread_counter(static_cast<std::uint32_t>(first)));
     Floats u[3];
     for (int k = 0; k < 3; ++k) {
-        const UInts counter = UInts::load_aligned(kLaneCounters.lanes[k]) + first_spread;
+        UInts counter = UInts::load_aligned(kLaneCounters.lanes[k]) + first_spread;
         u[k] = unit_interval(lowbias32_rounds(counter ^ key_shifted_in ^ (counter >> 16)));
     }
     return {u[0], u[1], u[2]};

@@ -393,12 +393,12 @@ PB_KERNEL_INLINE Floats log(Floats x) {
     // getmant halves a mantissa of 1.5 or more, so that its exponent is getexp's plus one
     const __m512 exponent = _mm512_getexp_ps(x);
     const __m512 e = _mm512_mask_add_ps(exponent, _mm512_cmp_ps_mask(m, one, _CMP_LT_OQ), exponent, one);
-    const Floats s = Floats(_mm512_sub_ps(m, one)) * reciprocal(Floats(_mm512_add_ps(m, one)));
-    const Floats s2 = s * s;
+    Floats s = Floats(_mm512_sub_ps(m, one)) * reciprocal(Floats(_mm512_add_ps(m, one)));
+    Floats s2 = s * s;
     Floats series(1.0f / 9.0f);
     for (float coefficient : {1.0f / 7.0f, 1.0f / 5.0f, 1.0f / 3.0f, 1.0f})
         series = mul_add(series, s2, Floats(coefficient));
-    const Floats log_m = (s + s) * series;
+    Floats log_m = (s + s) * series;
     return mul_add(Floats(e), Floats(kLn2High), mul_add(Floats(e), Floats(kLn2Low), log_m));
 }
 #else
@@ -430,20 +430,20 @@ PB_KERNEL_INLINE Floats interval_end(Ints bits) {
 // gather_corners takes the offset off and clamps.
 static_assert(kFirstIntervalBits % 64 == 0, "1/8's bits >> 19 are 0 modulo 64");
 PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
-    const Ints bits = xsimd::bitwise_cast<Ints>(nu);
+    Ints bits = xsimd::bitwise_cast<Ints>(nu);
     return {bits >> kIntervalShift, interval_end(bits)};
 }
 #else
 // ν clamped to [1/8, 9/8] first, where μ = 1 starts its interval, a NaN to
 // 1/8: x86's max returns its second operand for a NaN, NEON's the NaN
 PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
-    const Floats offset(energy::kCosineOffset);
+    Floats offset(energy::kCosineOffset);
 #if defined(__ARM_NEON)
-    const Floats at_least_first = select(nu > offset, nu, offset);
+    Floats at_least_first = select(nu > offset, nu, offset);
 #else
-    const Floats at_least_first = max(nu, offset);
+    Floats at_least_first = max(nu, offset);
 #endif
-    const Ints bits = xsimd::bitwise_cast<Ints>(min(at_least_first, offset + Floats(1.0f)));
+    Ints bits = xsimd::bitwise_cast<Ints>(min(at_least_first, offset + Floats(1.0f)));
     return {(bits >> kIntervalShift) - Ints(kFirstIntervalBits), interval_end(bits)};
 }
 #endif
@@ -525,7 +525,7 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
 // 128-bit halves, then split into the nodes below and above. Scalar loads, not
 // gathers, which measured slower on Zen 3 (bench/RESULTS.md).
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints i) {
-    const LaneIndices index = lane_indices(i);
+    LaneIndices index = lane_indices(i);
     auto pairs = [&](int lane) {  // lanes l and l + 1: (t[i_l], t[i_l + 1], t[i_(l+1)], t[i_(l+1) + 1])
         const __m128d low = _mm_castsi128_pd(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(table + index[lane])));
         return _mm_castpd_ps(_mm_loadh_pd(low, reinterpret_cast<const double*>(table + index[lane + 1])));
@@ -576,9 +576,9 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
 // addresses' displacement)
 PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints row_offset, Ints interval) {
     static_assert(energy::kCorners == 4, "a corner is 4 floats");
-    const Ints last(kFirstIntervalBits + energy::kIntervals - 1);
+    Ints last(kFirstIntervalBits + energy::kIntervals - 1);
     // in floats, kCorners a corner (addresses scale by 4 at most)
-    const LaneIndices at = lane_indices((row_offset + xsimd::min(xsimd::max(interval, Ints(kFirstIntervalBits)), last)) << 2);
+    LaneIndices at = lane_indices((row_offset + xsimd::min(xsimd::max(interval, Ints(kFirstIntervalBits)), last)) << 2);
     auto corners_of = [&](int lane) { return _mm_load_ps(corners + (at[lane] - energy::kCorners * kFirstIntervalBits)); };
     auto blocks = [&](int r) {
         const __m512 low = _mm512_insertf32x4(_mm512_castps128_ps512(corners_of(r)), corners_of(4 + r), 1);
@@ -592,7 +592,7 @@ PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints
 }
 #elif defined(__AVX2__)
 PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints row_offset, Ints interval) {
-    const LaneIndices at = lane_indices((row_offset + interval) << 2);  // in floats, as above
+    LaneIndices at = lane_indices((row_offset + interval) << 2);  // in floats, as above
     auto corners_of = [&](int lane) { return _mm_load_ps(corners + at[lane]); };
     auto blocks = [&](int r) { return _mm256_set_m128(corners_of(4 + r), corners_of(r)); };
     const __m256 r0 = blocks(0), r1 = blocks(1), r2 = blocks(2), r3 = blocks(3);
@@ -621,15 +621,15 @@ PB_KERNEL_INLINE std::array<Floats, 4> gather_corners(const float* corners, Ints
 // under 8e-7 absolute after float rounding, against about 1e-7 for a
 // quadrant-reduced sincos; wi, pdf and weight stay consistent whatever φ is).
 PB_KERNEL_INLINE std::pair<Floats, Floats> sincos_turns(Floats u) {
-    const Floats t = u - 0.5f;
-    const Floats z = t * t;
+    Floats t = u - 0.5f;
+    Floats z = t * t;
     Floats p(0.1098245158791542f);
     for (float coefficient : {-0.8461116552352905f, 3.606354236602783f, -7.308245658874512f, 4.442883014678955f})
         p = mul_add(p, z, Floats(coefficient));
     Floats q(0.034501612186431885f);
     for (float coefficient : {-0.33225154876708984f, 1.888274908065796f, -5.73988151550293f, 6.9788641929626465f, -1.4142135381698608f})
         q = mul_add(q, z, Floats(coefficient));
-    const Floats root2_sin = t * p;
+    Floats root2_sin = t * p;
     return {root2_sin * q, mul_sub(root2_sin, root2_sin, Floats(1.0f))};
 }
 
@@ -638,12 +638,12 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> sincos_turns(Floats u) {
 // then e^x - 1 = 2^k (e^r - 1) + (2^k - 1), both terms of one sign for k >= 1, and
 // e^r - 1 = r (1 + r/2 + ... + r^6/7!) (Taylor). Relative error < 2e-7 over [0, 14].
 PB_KERNEL_INLINE Floats exp_minus_one(Floats x) {
-    const Ints k_int = xsimd::nearbyint_as_int(x * 1.44269504088896341f);  // one conversion on every instruction set
-    const Floats k = xsimd::to_float(k_int);
-    const Floats r = neg_mul_add(k, Floats(kLn2Low), neg_mul_add(k, Floats(kLn2High), x));
+    Ints k_int = xsimd::nearbyint_as_int(x * 1.44269504088896341f);  // one conversion on every instruction set
+    Floats k = xsimd::to_float(k_int);
+    Floats r = neg_mul_add(k, Floats(kLn2Low), neg_mul_add(k, Floats(kLn2High), x));
     Floats series(1.0f / 5040.0f);
     for (float coefficient : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f})
         series = mul_add(series, r, Floats(coefficient));
-    const Floats two_to_k = xsimd::bitwise_cast<Floats>((k_int + Ints(127)) << 23);
+    Floats two_to_k = xsimd::bitwise_cast<Floats>((k_int + Ints(127)) << 23);
     return mul_add(two_to_k, series * r, two_to_k - 1.0f);
 }

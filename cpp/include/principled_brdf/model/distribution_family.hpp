@@ -32,15 +32,15 @@ struct Stretch {
 
     // a = n·w / sqrt((w·x ax)² + (w·y ay)²) (Heitz 2014 eq. 80 gives the projected roughness), n·w >= 0; +inf at the normal
     PB_MODEL_INLINE F cot_projected(const Vec3<F>& w) const {
-        const F p2 = mul_add(alpha_x * alpha_x, w.x * w.x, (alpha_y * alpha_y) * (w.y * w.y));
+        F p2 = mul_add(alpha_x * alpha_x, w.x * w.x, (alpha_y * alpha_y) * (w.y * w.y));
         return w.z * reciprocal_sqrt(p2);
     }
 
     // the unnormalised half vector of stretched slope radius ρ at azimuth φ, ρ = +inf the horizon
     PB_MODEL_INLINE Vec3<F> slope_direction(F sin_phi, F cos_phi, F radius) const {
-        const MaskOf<F> steep = radius > F(1.0);
-        const F scale = select(steep, F(1.0), radius);
-        const F height = select(steep, reciprocal(radius), F(1.0));
+        MaskOf<F> steep = radius > F(1.0);
+        F scale = select(steep, F(1.0), radius);
+        F height = select(steep, reciprocal(radius), F(1.0));
         return {scale * (alpha_x * cos_phi), scale * (alpha_y * sin_phi), height};
     }
 };
@@ -50,7 +50,7 @@ struct Stretch {
 // for a < 1.6, else 0.
 template <class F>
 PB_MODEL_INLINE F beckmann_lambda_walter(F a) {
-    const F value = mul_add(a, mul_add(F(0.396), a, F(-1.259)), F(1.0)) * reciprocal(a * mul_add(F(2.181), a, F(3.535)));
+    F value = mul_add(a, mul_add(F(0.396), a, F(-1.259)), F(1.0)) * reciprocal(a * mul_add(F(2.181), a, F(3.535)));
     return select(a < F(1.6), value, F(0.0));
 }
 
@@ -77,7 +77,7 @@ struct StudentT {
     // D cos θh: P(ρ <= r) = 1 - (1 + r²/ν)^(1-γ), inverted in closed form,
     // ρ² = ν expm1(-ln(1 - u2) / ν)
     PB_MODEL_INLINE Vec3<F> sample_distribution(F sin_phi, F cos_phi, F u2) const {
-        const F radius2 = nu * exp_minus_one(-log_one_plus(-u2) * reciprocal(nu));
+        F radius2 = nu * exp_minus_one(-log_one_plus(-u2) * reciprocal(nu));
         return stretch.slope_direction(sin_phi, cos_phi, square_root(radius2));
     }
 };
@@ -103,8 +103,8 @@ struct ExponentialPower {
 
     // D cos θh: ρ^(2p) = P^-1(1/p, u2), the inverse regularised incomplete gamma function
     PB_MODEL_INLINE Vec3<F> sample_distribution(F sin_phi, F cos_phi, F u2) const {
-        const F s = reciprocal(p);
-        const F radius = pow(inverse_regularized_gamma_of(s, u2, F(1.0) - u2), F(0.5) * s);
+        F s = reciprocal(p);
+        F radius = pow(inverse_regularized_gamma_of(s, u2, F(1.0) - u2), F(0.5) * s);
         return stretch.slope_direction(sin_phi, cos_phi, radius);
     }
 };
@@ -126,10 +126,10 @@ struct BlinnPhong {
 
     // cos^e θh = exp(-e ln(1 + tan²θh) / 2), e from the squares of the half vector
     PB_MODEL_INLINE F d(const HalfVector<F>& h) const {
-        const F sin2 = h.hx2 + h.hy2;
-        const MaskOf<F> off_normal = sin2 > F(0.0);
-        const F e = mul_add(exponent_x, h.hx2, exponent_y * h.hy2) * reciprocal(select(off_normal, sin2, F(1.0)));
-        const F log_cos = F(-0.5) * log_one_plus(sin2 * reciprocal(h.hz2));
+        F sin2 = h.hx2 + h.hy2;
+        MaskOf<F> off_normal = sin2 > F(0.0);
+        F e = mul_add(exponent_x, h.hx2, exponent_y * h.hy2) * reciprocal(select(off_normal, sin2, F(1.0)));
+        F log_cos = F(-0.5) * log_one_plus(sin2 * reciprocal(h.hz2));
         // e = 0 (alpha 1) is cos⁰ = 1 even where ln cos θh = -inf
         return norm * exp(select(off_normal & (e > F(0.0)), e * log_cos, F(0.0)));
     }
@@ -139,12 +139,12 @@ struct BlinnPhong {
     // D cos θh (Ashikhmin & Shirley 2000): the azimuth of (ax cos 2πu1, ay sin 2πu1),
     // then cos θh = u2^(1/(e + 2)), sin²θh = -expm1(2 ln u2 / (e + 2))
     PB_MODEL_INLINE Vec3<F> sample_distribution(F sin_phi, F cos_phi, F u2) const {
-        const F x = beckmann.alpha_x * cos_phi, y = beckmann.alpha_y * sin_phi;
-        const F length2 = mul_add(x, x, y * y);
-        const F inv_length = reciprocal_sqrt(length2);
-        const F e = mul_add(exponent_x, x * x, exponent_y * (y * y)) * reciprocal(length2);
-        const F log_cos = log(u2) * reciprocal(e + F(2.0));
-        const F sin_theta = square_root(-exp_minus_one(F(2.0) * log_cos));
+        F x = beckmann.alpha_x * cos_phi, y = beckmann.alpha_y * sin_phi;
+        F length2 = mul_add(x, x, y * y);
+        F inv_length = reciprocal_sqrt(length2);
+        F e = mul_add(exponent_x, x * x, exponent_y * (y * y)) * reciprocal(length2);
+        F log_cos = log(u2) * reciprocal(e + F(2.0));
+        F sin_theta = square_root(-exp_minus_one(F(2.0) * log_cos));
         return {sin_theta * x * inv_length, sin_theta * y * inv_length, exp(log_cos)};
     }
 };

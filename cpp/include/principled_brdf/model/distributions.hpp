@@ -26,7 +26,7 @@ struct LogAlphaPartials {
 // Smith denominator in its stretched squared length q
 template <class F>
 PB_MODEL_INLINE F log_smith_denominator_partial(F cos_theta, F q) {
-    const F root = q * reciprocal_sqrt(q);
+    F root = q * reciprocal_sqrt(q);
     return reciprocal(F(2.0) * root * (cos_theta + root));
 }
 
@@ -55,8 +55,8 @@ struct Ggx {
 
     // D(h), h = H/|H|: norm |H|⁴ / (Hx²/ax² + Hy²/ay² + Hz²)²
     PB_MODEL_INLINE F d(const HalfVector<F>& h) const {
-        const F stretched = mul_add(h.hx2, inv_alpha_x2, mul_add(h.hy2, inv_alpha_y2, h.hz2));
-        const F root = h.h_len2 * reciprocal(stretched);
+        F stretched = mul_add(h.hx2, inv_alpha_x2, mul_add(h.hy2, inv_alpha_y2, h.hz2));
+        F root = h.h_len2 * reciprocal(stretched);
         return norm * root * root;
     }
 
@@ -82,16 +82,16 @@ struct Ggx {
     // log-derivatives of D: with tx = Hx²/ax², ty = Hy²/ay², s = tx + ty + Hz² and
     // D ∝ (|H|²/s)² / (ax ay):  ax ∂ln D/∂ax = 4 tx / s - 1, ay ∂ln D/∂ay = 4 ty / s - 1
     PB_MODEL_INLINE LogAlphaPartials<F> log_d_partials(const HalfVector<F>& h) const {
-        const F tx = h.hx2 * inv_alpha_x2, ty = h.hy2 * inv_alpha_y2;
+        F tx = h.hx2 * inv_alpha_x2, ty = h.hy2 * inv_alpha_y2;
         // s as d() forms it, so that the two share one reciprocal
-        const F inv_s = reciprocal(mul_add(h.hx2, inv_alpha_x2, mul_add(h.hy2, inv_alpha_y2, h.hz2)));
+        F inv_s = reciprocal(mul_add(h.hx2, inv_alpha_x2, mul_add(h.hy2, inv_alpha_y2, h.hz2)));
         return {F(2.0) * (tx + ty - h.hz2) * inv_s, F(4.0) * (tx - ty) * inv_s};
     }
 
     // log-derivatives of smith_denominator(w): ax ∂/∂ax = 2 (w·x ax)² ∂ln/∂q, the same in y
     PB_MODEL_INLINE LogAlphaPartials<F> log_smith_partials(const Vec3<F>& w) const {
-        const F by_q = F(2.0) * log_smith_denominator_partial(w.z, stretched_length2(w));
-        const F px = alpha_x2 * (w.x * w.x), py = alpha_y2 * (w.y * w.y);
+        F by_q = F(2.0) * log_smith_denominator_partial(w.z, stretched_length2(w));
+        F px = alpha_x2 * (w.x * w.x), py = alpha_y2 * (w.y * w.y);
         return {(px + py) * by_q, (px - py) * by_q};
     }
 
@@ -102,7 +102,7 @@ struct Ggx {
     // p² / (2 cos θ (cos θ + sqrt(cos²θ + p²))), which does not cancel as p -> 0
     // and is +inf at cos θ = 0, its value there
     PB_MODEL_INLINE F lambda(const Vec3<F>& w) const {
-        const F p2 = projected_length2(w);
+        F p2 = projected_length2(w);
         return p2 * reciprocal(F(2.0) * w.z * (w.z + square_root(mul_add(w.z, w.z, p2))));
     }
 
@@ -112,8 +112,8 @@ struct Ggx {
     // height-correlated G2 = 1 / (1 + Λ(wi) + Λ(wo)) (Heitz 2014 eq. 99) =
     // 2 cos θi cos θo / (cos θi |Vo| + cos θo |Vi|), V the stretched direction
     PB_MODEL_INLINE F g2_height_correlated(const Vec3<F>& wi, const Vec3<F>& wo) const {
-        const F length_i = square_root(stretched_length2(wi)), length_o = square_root(stretched_length2(wo));
-        const F denominator = mul_add(wi.z, length_o, wo.z * length_i);
+        F length_i = square_root(stretched_length2(wi)), length_o = square_root(stretched_length2(wo));
+        F denominator = mul_add(wi.z, length_o, wo.z * length_i);
         // a quotient, not a reciprocal: the denominator may be subnormal
         return select(denominator > F(0.0), F(2.0) * wi.z * wo.z / denominator, F(0.0));
     }
@@ -135,17 +135,17 @@ struct Ggx {
     // visible normals of wo, n·wo > 0: the cap point about V / L, offset by it,
     // scaled by L and unstretched: d = (ax (L sin θ cos φ + V.x), ay (L sin θ sin φ + V.y), L cos θ + V.z)
     PB_MODEL_INLINE Vec3<F> sample_visible(const Vec3<F>& wo, F sin_phi, F cos_phi, F u2) const {
-        const Vec3<F> v = stretch(wo);
-        const F length2 = squared_length(v);
-        const F scaled_cos = cap_scaled_cos(u2, square_root(length2), v.z);
-        const F scaled_sin = square_root(neg_mul_add(scaled_cos, scaled_cos, length2));
+        Vec3<F> v = stretch(wo);
+        F length2 = squared_length(v);
+        F scaled_cos = cap_scaled_cos(u2, square_root(length2), v.z);
+        F scaled_sin = square_root(neg_mul_add(scaled_cos, scaled_cos, length2));
         return {alpha_x * mul_add(scaled_sin, cos_phi, v.x), alpha_y * mul_add(scaled_sin, sin_phi, v.y),
                 max(scaled_cos + v.z, F(0.0))};
     }
 
     // the distribution, D cos θh (Burley 2012 eq. 14-15): d = (ax sqrt(u2) cos φ, ay sqrt(u2) sin φ, sqrt(1 - u2))
     PB_MODEL_INLINE Vec3<F> sample_distribution(F sin_phi, F cos_phi, F u2) const {
-        const F radius = square_root(u2);
+        F radius = square_root(u2);
         return {alpha_x * radius * cos_phi, alpha_y * radius * sin_phi, square_root(F(1.0) - u2)};
     }
 };
@@ -178,8 +178,8 @@ struct Beckmann {
     // D(h) for h = H/|H|, h·n > 0; ln cos θh from Hz itself, which stays
     // finite where Hz² underflows (the stretched tan² is then +inf, D 0)
     PB_MODEL_INLINE F d(const HalfVector<F>& h) const {
-        const F tan2_stretched = mul_add(h.hx2, inv_alpha_x2, h.hy2 * inv_alpha_y2) * reciprocal(h.hz2);
-        const F log_cos = log(h.hz * reciprocal_sqrt(h.h_len2));
+        F tan2_stretched = mul_add(h.hx2, inv_alpha_x2, h.hy2 * inv_alpha_y2) * reciprocal(h.hz2);
+        F log_cos = log(h.hz * reciprocal_sqrt(h.h_len2));
         return norm * exp(neg_mul_add(F(4.0), log_cos, -tan2_stretched));
     }
 
@@ -187,9 +187,9 @@ struct Beckmann {
     //   Λ = (erf(a) - 1)/2 + exp(-a²) / (2 a sqrt(π)),  a = cos θ / sqrt((w·x ax)² + (w·y ay)²),
     // with erf(a) - 1 = -erfc(a); 0 at the normal (p = 0), +inf at grazing
     PB_MODEL_INLINE F lambda(const Vec3<F>& w) const {
-        const F p2 = mul_add(alpha_x2, w.x * w.x, alpha_y2 * (w.y * w.y));
-        const F a = w.z * reciprocal_sqrt(p2);
-        const F value = mul_add(F(-0.5), erfc(a), exp(-a * a) * reciprocal(F(2.0 * kSqrtPi) * a));
+        F p2 = mul_add(alpha_x2, w.x * w.x, alpha_y2 * (w.y * w.y));
+        F a = w.z * reciprocal_sqrt(p2);
+        F value = mul_add(F(-0.5), erfc(a), exp(-a * a) * reciprocal(F(2.0 * kSqrtPi) * a));
         return select(p2 > F(0.0), value, F(0.0));
     }
 
@@ -199,10 +199,10 @@ struct Beckmann {
     // d = (ρ ax cos φ, ρ ay sin φ, 1), divided by ρ where ρ > 1 (it is only a
     // direction) and the tangent itself at u2 = 1
     PB_MODEL_INLINE Vec3<F> sample_distribution(F sin_phi, F cos_phi, F u2) const {
-        const F radius = square_root(-log_one_plus(-u2));
-        const MaskOf<F> steep = radius > F(1.0);
-        const F tangent_scale = select(steep, F(1.0), radius);
-        const F height = select(u2 < F(1.0), select(steep, reciprocal(radius), F(1.0)), F(0.0));
+        F radius = square_root(-log_one_plus(-u2));
+        MaskOf<F> steep = radius > F(1.0);
+        F tangent_scale = select(steep, F(1.0), radius);
+        F height = select(u2 < F(1.0), select(steep, reciprocal(radius), F(1.0)), F(0.0));
         return {tangent_scale * (alpha_x * cos_phi), tangent_scale * (alpha_y * sin_phi), height};
     }
 };
@@ -225,7 +225,7 @@ PB_MODEL_INLINE F smith_denominator_iso(const Vec3<F>& w, F a2) {
 // (e^x - 1) / x given e^x - 1, 1 at x = 0
 template <class F>
 PB_MODEL_INLINE F ratio_exp_minus_one(F x, F exp_minus_one_of_x) {
-    const MaskOf<F> zero = x == F(0.0);
+    MaskOf<F> zero = x == F(0.0);
     return select(zero, F(1.0), exp_minus_one_of_x * reciprocal(select(zero, F(1.0), x)));
 }
 
@@ -235,7 +235,7 @@ PB_MODEL_INLINE F exp_minus_one_over_x(F x) { return ratio_exp_minus_one(x, exp_
 // ∂ln smith_denominator_iso(w, a2)/∂a2 = ((w·x)² + (w·y)²) ∂ln/∂q
 template <class F>
 PB_MODEL_INLINE F log_smith_denominator_iso_partial(const Vec3<F>& w, F a2) {
-    const F sin2 = mul_add(w.x, w.x, w.y * w.y);
+    F sin2 = mul_add(w.x, w.x, w.y * w.y);
     return sin2 * log_smith_denominator_partial(w.z, mul_add(a2, sin2, w.z * w.z));
 }
 
@@ -258,7 +258,7 @@ struct Gtr1 {
         d.log_alpha2 = log(d.alpha2);
         // a² - 1 itself keeps its digits while a² is small (the clearcoat's a <= 0.1, so
         // the kernels never take e^L - 1); e^L - 1 keeps them as a -> 1
-        const F alpha2_minus_1 = all(d.alpha2 <= F(0.25)) ? d.alpha2 - F(1.0) : exp_minus_one(d.log_alpha2);
+        F alpha2_minus_1 = all(d.alpha2 <= F(0.25)) ? d.alpha2 - F(1.0) : exp_minus_one(d.log_alpha2);
         d.inv_one_minus_alpha2 = -reciprocal(alpha2_minus_1);
         d.norm = F(kInvPi) * ratio_exp_minus_one(d.log_alpha2, alpha2_minus_1);
         d.sin2_scale = d.alpha2 * d.inv_one_minus_alpha2;
@@ -275,7 +275,7 @@ struct Gtr1 {
 
     // ∂ln D/∂a² = 1/(a² - 1) - 1/(a² ln a²) - Hz² / denominator
     PB_MODEL_INLINE F log_d_partial_alpha2(const HalfVector<F>& h) const {
-        const F log_norm = -inv_one_minus_alpha2 - reciprocal(alpha2 * log_alpha2);
+        F log_norm = -inv_one_minus_alpha2 - reciprocal(alpha2 * log_alpha2);
         return neg_mul_add(h.hz2, reciprocal(denominator(h)), log_norm);
     }
 
@@ -294,9 +294,9 @@ struct Gtr1 {
 // cancels nor overflows.
 template <class F>
 PB_MODEL_INLINE F log_mix_exp(F weight, F weight_complement, F z) {
-    const F y = weight * exp_minus_one(min(z, F(700.0)));
-    const MaskOf<F> small = (z < F(700.0)) & (y <= F(0.5)) & (y >= F(-0.5));
-    const F large = select(z > F(0.0), z + log(mul_add(weight_complement, exp(-z), weight)),
+    F y = weight * exp_minus_one(min(z, F(700.0)));
+    MaskOf<F> small = (z < F(700.0)) & (y <= F(0.5)) & (y >= F(-0.5));
+    F large = select(z > F(0.0), z + log(mul_add(weight_complement, exp(-z), weight)),
                            log(mul_add(weight, exp(min(z, F(0.0))), weight_complement)));
     return select(small, log_one_plus(y), large);
 }
@@ -326,9 +326,9 @@ struct Gtr {
         d.log_alpha2 = F(2.0) * log(alpha);
         d.gamma = gamma;
         d.k = F(1.0) - gamma;
-        const F x = d.k * d.log_alpha2;
+        F x = d.k * d.log_alpha2;
         d.ratio_form = x > F(0.0);
-        const F normaliser_l = exp_minus_one_over_x(d.log_alpha2) * F(kInvPi);
+        F normaliser_l = exp_minus_one_over_x(d.log_alpha2) * F(kInvPi);
         d.norm = select(d.ratio_form, normaliser_l * reciprocal(exp_minus_one_over_x(-x)) * reciprocal(d.alpha2),
                         normaliser_l * reciprocal(exp_minus_one_over_x(x)));
         return d;
@@ -336,26 +336,26 @@ struct Gtr {
 
     // D for cos²θh > 0
     PB_MODEL_INLINE F d(F cos2, F sin2) const {
-        const F t = mul_add(alpha2, cos2, sin2);
+        F t = mul_add(alpha2, cos2, sin2);
         return norm * select(ratio_form, pow(alpha2 * reciprocal(t), gamma), pow(t, -gamma));
     }
 
     // (cos²θh, sin²θh) of the draw at u2 < 1 (u2 = 1: the horizon, (0, 1))
     PB_MODEL_INLINE std::pair<F, F> draw_cos2_sin2(F u2) const {
-        const F one(1.0), zero(0.0);
-        const F u_complement = one - u2;
-        const MaskOf<F> exponential = k == zero;  // γ = 1: eq. 5
-        const F safe_k = select(exponential, one, k);
-        const F m = select(exponential, u_complement * log_alpha2,
+        F one(1.0), zero(0.0);
+        F u_complement = one - u2;
+        MaskOf<F> exponential = k == zero;  // γ = 1: eq. 5
+        F safe_k = select(exponential, one, k);
+        F m = select(exponential, u_complement * log_alpha2,
                            log_mix_exp(u_complement, u2, k * log_alpha2) * reciprocal(safe_k));
-        const F q = select(exponential, -u2 * log_alpha2, log_mix_exp(u2, u_complement, -k * log_alpha2) * reciprocal(safe_k));
-        const F inv_expm1_l = reciprocal(exp_minus_one(log_alpha2));
-        const F cos2 = exp_minus_one(m) * inv_expm1_l;
-        const F sin2 = exp(m) * exp_minus_one(-q) * inv_expm1_l;
-        const MaskOf<F> uniform = log_alpha2 == zero;  // a = 1: cos²θh uniform
-        const MaskOf<F> horizon = u2 >= one;
-        const F cos2_drawn = select(horizon, zero, select(uniform, u_complement, min(max(cos2, zero), one)));
-        const F sin2_drawn = select(horizon, one, select(uniform, u2, min(max(sin2, zero), one)));
+        F q = select(exponential, -u2 * log_alpha2, log_mix_exp(u2, u_complement, -k * log_alpha2) * reciprocal(safe_k));
+        F inv_expm1_l = reciprocal(exp_minus_one(log_alpha2));
+        F cos2 = exp_minus_one(m) * inv_expm1_l;
+        F sin2 = exp(m) * exp_minus_one(-q) * inv_expm1_l;
+        MaskOf<F> uniform = log_alpha2 == zero;  // a = 1: cos²θh uniform
+        MaskOf<F> horizon = u2 >= one;
+        F cos2_drawn = select(horizon, zero, select(uniform, u_complement, min(max(cos2, zero), one)));
+        F sin2_drawn = select(horizon, one, select(uniform, u2, min(max(sin2, zero), one)));
         return {cos2_drawn, sin2_drawn};
     }
 };

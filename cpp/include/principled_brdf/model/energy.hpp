@@ -58,9 +58,9 @@ struct MultipleScatteringLobe {
     // 1 - E(μ) at r_eff: linear in μ within each interval, linear in r between the rows
     // (for μ in [0, 1 + 1/16); below the surface, where the lobe is discarded, some finite value)
     PB_MODEL_INLINE F missing_energy(F mu) const {
-        const F offset(energy::kCosineOffset);
+        F offset(energy::kCosineOffset);
         const auto [interval, end] = energy_interval(mu + offset);
-        const F along = mu - (end - offset);  // <= 0
+        F along = mu - (end - offset);  // <= 0
         if (single_row) {
             const auto [value, slope] = value_and_slope_in_row(missing, interval);
             return mul_add(along, slope, value);
@@ -86,27 +86,27 @@ struct MultipleScatteringLobe {
 // For a material of kParamSlots values (params.hpp's order) and its Shading.
 template <class F>
 PB_MODEL_INLINE MultipleScatteringLobe<F> multiple_scattering_of(const F* p, const Shading<F>& s, Model model) {
-    const F one(1.0);
+    F one(1.0);
     MultipleScatteringLobe<F> ms;
     ms.missing = energy::kMissing[static_cast<int>(model)];
     ms.corners = energy::kMissingCorners[static_cast<int>(model)];
     // r_eff clamped to the tables' [0, 1]
-    const F y = min(max(p[kRoughness], F(0.0)), one) * F(energy::kRoughnesses - 1);
-    const IndexOf<F> j = min(truncate_to_index(y), IndexOf<F>(energy::kRoughnesses - 2));
+    F y = min(max(p[kRoughness], F(0.0)), one) * F(energy::kRoughnesses - 1);
+    IndexOf<F> j = min(truncate_to_index(y), IndexOf<F>(energy::kRoughnesses - 2));
     ms.row = {truncate_to_index(index_to_real(j) * F(energy::kIntervals)), y - index_to_real(j)};
     const float* average = energy::kMissingAverage[static_cast<int>(model)];
     const auto [average_j, average_next] = gather_pair_in_row<energy::kRoughnesses - 1>(average, j);
-    const F missing_average = mix(average_j, average_next, ms.row.fraction);
-    const F e_average = one - missing_average;
+    F missing_average = mix(average_j, average_next, ms.row.fraction);
+    F e_average = one - missing_average;
     // F_avg = (20 Cspec0 + 1) / 21 per channel, at most 1 (Cspec0 > 1 for a base_color or
     // specular past the physical range, where 1 - F_avg (1 - E_avg) could reach 0)
     auto factor = [&](F f0) {
-        const F f_avg = min(mul_add(F(20.0 / 21.0), f0, F(1.0 / 21.0)), F(1.0));
+        F f_avg = min(mul_add(F(20.0 / 21.0), f0, F(1.0 / 21.0)), F(1.0));
         return f_avg * f_avg * e_average * reciprocal(neg_mul_add(f_avg, missing_average, one));
     };
-    const Rgb<F> tint{factor(s.specular.f0.r), factor(s.specular.f0.g), factor(s.specular.f0.b)};
+    Rgb<F> tint{factor(s.specular.f0.r), factor(s.specular.f0.g), factor(s.specular.f0.b)};
     ms.albedo_scale = luminance_of(tint);
-    const F norm = F(kInvPi) * reciprocal(max(missing_average, F(1e-7)));
+    F norm = F(kInvPi) * reciprocal(max(missing_average, F(1e-7)));
     ms.color = norm * tint;
     return ms;
 }
@@ -138,9 +138,9 @@ PB_MODEL_INLINE CompensatedWeighed<F> weigh_compensated(const Vec3<F>& wo, F fv,
     CompensatedWeighed<F> out;
     out.weighed = weigh<model>(wo, fv, weights, drawn, compensated, sampler);
     Weighed<F>& w = out.weighed;
-    const Geometry<F> g = geometry_of(drawn.wi, wo);
+    Geometry<F> g = geometry_of(drawn.wi, wo);
     out.multiple_scattering = ms.rgb(ms.value(g, missing_wo));
-    const Rgb<F> share = w.share(out.multiple_scattering);
+    Rgb<F> share = w.share(out.multiple_scattering);
     w.weight = {w.weight.r + share.r, w.weight.g + share.g, w.weight.b + share.b};
     return out;
 }

@@ -45,21 +45,21 @@ struct MaterialPartials {
 
 template <class F>
 PB_MODEL_INLINE MaterialPartials<F> material_partials_of(const F* p) {
-    const F zero(0.0), one(1.0);
-    const Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
-    const F metallic = p[kMetallic], dielectric = one - metallic;
-    const F luminance = luminance_of(base);
-    const MaskOf<F> has_luminance = luminance > zero;
-    const F inv_luminance = reciprocal(select(has_luminance, luminance, one));
-    const Rgb<F> tint{select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
+    F zero(0.0), one(1.0);
+    Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
+    F metallic = p[kMetallic], dielectric = one - metallic;
+    F luminance = luminance_of(base);
+    MaskOf<F> has_luminance = luminance > zero;
+    F inv_luminance = reciprocal(select(has_luminance, luminance, one));
+    Rgb<F> tint{select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
                       select(has_luminance, base.b * inv_luminance, one)};
     const F weight_of[3] = {F(0.3), F(0.6), F(0.1)};  // lum's weights
-    const F sheen = p[kSheen], sheen_tint = p[kSheenTint];
-    const F specular_scale = F(0.08) * p[kSpecular], specular_tint = p[kSpecularTint];
-    const Rgb<F> white{one, one, one};
-    const Rgb<F> sheen_mix = mix(white, tint, sheen_tint);        // Csheen
-    const Rgb<F> specular_mix = mix(white, tint, specular_tint);  // mix(1, Ctint, specular_tint)
-    const Rgb<F> tint_minus_one{tint.r - one, tint.g - one, tint.b - one};
+    F sheen = p[kSheen], sheen_tint = p[kSheenTint];
+    F specular_scale = F(0.08) * p[kSpecular], specular_tint = p[kSpecularTint];
+    Rgb<F> white{one, one, one};
+    Rgb<F> sheen_mix = mix(white, tint, sheen_tint);        // Csheen
+    Rgb<F> specular_mix = mix(white, tint, specular_tint);  // mix(1, Ctint, specular_tint)
+    Rgb<F> tint_minus_one{tint.r - one, tint.g - one, tint.b - one};
 
     MaterialPartials<F> d;
     d.dielectric_over_pi = dielectric * F(kInvPi);
@@ -81,25 +81,25 @@ PB_MODEL_INLINE MaterialPartials<F> material_partials_of(const F* p) {
 
     // ax = max(0.001, r² / aspect), ay = max(0.001, r² aspect), aspect = sqrt(1 - 0.9 anisotropic):
     // ∂ln ax/∂r = ∂ln ay/∂r = 2 / r, ∂ln ax/∂anisotropic = -∂ln ay/∂anisotropic = 0.45 / aspect²
-    const F roughness = p[kRoughness];
-    const F aspect2 = neg_mul_add(F(0.9), p[kAnisotropic], one);
-    const F inv_aspect = reciprocal_sqrt(aspect2);
-    const F alpha = roughness * roughness;
-    const MaskOf<F> x_active = alpha * inv_aspect > F(0.001), y_active = alpha * (aspect2 * inv_aspect) > F(0.001);
-    const F log_roughness = F(2.0) * reciprocal(select(x_active | y_active, roughness, one));
-    const F log_aspect = F(0.45) * reciprocal(aspect2);
-    const F x_roughness = select(x_active, log_roughness, zero), y_roughness = select(y_active, log_roughness, zero);
-    const F x_anisotropic = select(x_active, log_aspect, zero), y_anisotropic = select(y_active, -log_aspect, zero);
-    const F half(0.5);
+    F roughness = p[kRoughness];
+    F aspect2 = neg_mul_add(F(0.9), p[kAnisotropic], one);
+    F inv_aspect = reciprocal_sqrt(aspect2);
+    F alpha = roughness * roughness;
+    MaskOf<F> x_active = alpha * inv_aspect > F(0.001), y_active = alpha * (aspect2 * inv_aspect) > F(0.001);
+    F log_roughness = F(2.0) * reciprocal(select(x_active | y_active, roughness, one));
+    F log_aspect = F(0.45) * reciprocal(aspect2);
+    F x_roughness = select(x_active, log_roughness, zero), y_roughness = select(y_active, log_roughness, zero);
+    F x_anisotropic = select(x_active, log_aspect, zero), y_anisotropic = select(y_active, -log_aspect, zero);
+    F half(0.5);
     d.roughness_sum = half * (x_roughness + y_roughness);
     d.roughness_difference = half * (x_roughness - y_roughness);
     d.anisotropic_sum = half * (x_anisotropic + y_anisotropic);
     d.anisotropic_difference = half * (x_anisotropic - y_anisotropic);
     // alpha_g² = ((0.5 + roughness / 2)²)²: ∂/∂roughness = 2 alpha_g³
-    const F alpha_g = mul_add(F(0.5), roughness, F(0.5));
+    F alpha_g = mul_add(F(0.5), roughness, F(0.5));
     d.alpha_g2_roughness = F(2.0) * alpha_g * alpha_g * alpha_g;
     // ac = mix(0.1, 0.001, gloss) = 0.1 - 0.099 gloss: ∂ac²/∂gloss = -0.198 ac
-    const F clearcoat_alpha = mix(F(0.1), F(0.001), p[kClearcoatGloss]);
+    F clearcoat_alpha = mix(F(0.1), F(0.001), p[kClearcoatGloss]);
     d.clearcoat_alpha2_gloss = F(-0.198) * clearcoat_alpha;
     return d;
 }
@@ -109,8 +109,8 @@ PB_MODEL_INLINE MaterialPartials<F> material_partials_of(const F* p) {
 // with m = clamp(1 - cos θd) and 1 - m taken as cos θd itself.
 template <class F>
 PB_MODEL_INLINE F one_minus_schlick_weight(const Geometry<F>& g) {
-    const F one(1.0), zero(0.0);
-    const F m = min(max(g.one_minus_cos_theta_d, zero), one);
+    F one(1.0), zero(0.0);
+    F m = min(max(g.one_minus_cos_theta_d, zero), one);
     return min(max(g.cos_theta_d, zero), one) * mul_add(m, mul_add(m, mul_add(m, m + one, one), one), one);
 }
 
@@ -124,34 +124,34 @@ PB_MODEL_INLINE F one_minus_schlick_weight(const Geometry<F>& g) {
 template <Model model, class F, class Weigh, class Sink>
 PB_MODEL_INLINE Rgb<F> eval_gradient(const Geometry<F>& g, const Shading<F>& s, const View<F>& view,
                                      const MaterialPartials<F>& d, const Weigh& weigh, Sink&& jacobian) {
-    const LobeValues<F> lobes = eval_lobes<model>(g, s, view);
-    const F fh = lobes.fh, one_minus_fh = one_minus_schlick_weight(g);
+    LobeValues<F> lobes = eval_lobes<model>(g, s, view);
+    F fh = lobes.fh, one_minus_fh = one_minus_schlick_weight(g);
     // D, S, C per unit clearcoat, with their partials
-    const DiffusePartials<F> diffuse = diffuse_partials(s.diffuse, g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
-    const LogAlphaPartials<F> log_specular = s.specular.template log_value_partials<model>(g);
+    DiffusePartials<F> diffuse = diffuse_partials(s.diffuse, g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
+    LogAlphaPartials<F> log_specular = s.specular.template log_value_partials<model>(g);
     F log_specular_roughness = mul_add(log_specular.sum, d.roughness_sum, log_specular.difference * d.roughness_difference);
     if constexpr (model == Model::kDisney2012)
         log_specular_roughness = mul_add(s.specular.log_value_partial_alpha_g2(g), d.alpha_g2_roughness, log_specular_roughness);
-    const F log_specular_anisotropic =
+    F log_specular_anisotropic =
             mul_add(log_specular.sum, d.anisotropic_sum, log_specular.difference * d.anisotropic_difference);
-    const F clearcoat_unit_raw = s.clearcoat.unit_value(g, fh);
-    const F clearcoat_gloss = weigh(F(4.0) * s.clearcoat.lobe_weight * clearcoat_unit_raw *
+    F clearcoat_unit_raw = s.clearcoat.unit_value(g, fh);
+    F clearcoat_gloss = weigh(F(4.0) * s.clearcoat.lobe_weight * clearcoat_unit_raw *
                                     s.clearcoat.gtr1.log_d_partial_alpha2(g) * d.clearcoat_alpha2_gloss);
     // the weighed scalars (fh and 1 - fh stay as they are inside specular_factor, a finite factor)
-    const F specular_roughness = weigh(lobes.specular * log_specular_roughness);
-    const F specular_anisotropic = weigh(lobes.specular * log_specular_anisotropic);
-    const F clearcoat_unit = weigh(clearcoat_unit_raw);
-    const F diffuse_value = weigh(lobes.diffuse), diffuse_roughness = weigh(diffuse.roughness);
-    const F diffuse_subsurface = weigh(diffuse.subsurface), fh_weighed = weigh(fh);
-    const F specular_tinted = weigh(lobes.specular * one_minus_fh);  // T
+    F specular_roughness = weigh(lobes.specular * log_specular_roughness);
+    F specular_anisotropic = weigh(lobes.specular * log_specular_anisotropic);
+    F clearcoat_unit = weigh(clearcoat_unit_raw);
+    F diffuse_value = weigh(lobes.diffuse), diffuse_roughness = weigh(diffuse.roughness);
+    F diffuse_subsurface = weigh(diffuse.subsurface), fh_weighed = weigh(fh);
+    F specular_tinted = weigh(lobes.specular * one_minus_fh);  // T
 
     // base_color: ∂f_c/∂base_k = δ_ck (D (1 - metallic)/π + T metallic) + (FH sheen_tint_scale + T specular_tint_scale) ∂Ctint_c/∂base_k
-    const F own_channel = mul_add(diffuse_value, d.dielectric_over_pi, specular_tinted * d.metallic);
-    const F through_tint = mul_add(fh_weighed, d.sheen_tint_scale, specular_tinted * d.specular_tint_scale);
+    F own_channel = mul_add(diffuse_value, d.dielectric_over_pi, specular_tinted * d.metallic);
+    F through_tint = mul_add(fh_weighed, d.sheen_tint_scale, specular_tinted * d.specular_tint_scale);
     for (int c = 0; c < 3; ++c) {
-        const F dc = channel_of(s.diffuse.color, c), f0 = channel_of(s.specular.f0, c);
+        F dc = channel_of(s.diffuse.color, c), f0 = channel_of(s.specular.f0, c);
         for (int k = 0; k < 3; ++k) {
-            const F tinted = through_tint * d.tint_base[c][k];
+            F tinted = through_tint * d.tint_base[c][k];
             jacobian(c, kBaseColorR + k, c == k ? own_channel + tinted : tinted);
         }
         jacobian(c, kMetallic,
@@ -160,7 +160,7 @@ PB_MODEL_INLINE Rgb<F> eval_gradient(const Geometry<F>& g, const Shading<F>& s, 
         jacobian(c, kSubsurface, diffuse_subsurface * dc);
         jacobian(c, kSpecular, specular_tinted * channel_of(d.f0_specular, c));
         jacobian(c, kSpecularTint, specular_tinted * channel_of(d.f0_specular_tint, c));
-        const F specular_factor = mul_add(one_minus_fh, f0, fh);  // ∂f_c/∂S = (1 - FH) f0_c + FH
+        F specular_factor = mul_add(one_minus_fh, f0, fh);  // ∂f_c/∂S = (1 - FH) f0_c + FH
         jacobian(c, kRoughness, mul_add(diffuse_roughness, dc, specular_roughness * specular_factor));
         jacobian(c, kAnisotropic, specular_anisotropic * specular_factor);
         jacobian(c, kSheen, fh_weighed * channel_of(d.sheen_sheen, c));

@@ -21,7 +21,7 @@ PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
     // by component: after an aggregate copy GCC kept the directions on the stack in the kernels' loops
     g.wi.x = wi.x; g.wi.y = wi.y; g.wi.z = wi.z;
     g.wo.x = wo.x; g.wo.y = wo.y; g.wo.z = wo.z;
-    const F hx = wi.x + wo.x, hy = wi.y + wo.y;
+    F hx = wi.x + wo.x, hy = wi.y + wo.y;
     g.hz = wi.z + wo.z;
     g.hx2 = hx * hx;
     g.hy2 = hy * hy;
@@ -29,8 +29,8 @@ PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
     g.h_len2 = g.hx2 + g.hy2 + g.hz2;
     g.finite = g.h_len2 <= largest_finite(g.h_len2);
     g.cos_theta_d = F(0.5) * g.h_len2 * reciprocal_sqrt(g.h_len2);
-    const F dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
-    const F d_len2 = mul_add(dx, dx, mul_add(dy, dy, dz * dz));
+    F dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
+    F d_len2 = mul_add(dx, dx, mul_add(dy, dy, dz * dz));
     g.one_minus_cos_theta_d = d_len2 * reciprocal(mul_add(F(4.0), g.cos_theta_d, F(4.0)));
     return g;
 }
@@ -55,17 +55,17 @@ struct DiffuseLobe {
     // the scalar factor of color (with_subsurface false: for a subsurface of 0, known)
     template <bool with_subsurface = true>
     PB_MODEL_INLINE F value(const Geometry<F>& g, const Fresnel<F>& fresnel) const {
-        const F one(1.0);
-        const F cos2_theta_d = F(0.25) * g.h_len2;
-        const F fd90_minus_1 = mul_add(F(2.0) * roughness, cos2_theta_d, F(-0.5));
-        const F fd = mul_add(fd90_minus_1, fresnel.fl, one) * mul_add(fd90_minus_1, fresnel.fv, one);
+        F one(1.0);
+        F cos2_theta_d = F(0.25) * g.h_len2;
+        F fd90_minus_1 = mul_add(F(2.0) * roughness, cos2_theta_d, F(-0.5));
+        F fd = mul_add(fd90_minus_1, fresnel.fl, one) * mul_add(fd90_minus_1, fresnel.fv, one);
         // Skipped when 0 in every lane: for a uniform material the test has the
         // same outcome for every batch, and mix(fd, ss, 0) = fd bit for bit.
         if (!with_subsurface || !any(subsurface != F(0.0))) return fd;
-        const F fss90_minus_1 = mul_sub(roughness, cos2_theta_d, one);
-        const F fss = mul_add(fss90_minus_1, fresnel.fl, one) * mul_add(fss90_minus_1, fresnel.fv, one);
-        const F inv_cos_sum = reciprocal(g.wi.z + g.wo.z);
-        const F ss = F(1.25) * mul_add(fss, inv_cos_sum - F(0.5), F(0.5));
+        F fss90_minus_1 = mul_sub(roughness, cos2_theta_d, one);
+        F fss = mul_add(fss90_minus_1, fresnel.fl, one) * mul_add(fss90_minus_1, fresnel.fv, one);
+        F inv_cos_sum = reciprocal(g.wi.z + g.wo.z);
+        F ss = F(1.25) * mul_add(fss, inv_cos_sum - F(0.5), F(0.5));
         return mix(fd, ss, subsurface);
     }
 };
@@ -80,18 +80,18 @@ struct DiffusePartials {
 // in roughness, (1 + (F90 - 1) FL)(1 + (F90 - 1) FV), and D = mix(fd, ss, subsurface)
 template <class F>
 PB_MODEL_INLINE DiffusePartials<F> diffuse_partials(const DiffuseLobe<F>& lobe, const Geometry<F>& g, const Fresnel<F>& fresnel) {
-    const F one(1.0), half(0.5);
-    const F cos2_theta_d = F(0.25) * g.h_len2;
-    const F fd90_minus_1 = mul_add(F(2.0) * lobe.roughness, cos2_theta_d, F(-0.5));
-    const F fd_l = mul_add(fd90_minus_1, fresnel.fl, one), fd_v = mul_add(fd90_minus_1, fresnel.fv, one);
-    const F fd = fd_l * fd_v;
-    const F fd_roughness = F(2.0) * cos2_theta_d * mul_add(fresnel.fl, fd_v, fresnel.fv * fd_l);
-    const F fss90_minus_1 = mul_sub(lobe.roughness, cos2_theta_d, one);
-    const F fss_l = mul_add(fss90_minus_1, fresnel.fl, one), fss_v = mul_add(fss90_minus_1, fresnel.fv, one);
-    const F fss_roughness = cos2_theta_d * mul_add(fresnel.fl, fss_v, fresnel.fv * fss_l);
-    const F inv_cos_sum_minus_half = reciprocal(g.wi.z + g.wo.z) - half;
-    const F ss = F(1.25) * mul_add(fss_l * fss_v, inv_cos_sum_minus_half, half);
-    const F ss_roughness = F(1.25) * fss_roughness * inv_cos_sum_minus_half;
+    F one(1.0), half(0.5);
+    F cos2_theta_d = F(0.25) * g.h_len2;
+    F fd90_minus_1 = mul_add(F(2.0) * lobe.roughness, cos2_theta_d, F(-0.5));
+    F fd_l = mul_add(fd90_minus_1, fresnel.fl, one), fd_v = mul_add(fd90_minus_1, fresnel.fv, one);
+    F fd = fd_l * fd_v;
+    F fd_roughness = F(2.0) * cos2_theta_d * mul_add(fresnel.fl, fd_v, fresnel.fv * fd_l);
+    F fss90_minus_1 = mul_sub(lobe.roughness, cos2_theta_d, one);
+    F fss_l = mul_add(fss90_minus_1, fresnel.fl, one), fss_v = mul_add(fss90_minus_1, fresnel.fv, one);
+    F fss_roughness = cos2_theta_d * mul_add(fresnel.fl, fss_v, fresnel.fv * fss_l);
+    F inv_cos_sum_minus_half = reciprocal(g.wi.z + g.wo.z) - half;
+    F ss = F(1.25) * mul_add(fss_l * fss_v, inv_cos_sum_minus_half, half);
+    F ss_roughness = F(1.25) * fss_roughness * inv_cos_sum_minus_half;
     return {mix(fd, ss, lobe.subsurface), mix(fd_roughness, ss_roughness, lobe.subsurface), ss - fd};
 }
 
@@ -132,7 +132,7 @@ struct SpecularLobe {
     PB_MODEL_INLINE LogAlphaPartials<F> log_value_partials(const Geometry<F>& g) const {
         LogAlphaPartials<F> d = ggx.log_d_partials(g);
         if constexpr (model == Model::kDisney2014) {
-            const LogAlphaPartials<F> smith_i = ggx.log_smith_partials(g.wi), smith_o = ggx.log_smith_partials(g.wo);
+            LogAlphaPartials<F> smith_i = ggx.log_smith_partials(g.wi), smith_o = ggx.log_smith_partials(g.wo);
             d = {d.sum - (smith_i.sum + smith_o.sum), d.difference - (smith_i.difference + smith_o.difference)};
         }
         return d;
@@ -145,7 +145,7 @@ struct SpecularLobe {
 
     // the density in wi of the half vector drawn by `sampler`
     PB_MODEL_INLINE F pdf(const Geometry<F>& g, F smith_visible_wo, SpecularSampler sampler) const {
-        const F d_h = ggx.d(g);
+        F d_h = ggx.d(g);
         return sampler == SpecularSampler::kDistribution ? ggx.distribution_pdf(d_h, g) : ggx.visible_pdf(d_h, smith_visible_wo);
     }
 };
@@ -170,16 +170,16 @@ struct ClearcoatLobe {
     // the grey value (0 in every lane without a clearcoat)
     PB_MODEL_INLINE F value(const Geometry<F>& g, F fh, F smith_wo) const {
         if (absent()) return F(0.0);
-        const F fr = mul_add(F(0.96), fh, F(0.04));
-        const F denominator = smith_denominator_iso_small(g.wi.z, F(kSmithAlpha2)) * smith_wo;
+        F fr = mul_add(F(0.96), fh, F(0.04));
+        F denominator = smith_denominator_iso_small(g.wi.z, F(kSmithAlpha2)) * smith_wo;
         return scale * fr * g.h_len2 * reciprocal(gtr1.denominator(g) * denominator);
     }
 
     // the value per unit clearcoat, 0.25 Gr Fr Dr, computed whether or not the lobe is present
     PB_MODEL_INLINE F unit_value(const Geometry<F>& g, F fh) const {
-        const F fr = mul_add(F(0.96), fh, F(0.04));
-        const F alpha2 = F(kSmithAlpha2);
-        const F denominator = smith_denominator_iso_small(g.wi.z, alpha2) * smith_denominator_iso_small(g.wo.z, alpha2);
+        F fr = mul_add(F(0.96), fh, F(0.04));
+        F alpha2 = F(kSmithAlpha2);
+        F denominator = smith_denominator_iso_small(g.wi.z, alpha2) * smith_denominator_iso_small(g.wo.z, alpha2);
         return F(0.25) * gtr1.norm * fr * g.h_len2 * reciprocal(gtr1.denominator(g) * denominator);
     }
 

@@ -16,36 +16,36 @@ struct Shading {
 // From the kParamSlots values of params.hpp's order.
 template <class F>
 PB_MODEL_INLINE Shading<F> shading_of(const F* p) {
-    const F one(1.0);
-    const Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
-    const F metallic = p[kMetallic];
-    const F dielectric = one - metallic;
+    F one(1.0);
+    Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
+    F metallic = p[kMetallic];
+    F dielectric = one - metallic;
 
     // Ctint: hue and saturation at unit luminance (1 where the luminance is 0)
-    const F luminance = luminance_of(base);
-    const MaskOf<F> has_luminance = luminance > F(0.0);
-    const F inv_luminance = reciprocal(select(has_luminance, luminance, one));
-    const Rgb<F> tint{select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
+    F luminance = luminance_of(base);
+    MaskOf<F> has_luminance = luminance > F(0.0);
+    F inv_luminance = reciprocal(select(has_luminance, luminance, one));
+    Rgb<F> tint{select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
                       select(has_luminance, base.b * inv_luminance, one)};
-    const Rgb<F> white{one, one, one};
+    Rgb<F> white{one, one, one};
 
     Shading<F> s;
     s.diffuse.color = (dielectric * F(kInvPi)) * base;
     s.diffuse.subsurface = p[kSubsurface];
     s.diffuse.roughness = p[kRoughness];
-    const Rgb<F> sheen_tint = mix(white, tint, p[kSheenTint]);
+    Rgb<F> sheen_tint = mix(white, tint, p[kSheenTint]);
     s.sheen.color = (p[kSheen] * dielectric) * sheen_tint;
     s.diffuse.cosine_lobe_weight = dielectric * mul_add(F(0.1) * p[kSheen], luminance_of(sheen_tint), luminance);
 
     s.specular.f0 = mix((p[kSpecular] * F(0.08)) * mix(white, tint, p[kSpecularTint]), base, metallic);
     s.specular.f0_luminance = luminance_of(s.specular.f0);
     // 2014 addenda: aspect = sqrt(1 - 0.9 anisotropic), alpha = roughness²
-    const F aspect2 = neg_mul_add(F(0.9), p[kAnisotropic], one);  // in [0.1, 1]
-    const F inv_aspect = reciprocal_sqrt(aspect2);
-    const F aspect = aspect2 * inv_aspect;
-    const F alpha = p[kRoughness] * p[kRoughness];
+    F aspect2 = neg_mul_add(F(0.9), p[kAnisotropic], one);  // in [0.1, 1]
+    F inv_aspect = reciprocal_sqrt(aspect2);
+    F aspect = aspect2 * inv_aspect;
+    F alpha = p[kRoughness] * p[kRoughness];
     s.specular.ggx = Ggx<F>::from_alphas(max(F(0.001), alpha * inv_aspect), max(F(0.001), alpha * aspect));
-    const F alpha_g = mul_add(F(0.5), p[kRoughness], F(0.5));
+    F alpha_g = mul_add(F(0.5), p[kRoughness], F(0.5));
     s.specular.alpha_g2 = (alpha_g * alpha_g) * (alpha_g * alpha_g);
 
     // ac = mix(0.1, 0.001, clearcoat_gloss) stays in [0.001, 0.1]
@@ -116,10 +116,10 @@ struct LobeValues {
     // (fewer for a LobeSet without the diffuse or the sheen: their terms are 0)
     template <LobeSet lobes = LobeSet::kAll>
     Rgb<F> total(const Shading<F>& s) const {
-        const F specular_tinted = specular * (F(1.0) - fh);
-        const F grey = lobes == LobeSet::kAll ? mul_add(specular, fh, clearcoat) : specular * fh;
+        F specular_tinted = specular * (F(1.0) - fh);
+        F grey = lobes == LobeSet::kAll ? mul_add(specular, fh, clearcoat) : specular * fh;
         auto channel = [&](F dc, F sc, F f0) {
-            const F specular_part = mul_add(specular_tinted, f0, grey);
+            F specular_part = mul_add(specular_tinted, f0, grey);
             if constexpr (lobes == LobeSet::kSpecular) {
                 return specular_part;
             } else if constexpr (lobes == LobeSet::kPlain) {
@@ -144,7 +144,7 @@ PB_MODEL_INLINE MaskOf<F> above_surface(const Geometry<F>& g) {
 // (the lobes a LobeSet leaves out are 0)
 template <Model model, LobeSet lobes = LobeSet::kAll, class F>
 PB_MODEL_INLINE LobeValues<F> eval_lobes(const Geometry<F>& g, const Shading<F>& s, const View<F>& view) {
-    const F fh = schlick_weight_of_complement(g.one_minus_cos_theta_d);
+    F fh = schlick_weight_of_complement(g.one_minus_cos_theta_d);
     LobeValues<F> out;
     if constexpr (lobes == LobeSet::kSpecular) {
         out.diffuse = F(0.0);
@@ -175,7 +175,7 @@ struct LobeWeights {
 
 template <class F>
 PB_MODEL_INLINE LobeWeights<F> lobe_weights(F fv, const Shading<F>& s) {
-    const F w1 = s.specular.weight(fv), w2 = s.clearcoat.weight(fv);
+    F w1 = s.specular.weight(fv), w2 = s.clearcoat.weight(fv);
     return {w1, w2, reciprocal(s.diffuse.cosine_lobe_weight + w1 + w2)};
 }
 
@@ -184,8 +184,8 @@ PB_MODEL_INLINE LobeWeights<F> lobe_weights(F fv, const Shading<F>& s) {
 template <class F>
 PB_MODEL_INLINE F mixture_pdf(const Geometry<F>& g, const Shading<F>& s, const View<F>& view, const LobeWeights<F>& w,
                               SpecularSampler sampler) {
-    const F pdf1 = s.specular.pdf(g, view.smith_visible, sampler);
-    const F pdf2 = s.clearcoat.gtr1.pdf(g);
+    F pdf1 = s.specular.pdf(g, view.smith_visible, sampler);
+    F pdf2 = s.clearcoat.gtr1.pdf(g);
     return w.inv_total * mul_add(s.diffuse.cosine_lobe_weight * F(kInvPi), g.wi.z, mul_add(w.specular, pdf1, w.clearcoat * pdf2));
 }
 
@@ -198,10 +198,10 @@ struct LobeChoice {
 // against w0 and w0 + w1; never 2 when w2 = 0 (u0 may be 1 if passed).
 template <class F>
 PB_MODEL_INLINE LobeChoice<F> choose_lobe(F u0, const Shading<F>& s, const LobeWeights<F>& w) {
-    const F w0 = s.diffuse.cosine_lobe_weight;
-    const F scaled = u0 * (w0 + w.specular + w.clearcoat);
-    const MaskOf<F> cosine = scaled < w0;
-    const MaskOf<F> specular = ((scaled < w0 + w.specular) | (w.clearcoat <= F(0.0))) & !cosine;
+    F w0 = s.diffuse.cosine_lobe_weight;
+    F scaled = u0 * (w0 + w.specular + w.clearcoat);
+    MaskOf<F> cosine = scaled < w0;
+    MaskOf<F> specular = ((scaled < w0 + w.specular) | (w.clearcoat <= F(0.0))) & !cosine;
     return {cosine, specular};
 }
 
@@ -238,23 +238,23 @@ template <class F>
 PB_MODEL_INLINE Direction<F> sample_direction(const Vec3<F>& wo, const Uniforms<F>& u, const LobeChoice<F>& lobe,
                                               const Shading<F>& s, SpecularSampler sampler) {
     using Mask = MaskOf<F>;
-    const F zero(0.0), one(1.0);
+    F zero(0.0), one(1.0);
     const Ggx<F>& ggx = s.specular.ggx;
     // the visible-normal cap construction scaled by L = |V|, V = (ax wo.x, ay wo.y, wo.z),
     // so V need not be normalised: L cosθ = (1 - u2)(L + V.z) - V.z, L² sin²θ = L² - (L cosθ)²;
     // cos θv + L is the View's smith_visible, which the weight needs anyway
-    const Vec3<F> stretched = ggx.stretch(wo);
-    const F length2 = squared_length(stretched);
-    const F length = square_root(length2);
-    const F smith_visible = wo.z + length;
+    Vec3<F> stretched = ggx.stretch(wo);
+    F length2 = squared_length(stretched);
+    F length = square_root(length2);
+    F smith_visible = wo.z + length;
     const auto [sin_phi, cos_phi] = sincos_turns(u.u1);
     if (all(lobe.cosine)) {
-        const F radius = square_root(u.u2);
+        F radius = square_root(u.u2);
         return {{radius * cos_phi, radius * sin_phi, square_root(one - u.u2)}, smith_visible};
     }
-    const Mask clearcoat = !lobe.cosine & !lobe.specular;
+    Mask clearcoat = !lobe.cosine & !lobe.specular;
     const bool visible_normals = sampler == SpecularSampler::kVisibleNormals;
-    const Mask visible_specular = visible_normals ? lobe.specular : Mask(false);
+    Mask visible_specular = visible_normals ? lobe.specular : Mask(false);
 
     F sin2_theta = u.u2;  // cosine lobe, distribution sampler
     F scaled_cos = zero;  // L cosθ of the visible-normal specular
@@ -266,17 +266,17 @@ PB_MODEL_INLINE Direction<F> sample_direction(const Vec3<F>& wo, const Uniforms<
         centre_y = select(lobe.specular, stretched.y, zero);
     }
     if (any(clearcoat)) sin2_theta = select(clearcoat, s.clearcoat.gtr1.draw_sin2(u.u2), sin2_theta);
-    const F sin_theta = square_root(sin2_theta);
+    F sin_theta = square_root(sin2_theta);
     // m.z: L cosθ + V.z for the visible-normal specular, else cosθ from sin²θ
-    const F height = select(visible_specular, scaled_cos + stretched.z, square_root(one - sin2_theta));
-    const F stretch_x = select(lobe.specular, ggx.alpha_x, one);
-    const F stretch_y = select(lobe.specular, ggx.alpha_y, one);
-    const Vec3<F> d{stretch_x * mul_add(sin_theta, cos_phi, centre_x), stretch_y * mul_add(sin_theta, sin_phi, centre_y), height};
+    F height = select(visible_specular, scaled_cos + stretched.z, square_root(one - sin2_theta));
+    F stretch_x = select(lobe.specular, ggx.alpha_x, one);
+    F stretch_y = select(lobe.specular, ggx.alpha_y, one);
+    Vec3<F> d{stretch_x * mul_add(sin_theta, cos_phi, centre_x), stretch_y * mul_add(sin_theta, sin_phi, centre_y), height};
 
     // wi = 2 (wo·h) h - wo with h = d / |d|
-    const F d_len2 = squared_length(d);
-    const F scale = select(d_len2 > zero, F(2.0) * dot(wo, d) * reciprocal(d_len2), zero);
-    const Vec3<F> reflected{mul_sub(scale, d.x, wo.x), mul_sub(scale, d.y, wo.y), mul_sub(scale, d.z, wo.z)};
+    F d_len2 = squared_length(d);
+    F scale = select(d_len2 > zero, F(2.0) * dot(wo, d) * reciprocal(d_len2), zero);
+    Vec3<F> reflected{mul_sub(scale, d.x, wo.x), mul_sub(scale, d.y, wo.y), mul_sub(scale, d.z, wo.z)};
     return {select(lobe.cosine, d, reflected), smith_visible};
 }
 
@@ -294,7 +294,7 @@ struct Weighed {
     MaskOf<F> valid;
 
     Rgb<F> share(const Rgb<F>& lobe) const {
-        const Rgb<F> zero{F(0.0), F(0.0), F(0.0)};
+        Rgb<F> zero{F(0.0), F(0.0), F(0.0)};
         return select(valid, scale * lobe, zero);
     }
 };
@@ -303,13 +303,13 @@ template <Model model, class F>
 PB_MODEL_INLINE Weighed<F> weigh(const Vec3<F>& wo, F fv, const LobeWeights<F>& weights, const Direction<F>& drawn,
                                  const Shading<F>& s, SpecularSampler sampler) {
     const Vec3<F>& wi = drawn.wi;
-    const View<F> view = view_of<model>(wo, s, drawn.smith_visible, fv);
-    const Geometry<F> g = geometry_of(wi, wo);
-    const F pdf = mixture_pdf(g, s, view, weights, sampler);
-    const MaskOf<F> valid = (min(wi.z, wo.z) > F(0.0)) & g.finite & (pdf > F(0.0));
-    const LobeValues<F> lobes = eval_lobes<model>(g, s, view);
-    const Rgb<F> f = lobes.total(s);
-    const F scale = wi.z * reciprocal(pdf);  // cos θl / pdf
+    View<F> view = view_of<model>(wo, s, drawn.smith_visible, fv);
+    Geometry<F> g = geometry_of(wi, wo);
+    F pdf = mixture_pdf(g, s, view, weights, sampler);
+    MaskOf<F> valid = (min(wi.z, wo.z) > F(0.0)) & g.finite & (pdf > F(0.0));
+    LobeValues<F> lobes = eval_lobes<model>(g, s, view);
+    Rgb<F> f = lobes.total(s);
+    F scale = wi.z * reciprocal(pdf);  // cos θl / pdf
     // select after multiplying: below the horizon f may be infinite or NaN
     auto weight = [&](F value) { return select(valid, scale * value, F(0.0)); };
     auto finite = [&](F value) { return select(g.finite, value, F(0.0)); };

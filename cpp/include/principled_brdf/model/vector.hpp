@@ -50,8 +50,8 @@ PB_MODEL_INLINE Rgb<F> mix(const Rgb<F>& a, const Rgb<F>& b, F t) { return {mix(
 // Schlick(u) = clamp(1 - u, 0, 1)^5, given 1 - u
 template <class F>
 PB_MODEL_INLINE F schlick_weight_of_complement(F one_minus_u) {
-    const F m = min(max(one_minus_u, F(0.0)), F(1.0));
-    const F m2 = m * m;
+    F m = min(max(one_minus_u, F(0.0)), F(1.0));
+    F m2 = m * m;
     return m2 * m2 * m;
 }
 
