@@ -36,21 +36,26 @@ PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shadi
 struct BlendedEnergyRow {
     alignas(64) float values[2 * 64];  // laid out by row_value_at and row_slope_at (simd_ops.hpp)
 
-    void use_for(MultipleScatteringLobe<Floats>& ms) {
+    PB_KERNEL_INLINE void use_for(MultipleScatteringLobe<Floats>& ms) {
         alignas(64) std::int32_t offset[kLanes];
         alignas(64) float fraction[kLanes];
         ms.row.offset.store_aligned(offset);
         ms.row.fraction.store_aligned(fraction);
-        const float* below = ms.missing + 2 * offset[0];  // (value, slope) an interval
+        fill(ms.missing + 2 * offset[0], fraction[0]);
+        ms.missing = values;
+        ms.single_row = true;
+    }
+
+    // The row at below ((value, slope) an interval) blended with the next one by t.
+    // Out of line: it runs once per call, and its loop then stays out of the
+    // batch loops' functions, whose largest loop bench/loop_asm.py reports.
+    __attribute__((noinline)) void fill(const float* below, float t) {
         const float* above = below + 2 * energy::kIntervals;
-        const float t = fraction[0];
         auto blend = [&](int at) { return below[at] * (1.0f - t) + above[at] * t; };
         for (int b = 0; b < 64; ++b) {  // the slots past the last interval (μ = 1, flat) repeat it
-            const int interval = std::min(b, energy::kIntervals - 1);
+            int interval = std::min(b, energy::kIntervals - 1);
             values[row_value_at(b)] = blend(2 * interval);
             values[row_slope_at(b)] = blend(2 * interval + 1);
         }
-        ms.missing = values;
-        ms.single_row = true;
     }
 };

@@ -18,9 +18,8 @@ struct Geometry : HalfVector<F> {
 template <class F>
 PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
     Geometry<F> g;
-    // by component: after an aggregate copy GCC kept the directions on the stack in the kernels' loops
-    g.wi.x = wi.x; g.wi.y = wi.y; g.wi.z = wi.z;
-    g.wo.x = wo.x; g.wo.y = wo.y; g.wo.z = wo.z;
+    g.wi = wi;
+    g.wo = wo;
     F hx = wi.x + wo.x, hy = wi.y + wo.y;
     g.hz = wi.z + wo.z;
     g.hx2 = hx * hx;
