@@ -136,9 +136,8 @@ void simd_eval_material(benchmark::State& state, std::string isa, int index, boo
 }
 
 // Importance sampling with the counter-based generator: wi, pdf, weight, lobe per element.
-void simd_sample(benchmark::State& state, std::string isa, bool soa, bool per_element) {
+void simd_sample_job(benchmark::State& state, const std::string& isa, const pb::EvalJob& eval_job) {
     Data& d = data_for(state.range(0));
-    const pb::EvalJob eval_job = make_job(d, soa, per_element);
     pb::SampleJob job;
     job.wo = eval_job.wo;
     job.seed = 7;
@@ -155,6 +154,18 @@ void simd_sample(benchmark::State& state, std::string isa, bool soa, bool per_el
         benchmark::ClobberMemory();
     }
     state.SetItemsProcessed(state.iterations() * d.n);
+}
+
+void simd_sample(benchmark::State& state, std::string isa, bool soa, bool per_element) {
+    simd_sample_job(state, isa, make_job(data_for(state.range(0)), soa, per_element));
+}
+
+// The material set's samples, as simd_eval_material's f.
+void simd_sample_material(benchmark::State& state, std::string isa, int index) {
+    pb::EvalJob job = make_job(data_for(state.range(0)), false, index < 0);
+    if (index >= 0)
+        for (int s = 0; s < pb::kParamSlots; ++s) job.params[s].value = bench::kMaterials[index].slots[s];
+    simd_sample_job(state, isa, job);
 }
 
 void reference_eval(benchmark::State& state) {
@@ -287,6 +298,11 @@ void register_all() {
                 ->Unit(benchmark::kMicrosecond);
             const std::string compensated_name = "eval_material_compensated/" + isa + "/aos/" + material;
             benchmark::RegisterBenchmark(compensated_name.c_str(), simd_eval_material, isa, index, false, true)
+                ->Args({kSizes[0], 1})
+                ->UseRealTime()
+                ->Unit(benchmark::kMicrosecond);
+            benchmark::RegisterBenchmark(("sample_material/" + isa + "/aos/" + material).c_str(), simd_sample_material, isa,
+                                         index)
                 ->Args({kSizes[0], 1})
                 ->UseRealTime()
                 ->Unit(benchmark::kMicrosecond);

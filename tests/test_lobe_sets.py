@@ -2,7 +2,8 @@
 without them (specular alone for metallic 1 without clearcoat; diffuse and
 specular without sheen, subsurface and clearcoat), chosen once per call for a
 uniform material and per batch, when all its lanes agree, for a per-element
-one; `eval` and `eval_pdf` have them. Such a kernel leaves out only terms that
+one; `eval` and `eval_pdf` have them, and `sample`'s pipelined loop for a
+uniform material. Such a kernel leaves out only terms that
 are exactly 0, so its f must be the same bits as the full kernel's, which a
 batch runs when one of its lanes has a clearcoat. With the energy compensation
 the kernels take the lobe sets too: per element with the same bits again; a
@@ -45,16 +46,21 @@ def pairs():
     return wi.astype(np.float32), wo.astype(np.float32)
 
 
-def full_kernel(material: pb.Material, wi: np.ndarray, wo: np.ndarray, evaluate=pb.eval, **options):
-    """f (or `evaluate`'s result) by the full kernel: each element beside one with a clearcoat,
-    so that no batch of any width has all its lanes in a smaller LobeSet (the elements are
-    independent)."""
-    n = len(wi)
+def beside_a_clearcoat(material: pb.Material, n: int) -> pb.Material:
+    """2n elements per element: the material's at the even ones, with a clearcoat at the odd
+    ones, so that no batch of any width has all its lanes in a smaller LobeSet (the elements
+    are independent): the full kernel."""
     values = {k: np.broadcast_to(np.asarray(v, np.float64), (n, 3) if k == "base_color" else (n,))
               for k, v in material.as_dict().items()}
     breaker = {**values, "clearcoat": np.full(n, 0.5)}
-    pairs = {k: np.stack([values[k], breaker[k]], axis=1).reshape((2 * n,) + values[k].shape[1:]) for k in values}
-    result = evaluate(pb.Material(**pairs), np.repeat(wi, 2, axis=0), np.repeat(wo, 2, axis=0), **options)
+    return pb.Material(**{k: np.stack([values[k], breaker[k]], axis=1).reshape((2 * n,) + values[k].shape[1:])
+                          for k in values})
+
+
+def full_kernel(material: pb.Material, wi: np.ndarray, wo: np.ndarray, evaluate=pb.eval, **options):
+    """f (or `evaluate`'s result) by the full kernel (beside_a_clearcoat)."""
+    result = evaluate(beside_a_clearcoat(material, len(wi)), np.repeat(wi, 2, axis=0), np.repeat(wo, 2, axis=0),
+                      **options)
     if evaluate is pb.eval_pdf:
         return result.value[0::2], result.pdf[0::2]
     return result[0::2]
@@ -128,3 +134,28 @@ def test_the_compensated_kernels_of_the_lobe_sets_agree_with_the_full_kernel(pai
         np.testing.assert_allclose(got_pair.pdf, pdf, rtol=1e-5, atol=1e-30, err_msg=name)
         # and they differ from the single-scattering f where the lobe has energy to give back
         assert np.any(got > pb.eval(material, wi, wo, model=model, isa=isa) * (1 + 1e-4)) or material.roughness < 0.05
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", MODELS)
+def test_sampling_by_a_lobe_set_gives_the_full_kernels_bits(pairs, isa, model):
+    """A uniform material's samples come from its lobe set's pipelined loop; beside a
+    coated material, per element, the same uniforms go through the full kernel."""
+    _, wo = pairs
+    n = len(wo)
+    u = seeded_rng("lobe-sets-sampling", isa, model).random((n, 3)).astype(np.float32)
+    for name in sorted(MATERIALS):
+        material = pb.Material(**MATERIALS[name])
+        for sampler in ("visible", "distribution"):
+            options = dict(model=model, isa=isa, specular_sampler=sampler)
+            full = pb.sample(beside_a_clearcoat(material, n), np.repeat(wo, 2, axis=0), u=np.repeat(u, 2, axis=0),
+                             **options)
+            got = pb.sample(material, wo, u=u, **options)
+            rows = pb.sample(material, np.ascontiguousarray(wo.T), u=np.ascontiguousarray(u.T), layout="soa",
+                             **options)
+            for field in ("wi", "pdf", "weight", "lobe"):
+                expected = getattr(full, field)[0::2]
+                message = f"{name} {sampler} {field}"
+                np.testing.assert_array_equal(bits(getattr(got, field)), bits(expected), err_msg=message)
+                np.testing.assert_array_equal(bits(getattr(rows, field).T), bits(expected), err_msg=message)
+            assert np.all(np.isfinite(got.weight)) and np.any(got.pdf > 0)

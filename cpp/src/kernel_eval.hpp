@@ -92,7 +92,7 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
     auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };
     if constexpr (output == Output::kPdf || output == Output::kValuePdf) {
         Shading<Floats> mixture = with_multiple_scattering_weight(s, ms.weight(missing_wo));
-        Floats pdf = mixture_pdf(g, mixture, view, lobe_weights(view.fv, mixture), job.sampler);
+        Floats pdf = mixture_pdf<lobes>(g, mixture, view, lobe_weights(view.fv, mixture), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     }
     if constexpr (output == Output::kPdf) return;
@@ -133,7 +133,7 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
         Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
     } else if constexpr (output == Output::kValuePdf) {
-        Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
+        Floats pdf = mixture_pdf<lobes>(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
         Rgb<Floats> f = eval_lobes<model, lobes>(g, s, view).template total<lobes>(s);
         auto masked = [&](Floats x) { return select(above, job.cosine ? wi.z * x : x, Floats(0.0f)); };

@@ -73,11 +73,12 @@ PB_KERNEL_INLINE void store_sample(const SampleJob& job, std::int64_t i, const L
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
-template <Model model, Layouts layouts, bool with_lobes>
+template <Model model, Layouts layouts, bool with_lobes, LobeSet lobes = LobeSet::kAll>
 PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction<Floats>& d,
                             const Shading<Floats>& s) {
+    static_assert(!with_lobes || lobes == LobeSet::kAll, "each lobe's share needs every lobe's value");
     Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
-    store_sample<layouts, with_lobes>(job, i, c.lobe, weigh<model>(c.wo, c.fv, c.weights, d, s, job.sampler), s, zero);
+    store_sample<layouts, with_lobes>(job, i, c.lobe, weigh<model, lobes>(c.wo, c.fv, c.weights, d, s, job.sampler), s, zero);
 }
 
 // The energy compensation's batch (model/energy.hpp): the multiple-scattering
@@ -106,7 +107,8 @@ PB_KERNEL_INLINE bool sample_compensated_batch(const SampleJob& job, std::int64_
     return true;
 }
 
-template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool compensated = false>
+template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool compensated = false,
+          LobeSet lobes = LobeSet::kAll>
 PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform,
                                        const MultipleScatteringLobe<Floats>& uniform_ms, const CounterSeed& seed) {
     if constexpr (compensated) return sample_compensated_batch<model, per_element, layouts, with_lobes>(job, i, uniform, uniform_ms, seed);
@@ -115,11 +117,11 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
     const Shading<Floats>& s = per_element ? per_batch : uniform;
     Chosen chosen;
     if (!choose<model, layouts>(job, i, s, seed, chosen)) return false;
-    weigh<model, layouts, with_lobes>(job, i, chosen, draw(job, chosen, s), s);
+    weigh<model, layouts, with_lobes, lobes>(job, i, chosen, draw(job, chosen, s), s);
     return true;
 }
 
-template <Model model, bool per_element, bool with_lobes, bool compensated>
+template <Model model, bool per_element, bool with_lobes, bool compensated, LobeSet lobes>
 bool sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>& uniform,
                  const MultipleScatteringLobe<Floats>& uniform_ms, const CounterSeed& seed) {
     alignas(64) PadBuffer wo, u, params[kParamSlots], wi, weight, lobe_weight[kLobeCount];
@@ -137,7 +139,7 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>
     padded.lobe = lobe;
     padded.first_index = job.first_index + pad.begin;  // the generator sees the true element indices
 
-    if (!sample_one_batch<model, per_element, Layouts::kMixed, with_lobes, compensated>(padded, 0, uniform, uniform_ms, seed))
+    if (!sample_one_batch<model, per_element, Layouts::kMixed, with_lobes, compensated, lobes>(padded, 0, uniform, uniform_ms, seed))
         return false;
 
     unpad_vec3(job.wi, pad, wi);
@@ -158,10 +160,10 @@ struct InFlight {
 // One step of the pipeline: weigh the batch at i, draw the next one, choose
 // the one after it at i + 2 kLanes (false when the fast direction test does
 // not accept that one's wo).
-template <Model model, Layouts layouts>
+template <Model model, Layouts layouts, LobeSet lobes>
 PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed,
                                     InFlight& weighed, InFlight& drawn, InFlight& chosen) {
-    weigh<model, layouts, false>(job, i, weighed.chosen, weighed.drawn, s);
+    weigh<model, layouts, false, lobes>(job, i, weighed.chosen, weighed.drawn, s);
     drawn.drawn = draw(job, drawn.chosen, s);
     return choose<model, layouts>(job, i + 2 * kLanes, s, seed, chosen.chosen);
 }
@@ -183,7 +185,7 @@ PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const 
 // every element of [begin, end) written, or the start of the first batch the
 // fast direction test did not accept, every element before it written (see
 // run_checked).
-template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool compensated>
+template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool compensated, LobeSet lobes>
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     Shading<Floats> uniform{};
     MultipleScatteringLobe<Floats> uniform_ms{};
@@ -207,37 +209,52 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
             // every element before the returned batch is written
             if (!choose<model, layouts>(job, at(0), uniform, seed, slot0.chosen)) return at(0);
             if (!choose<model, layouts>(job, at(1), uniform, seed, slot1.chosen)) {
-                weigh<model, layouts, false>(job, at(0), slot0.chosen, draw(job, slot0.chosen, uniform), uniform);
+                weigh<model, layouts, false, lobes>(job, at(0), slot0.chosen, draw(job, slot0.chosen, uniform), uniform);
                 return at(1);
             }
             slot0.drawn = draw(job, slot0.chosen, uniform);
             // here and after each step: slot0 holds batch b, drawn, and slot1 batch b + 1, chosen
             for (; b + 4 < batches; b += 3) {
-                if (!pipeline_step<model, layouts>(job, at(b), uniform, seed, slot0, slot1, slot2))
-                    { weigh<model, layouts, false>(job, at(b + 1), slot1.chosen, slot1.drawn, uniform); return at(b + 2); }
-                if (!pipeline_step<model, layouts>(job, at(b + 1), uniform, seed, slot1, slot2, slot0))
-                    { weigh<model, layouts, false>(job, at(b + 2), slot2.chosen, slot2.drawn, uniform); return at(b + 3); }
-                if (!pipeline_step<model, layouts>(job, at(b + 2), uniform, seed, slot2, slot0, slot1))
-                    { weigh<model, layouts, false>(job, at(b + 3), slot0.chosen, slot0.drawn, uniform); return at(b + 4); }
+                if (!pipeline_step<model, layouts, lobes>(job, at(b), uniform, seed, slot0, slot1, slot2))
+                    { weigh<model, layouts, false, lobes>(job, at(b + 1), slot1.chosen, slot1.drawn, uniform); return at(b + 2); }
+                if (!pipeline_step<model, layouts, lobes>(job, at(b + 1), uniform, seed, slot1, slot2, slot0))
+                    { weigh<model, layouts, false, lobes>(job, at(b + 2), slot2.chosen, slot2.drawn, uniform); return at(b + 3); }
+                if (!pipeline_step<model, layouts, lobes>(job, at(b + 2), uniform, seed, slot2, slot0, slot1))
+                    { weigh<model, layouts, false, lobes>(job, at(b + 3), slot0.chosen, slot0.drawn, uniform); return at(b + 4); }
             }
-            weigh<model, layouts, false>(job, at(b), slot0.chosen, slot0.drawn, uniform);
-            weigh<model, layouts, false>(job, at(b + 1), slot1.chosen, draw(job, slot1.chosen, uniform), uniform);
+            weigh<model, layouts, false, lobes>(job, at(b), slot0.chosen, slot0.drawn, uniform);
+            weigh<model, layouts, false, lobes>(job, at(b + 1), slot1.chosen, draw(job, slot1.chosen, uniform), uniform);
             b += 2;
         }
     }
     for (; b < batches; ++b)
-        if (!sample_one_batch<model, per_element, layouts, with_lobes, compensated>(job, at(b), uniform, uniform_ms, seed))
+        if (!sample_one_batch<model, per_element, layouts, with_lobes, compensated, lobes>(job, at(b), uniform, uniform_ms, seed))
             return at(b);
     const std::int64_t i = begin + batches * kLanes;
-    if (i < end && !sample_tail<model, per_element, with_lobes, compensated>(job, Padding{i, end - i}, uniform, uniform_ms, seed))
+    if (i < end && !sample_tail<model, per_element, with_lobes, compensated, lobes>(job, Padding{i, end - i}, uniform, uniform_ms, seed))
         return i;
     return -1;
 }
 
-template <Model model, bool per_element, Layouts layouts, bool with_lobes = false, bool compensated = false>
+template <Model model, bool per_element, Layouts layouts, bool with_lobes = false, bool compensated = false,
+          LobeSet lobes = LobeSet::kAll>
 std::int64_t sample_checked(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     auto rejected = [&](std::int64_t i) { return !unit_length_at(job.wo, i, job.check); };
-    return run_checked(job, begin, end, sample_loop<model, per_element, layouts, with_lobes, compensated>, rejected);
+    return run_checked(job, begin, end, sample_loop<model, per_element, layouts, with_lobes, compensated, lobes>, rejected);
+}
+
+// A uniform material's pipelined loop for its LobeSet (as eval's; the draw
+// already skips the parts of the lobes no lane chose).
+template <Model model, bool per_element, Layouts layouts>
+std::int64_t sample_checked_for_lobes(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+    if constexpr (!per_element) {
+        switch (lobe_set_of(job.params)) {
+            case LobeSet::kSpecular: return sample_checked<model, false, layouts, false, false, LobeSet::kSpecular>(job, begin, end);
+            case LobeSet::kPlain: return sample_checked<model, false, layouts, false, false, LobeSet::kPlain>(job, begin, end);
+            default: break;
+        }
+    }
+    return sample_checked<model, per_element, layouts>(job, begin, end);
 }
 
 // -1 with every element written, or the first element whose wo fails the direction check.
@@ -255,9 +272,9 @@ std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int
                                 job.wi.layout == layout && job.weight.layout == layout &&
                                 (job.u.data == nullptr || job.u.layout == layout);
     if (uniform_layout && layout == Vec3Layout::kInterleaved)
-        return sample_checked<model, per_element, Layouts::kInterleaved>(job, begin, end);
+        return sample_checked_for_lobes<model, per_element, Layouts::kInterleaved>(job, begin, end);
     if (uniform_layout && layout == Vec3Layout::kRows)
-        return sample_checked<model, per_element, Layouts::kRows>(job, begin, end);
+        return sample_checked_for_lobes<model, per_element, Layouts::kRows>(job, begin, end);
     return sample_checked<model, per_element, Layouts::kMixed>(job, begin, end);
 }
 

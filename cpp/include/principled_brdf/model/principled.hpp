@@ -181,12 +181,15 @@ PB_MODEL_INLINE LobeWeights<F> lobe_weights(F fv, const Shading<F>& s) {
 
 // Σ P_k pdf_k(wi), before the horizon test:
 //   pdf0 = cos θl / π,  pdf1 the specular sampler's,  pdf2 the GTR1 draw's.
-template <class F>
+// A LobeSet without the clearcoat has P2 = +0, and P2 pdf2 = +0 wherever
+// pdf2 is finite (both directions above the surface): its kernels add +0
+// without computing pdf2, the same bits there.
+template <LobeSet lobes = LobeSet::kAll, class F>
 PB_MODEL_INLINE F mixture_pdf(const Geometry<F>& g, const Shading<F>& s, const View<F>& view, const LobeWeights<F>& w,
                               SpecularSampler sampler) {
     F pdf1 = s.specular.pdf(g, view.smith_visible, sampler);
-    F pdf2 = s.clearcoat.gtr1.pdf(g);
-    return w.inv_total * mul_add(s.diffuse.cosine_lobe_weight * F(kInvPi), g.wi.z, mul_add(w.specular, pdf1, w.clearcoat * pdf2));
+    F clearcoat_part = lobes == LobeSet::kAll ? w.clearcoat * s.clearcoat.gtr1.pdf(g) : F(0.0);
+    return w.inv_total * mul_add(s.diffuse.cosine_lobe_weight * F(kInvPi), g.wi.z, mul_add(w.specular, pdf1, clearcoat_part));
 }
 
 template <class F>
@@ -299,16 +302,17 @@ struct Weighed {
     }
 };
 
-template <Model model, class F>
+// (LobeSet as for eval_lobes; the lobes' values are then only the set's)
+template <Model model, LobeSet set = LobeSet::kAll, class F>
 PB_MODEL_INLINE Weighed<F> weigh(const Vec3<F>& wo, F fv, const LobeWeights<F>& weights, const Direction<F>& drawn,
                                  const Shading<F>& s, SpecularSampler sampler) {
     const Vec3<F>& wi = drawn.wi;
-    View<F> view = view_of<model>(wo, s, drawn.smith_visible, fv);
+    View<F> view = view_of<model, set>(wo, s, drawn.smith_visible, fv);
     Geometry<F> g = geometry_of(wi, wo);
-    F pdf = mixture_pdf(g, s, view, weights, sampler);
+    F pdf = mixture_pdf<set>(g, s, view, weights, sampler);
     MaskOf<F> valid = (min(wi.z, wo.z) > F(0.0)) & g.finite & (pdf > F(0.0));
-    LobeValues<F> lobes = eval_lobes<model>(g, s, view);
-    Rgb<F> f = lobes.total(s);
+    LobeValues<F> lobes = eval_lobes<model, set>(g, s, view);
+    Rgb<F> f = lobes.template total<set>(s);
     F scale = wi.z * reciprocal(pdf);  // cos θl / pdf
     // select after multiplying: below the horizon f may be infinite or NaN
     auto weight = [&](F value) { return select(valid, scale * value, F(0.0)); };
