@@ -2,8 +2,7 @@
 without them (specular alone for metallic 1 without clearcoat; diffuse and
 specular without sheen, subsurface and clearcoat), chosen once per call for a
 uniform material and per batch, when all its lanes agree, for a per-element
-one; `eval` and `eval_pdf` have them, and `sample`'s pipelined loop for a
-uniform material. Such a kernel leaves out only terms that
+one; `eval`, `eval_pdf` and `sample` have them. Such a kernel leaves out only terms that
 are exactly 0, so its f must be the same bits as the full kernel's, which a
 batch runs when one of its lanes has a clearcoat. With the energy compensation
 the kernels take the lobe sets too: per element with the same bits again; a
@@ -92,22 +91,25 @@ def test_the_kernel_of_a_lobe_set_has_the_full_kernels_bits(pairs, isa, model, n
     np.testing.assert_array_equal(bits(rows.T), bits(full_kernel(material, wi, wo, model=model, isa=isa)))
 
 
-@pytest.mark.parametrize("isa", ISAS)
-@pytest.mark.parametrize("model", MODELS)
-def test_a_textures_batches_take_their_lobe_set(pairs, isa, model):
+def texture_of_runs(rng, n: int) -> pb.Material:
     """Per element: runs of one material (metal, plastic, a coated one) of random
     lengths, so that some batches agree on a smaller set and some straddle two."""
-    wi, wo = pairs
-    rng = seeded_rng("lobe-sets-texture", isa, model)
     names = ["metal", "plastic", "car_paint", "metal_with_dormant_lobes", "black_dielectric"]
     runs, total = [], 0
-    while total < len(wi):
+    while total < n:
         length = int(rng.integers(1, 70))
         runs.append((names[int(rng.integers(len(names)))], length))
         total += length
-    choice = np.concatenate([[names.index(name)] * length for name, length in runs])[:len(wi)]
+    choice = np.concatenate([[names.index(name)] * length for name, length in runs])[:n]
     tables = [pb.Material(**MATERIALS[name]).as_dict() for name in names]
-    texture = pb.Material(**{k: np.array([table[k] for table in tables], np.float64)[choice] for k in tables[0]})
+    return pb.Material(**{k: np.array([table[k] for table in tables], np.float64)[choice] for k in tables[0]})
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", MODELS)
+def test_a_textures_batches_take_their_lobe_set(pairs, isa, model):
+    wi, wo = pairs
+    texture = texture_of_runs(seeded_rng("lobe-sets-texture", isa, model), len(wi))
     for compensation in (False, True):  # per element, the compensated kernels read the same corners: the same bits
         options = dict(model=model, isa=isa, energy_compensation=compensation)
         got = pb.eval(texture, wi, wo, **options)
@@ -159,3 +161,17 @@ def test_sampling_by_a_lobe_set_gives_the_full_kernels_bits(pairs, isa, model):
                 np.testing.assert_array_equal(bits(getattr(got, field)), bits(expected), err_msg=message)
                 np.testing.assert_array_equal(bits(getattr(rows, field).T), bits(expected), err_msg=message)
             assert np.all(np.isfinite(got.weight)) and np.any(got.pdf > 0)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", MODELS)
+def test_a_textures_samples_take_their_lobe_set(pairs, isa, model):
+    _, wo = pairs
+    n = len(wo)
+    texture = texture_of_runs(seeded_rng("lobe-sets-texture-sampling", isa, model), n)
+    u = seeded_rng("lobe-sets-texture-u", isa, model).random((n, 3)).astype(np.float32)
+    full = pb.sample(beside_a_clearcoat(texture, n), np.repeat(wo, 2, axis=0), u=np.repeat(u, 2, axis=0), model=model,
+                     isa=isa)
+    got = pb.sample(texture, wo, u=u, model=model, isa=isa)
+    for field in ("wi", "pdf", "weight", "lobe"):
+        np.testing.assert_array_equal(bits(getattr(got, field)), bits(getattr(full, field)[0::2]), err_msg=field)

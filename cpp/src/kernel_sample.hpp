@@ -112,12 +112,24 @@ template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool 
 PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform,
                                        const MultipleScatteringLobe<Floats>& uniform_ms, const CounterSeed& seed) {
     if constexpr (compensated) return sample_compensated_batch<model, per_element, layouts, with_lobes>(job, i, uniform, uniform_ms, seed);
+    RawMaterial m;  // (per element only)
     Shading<Floats> per_batch;
-    if constexpr (per_element) per_batch = shading_of(load_material(job.params, i));
+    if constexpr (per_element) {
+        m = load_material(job.params, i);
+        per_batch = shading_of(m);
+    }
     const Shading<Floats>& s = per_element ? per_batch : uniform;
     Chosen chosen;
     if (!choose<model, layouts>(job, i, s, seed, chosen)) return false;
-    weigh<model, layouts, with_lobes, lobes>(job, i, chosen, draw(job, chosen, s), s);
+    Direction<Floats> drawn = draw(job, chosen, s);
+    if constexpr (per_element && !with_lobes) {  // the batch's LobeSet, when all its lanes agree (as eval's)
+        switch (lobe_set_of(m)) {
+            case LobeSet::kSpecular: weigh<model, layouts, false, LobeSet::kSpecular>(job, i, chosen, drawn, s); return true;
+            case LobeSet::kPlain: weigh<model, layouts, false, LobeSet::kPlain>(job, i, chosen, drawn, s); return true;
+            default: break;
+        }
+    }
+    weigh<model, layouts, with_lobes, lobes>(job, i, chosen, drawn, s);
     return true;
 }
 
@@ -243,7 +255,8 @@ std::int64_t sample_checked(const SampleJob& job, std::int64_t begin, std::int64
     return run_checked(job, begin, end, sample_loop<model, per_element, layouts, with_lobes, compensated, lobes>, rejected);
 }
 
-// A uniform material's pipelined loop for its LobeSet (as eval's; the draw
+// A uniform material's pipelined loop for its LobeSet, as eval's (a
+// per-element batch's weight takes its LobeSet in sample_one_batch; the draw
 // already skips the parts of the lobes no lane chose).
 template <Model model, bool per_element, Layouts layouts>
 std::int64_t sample_checked_for_lobes(const SampleJob& job, std::int64_t begin, std::int64_t end) {
