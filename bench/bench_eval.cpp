@@ -117,14 +117,19 @@ void simd_eval_compensated(benchmark::State& state, std::string isa, bool soa, b
     simd_eval_with(state, isa, soa, per_element, false, pb::Output::kTotal, true);
 }
 
-// The material set (materials.hpp): f of material `index`, or of the random
-// per-element materials at index -1, (N, 3), the direction check on or off,
-// with or without the energy compensation.
-void simd_eval_material(benchmark::State& state, std::string isa, int index, bool checked, bool energy_compensation) {
-    Data& d = data_for(state.range(0));
+// The material set (materials.hpp): material `index`, or the random
+// per-element materials at index -1, with (N, 3) arrays.
+pb::EvalJob make_material_job(Data& d, int index) {
     pb::EvalJob job = make_job(d, false, index < 0);
     if (index >= 0)
         for (int s = 0; s < pb::kParamSlots; ++s) job.params[s].value = bench::kMaterials[index].slots[s];
+    return job;
+}
+
+// f of the material set, the direction check on or off, with or without the energy compensation.
+void simd_eval_material(benchmark::State& state, std::string isa, int index, bool checked, bool energy_compensation) {
+    Data& d = data_for(state.range(0));
+    pb::EvalJob job = make_material_job(d, index);
     if (checked) job.check = pb::direction_check(1e-3);
     job.energy_compensation = energy_compensation;
     const int threads = threads_of(state);
@@ -160,12 +165,9 @@ void simd_sample(benchmark::State& state, std::string isa, bool soa, bool per_el
     simd_sample_job(state, isa, make_job(data_for(state.range(0)), soa, per_element));
 }
 
-// The material set's samples, as simd_eval_material's f.
+// The material set's samples.
 void simd_sample_material(benchmark::State& state, std::string isa, int index) {
-    pb::EvalJob job = make_job(data_for(state.range(0)), false, index < 0);
-    if (index >= 0)
-        for (int s = 0; s < pb::kParamSlots; ++s) job.params[s].value = bench::kMaterials[index].slots[s];
-    simd_sample_job(state, isa, job);
+    simd_sample_job(state, isa, make_material_job(data_for(state.range(0)), index));
 }
 
 void reference_eval(benchmark::State& state) {
