@@ -1,5 +1,5 @@
-// Per-instruction-set building blocks of the kernel: fast reciprocal, square
-// root and reciprocal square root refined to float precision, and the (N, 3)
+// Per-instruction-set building blocks of the kernel: reciprocal, square root,
+// a fast reciprocal square root refined to float precision, and the (N, 3)
 // interleaved <-> structure-of-arrays transposes done in registers.
 //
 // Included by kernel.hpp inside the per-arch namespace, after `Floats` is
@@ -64,29 +64,22 @@ PB_KERNEL_INLINE Floats mul_sub(Floats a, Floats b, Floats c) { return xsimd::fm
 PB_KERNEL_INLINE Floats neg_mul_add(Floats a, Floats b, Floats c) { return xsimd::fnma(a, b, c); }
 #endif
 
-#if defined(__AVX512F__)
+// Reciprocals and square roots are exact (divps, sqrtps) on every instruction
+// set. The kernels are bound by the multiply and FMA pipes; the divide and
+// square-root unit works beside them, so an exact 1/x or sqrt(x) is cheaper
+// there than an rcp or rsqrt estimate refined by a Newton step, which takes 3
+// or 4 of the pipes' slots (bench/RESULTS.md, run 18).
+PB_KERNEL_INLINE Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
+// sqrt(x), 0 for x <= 0 (and for NaN on x86, where max returns its second operand)
+PB_KERNEL_INLINE Floats square_root(Floats x) { return xsimd::sqrt(xsimd::max(x, Floats(0.0f))); }
 
-PB_KERNEL_INLINE Floats reciprocal(Floats x) {
-    const __m512 estimate = _mm512_rcp14_ps(x);  // relative error < 2^-14
-    // One Newton-Raphson step: y (2 - x y)
-    return _mm512_mul_ps(estimate, _mm512_fnmadd_ps(x, estimate, _mm512_set1_ps(2.0f)));
-}
+#if defined(__AVX512F__)
 
 PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
     const __m512 estimate = _mm512_rsqrt14_ps(x);  // relative error < 2^-14
     // One Newton-Raphson step: y + (y / 2) (1 - x y²)
     const __m512 residual = _mm512_fnmadd_ps(_mm512_mul_ps(x, estimate), estimate, _mm512_set1_ps(1.0f));
     return _mm512_fmadd_ps(_mm512_mul_ps(_mm512_set1_ps(0.5f), estimate), residual, estimate);
-}
-
-// sqrt(x): s = x y from the estimate y of 1/sqrt(x), then one Newton-Raphson
-// step s + (s / 2) (1 - s y); 0 for x <= 0 (where s would be 0 inf or NaN).
-PB_KERNEL_INLINE Floats square_root(Floats x) {
-    const __m512 estimate = _mm512_rsqrt14_ps(x);
-    const __m512 root = _mm512_mul_ps(x, estimate);
-    const __m512 residual = _mm512_fnmadd_ps(root, estimate, _mm512_set1_ps(1.0f));
-    const __m512 refined = _mm512_fmadd_ps(_mm512_mul_ps(_mm512_set1_ps(0.5f), root), residual, root);
-    return _mm512_maskz_mov_ps(_mm512_cmp_ps_mask(x, _mm512_setzero_ps(), _CMP_GT_OQ), refined);
 }
 
 // Two-source permutes (vpermt2ps): a component of 16 elements comes from the
@@ -144,25 +137,11 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
 
 #elif defined(__AVX2__)
 
-PB_KERNEL_INLINE Floats reciprocal(Floats x) {
-    const __m256 estimate = _mm256_rcp_ps(x);  // relative error < 1.5 * 2^-12
-    return _mm256_mul_ps(estimate, _mm256_fnmadd_ps(x, estimate, _mm256_set1_ps(2.0f)));
-}
-
 PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
     const __m256 estimate = _mm256_rsqrt_ps(x);  // relative error < 1.5 * 2^-12
     // One Newton-Raphson step: y + (y / 2) (1 - x y²)
     const __m256 residual = _mm256_fnmadd_ps(_mm256_mul_ps(x, estimate), estimate, _mm256_set1_ps(1.0f));
     return _mm256_fmadd_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), estimate), residual, estimate);
-}
-
-// sqrt(x), 0 for x <= 0, as for AVX-512
-PB_KERNEL_INLINE Floats square_root(Floats x) {
-    const __m256 estimate = _mm256_rsqrt_ps(x);
-    const __m256 root = _mm256_mul_ps(x, estimate);
-    const __m256 residual = _mm256_fnmadd_ps(root, estimate, _mm256_set1_ps(1.0f));
-    const __m256 refined = _mm256_fmadd_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), root), residual, root);
-    return _mm256_and_ps(refined, _mm256_cmp_ps(x, _mm256_setzero_ps(), _CMP_GT_OQ));
 }
 
 template <int k>
@@ -221,9 +200,7 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
 
 #else  // SSE2, NEON: exact division and square root, transposes through memory
 
-PB_KERNEL_INLINE Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
 PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) { return Floats(1.0f) / xsimd::sqrt(x); }
-PB_KERNEL_INLINE Floats square_root(Floats x) { return xsimd::sqrt(xsimd::max(x, Floats(0.0f))); }
 
 PB_KERNEL_INLINE void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
     alignas(64) float xs[Floats::size], ys[Floats::size], zs[Floats::size];

@@ -26,7 +26,7 @@ struct LogAlphaPartials {
 // Smith denominator in its stretched squared length q
 template <class F>
 PB_MODEL_INLINE F log_smith_denominator_partial(F cos_theta, F q) {
-    F root = q * reciprocal_sqrt(q);
+    F root = square_root(q);
     return reciprocal(F(2.0) * root * (cos_theta + root));
 }
 
@@ -56,7 +56,7 @@ struct Ggx {
     // D(h), h = H/|H|: norm |H|⁴ / (Hx²/ax² + Hy²/ay² + Hz²)²
     PB_MODEL_INLINE F d(const HalfVector<F>& h) const {
         F stretched = mul_add(h.hx2, inv_alpha_x2, mul_add(h.hy2, inv_alpha_y2, h.hz2));
-        F root = h.h_len2 * reciprocal(stretched);
+        F root = h.h_len2 / stretched;
         return norm * root * root;
     }
 
@@ -71,13 +71,13 @@ struct Ggx {
     }
 
     // G1(wo) D(h) / (4 cos θv) = D(h) / (2 smith_denominator(wo))
-    PB_MODEL_INLINE F visible_pdf(F d_h, F smith_denominator_wo) const { return d_h * reciprocal(F(2.0) * smith_denominator_wo); }
+    PB_MODEL_INLINE F visible_pdf(F d_h, F smith_denominator_wo) const { return d_h / (F(2.0) * smith_denominator_wo); }
 
     // D(h) cos θh / (4 cos θd) = D(h) Hz / (2 |H|²): the density in wi of h drawn from D cos θh
-    PB_MODEL_INLINE F distribution_pdf(F d_h, const HalfVector<F>& h) const { return d_h * h.hz * reciprocal(F(2.0) * h.h_len2); }
+    PB_MODEL_INLINE F distribution_pdf(F d_h, const HalfVector<F>& h) const { return d_h * h.hz / (F(2.0) * h.h_len2); }
 
     // cos θ + sqrt(q): the Smith denominator given q (the stretched squared length)
-    static PB_MODEL_INLINE F smith_denominator_of(F cos_theta, F q) { return mul_add(q, reciprocal_sqrt(q), cos_theta); }
+    static PB_MODEL_INLINE F smith_denominator_of(F cos_theta, F q) { return square_root(q) + cos_theta; }
 
     // log-derivatives of D: with tx = Hx²/ax², ty = Hy²/ay², s = tx + ty + Hz² and
     // D ∝ (|H|²/s)² / (ax ay):  ax ∂ln D/∂ax = 4 tx / s - 1, ay ∂ln D/∂ay = 4 ty / s - 1
@@ -103,11 +103,11 @@ struct Ggx {
     // and is +inf at cos θ = 0, its value there
     PB_MODEL_INLINE F lambda(const Vec3<F>& w) const {
         F p2 = projected_length2(w);
-        return p2 * reciprocal(F(2.0) * w.z * (w.z + square_root(mul_add(w.z, w.z, p2))));
+        return p2 / (F(2.0) * w.z * (w.z + square_root(mul_add(w.z, w.z, p2))));
     }
 
     // G1(w) = 1 / (1 + Λ(w)) = 2 n·w / smith_denominator(w), n·w >= 0
-    PB_MODEL_INLINE F g1(const Vec3<F>& w) const { return F(2.0) * w.z * reciprocal(smith_denominator(w)); }
+    PB_MODEL_INLINE F g1(const Vec3<F>& w) const { return F(2.0) * w.z / smith_denominator(w); }
 
     // height-correlated G2 = 1 / (1 + Λ(wi) + Λ(wo)) (Heitz 2014 eq. 99) =
     // 2 cos θi cos θo / (cos θi |Vo| + cos θo |Vi|), V the stretched direction
@@ -268,10 +268,10 @@ struct Gtr1 {
     // |H|² (a² cos²θh + sin²θh) = a² Hz² + Hx² + Hy²: D(h) is norm |H|² over this
     PB_MODEL_INLINE F denominator(const HalfVector<F>& h) const { return mul_add(alpha2, h.hz2, h.hx2 + h.hy2); }
 
-    PB_MODEL_INLINE F d(const HalfVector<F>& h) const { return norm * h.h_len2 * reciprocal(denominator(h)); }
+    PB_MODEL_INLINE F d(const HalfVector<F>& h) const { return norm * h.h_len2 / denominator(h); }
 
     // D(h) cos θh / (4 cos θd) = norm Hz / (2 denominator), the density in wi
-    PB_MODEL_INLINE F pdf(const HalfVector<F>& h) const { return norm * h.hz * reciprocal(F(2.0) * denominator(h)); }
+    PB_MODEL_INLINE F pdf(const HalfVector<F>& h) const { return norm * h.hz / (F(2.0) * denominator(h)); }
 
     // ∂ln D/∂a² = 1/(a² - 1) - 1/(a² ln a²) - Hz² / denominator
     PB_MODEL_INLINE F log_d_partial_alpha2(const HalfVector<F>& h) const {

@@ -27,10 +27,10 @@ PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
     g.hz2 = g.hz * g.hz;
     g.h_len2 = g.hx2 + g.hy2 + g.hz2;
     g.finite = g.h_len2 <= largest_finite(g.h_len2);
-    g.cos_theta_d = F(0.5) * g.h_len2 * reciprocal_sqrt(g.h_len2);
+    g.cos_theta_d = F(0.5) * square_root(g.h_len2);
     F dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
     F d_len2 = mul_add(dx, dx, mul_add(dy, dy, dz * dz));
-    g.one_minus_cos_theta_d = d_len2 * reciprocal(mul_add(F(4.0), g.cos_theta_d, F(4.0)));
+    g.one_minus_cos_theta_d = d_len2 / mul_add(F(4.0), g.cos_theta_d, F(4.0));
     return g;
 }
 
@@ -119,7 +119,7 @@ struct SpecularLobe {
         } else {
             denominator = ggx.smith_denominator(g.wi) * smith_wo;
         }
-        return ggx.d(g) * reciprocal(denominator);
+        return ggx.d(g) / denominator;
     }
 
     // w1 = max(lum(mix(Cspec0, 1, FV)), 0.02)
@@ -171,7 +171,7 @@ struct ClearcoatLobe {
         if (absent()) return F(0.0);
         F fr = mul_add(F(0.96), fh, F(0.04));
         F denominator = smith_denominator_iso_small(g.wi.z, F(kSmithAlpha2)) * smith_wo;
-        return scale * fr * g.h_len2 * reciprocal(gtr1.denominator(g) * denominator);
+        return scale * fr * g.h_len2 / (gtr1.denominator(g) * denominator);
     }
 
     // the value per unit clearcoat, 0.25 Gr Fr Dr, computed whether or not the lobe is present
@@ -179,7 +179,7 @@ struct ClearcoatLobe {
         F fr = mul_add(F(0.96), fh, F(0.04));
         F alpha2 = F(kSmithAlpha2);
         F denominator = smith_denominator_iso_small(g.wi.z, alpha2) * smith_denominator_iso_small(g.wo.z, alpha2);
-        return F(0.25) * gtr1.norm * fr * g.h_len2 * reciprocal(gtr1.denominator(g) * denominator);
+        return F(0.25) * gtr1.norm * fr * g.h_len2 / (gtr1.denominator(g) * denominator);
     }
 
     // w2 = 0.25 clearcoat mix(0.04, 1, FV)

@@ -278,7 +278,7 @@ PB_MODEL_INLINE Direction<F> sample_direction(const Vec3<F>& wo, const Uniforms<
 
     // wi = 2 (wo·h) h - wo with h = d / |d|
     F d_len2 = squared_length(d);
-    F scale = select(d_len2 > zero, F(2.0) * dot(wo, d) * reciprocal(d_len2), zero);
+    F scale = select(d_len2 > zero, F(2.0) * dot(wo, d) / d_len2, zero);
     Vec3<F> reflected{mul_sub(scale, d.x, wo.x), mul_sub(scale, d.y, wo.y), mul_sub(scale, d.z, wo.z)};
     return {select(lobe.cosine, d, reflected), smith_visible};
 }
@@ -313,7 +313,7 @@ PB_MODEL_INLINE Weighed<F> weigh(const Vec3<F>& wo, F fv, const LobeWeights<F>& 
     MaskOf<F> valid = (min(wi.z, wo.z) > F(0.0)) & g.finite & (pdf > F(0.0));
     LobeValues<F> lobes = eval_lobes<model, set>(g, s, view);
     Rgb<F> f = lobes.template total<set>(s);
-    F scale = wi.z * reciprocal(pdf);  // cos θl / pdf
+    F scale = wi.z / pdf;  // cos θl / pdf
     // select after multiplying: below the horizon f may be infinite or NaN
     auto weight = [&](F value) { return select(valid, scale * value, F(0.0)); };
     auto finite = [&](F value) { return select(g.finite, value, F(0.0)); };
