@@ -177,13 +177,18 @@ PB_KERNEL_INLINE LobeSet lobe_set_of(const RawMaterial& m) {
     return lobe_set_where([&](Param slot) { return m.slot[slot]; }, [](const Mask& b) { return all(b); });
 }
 
+// true unless the direction check is on and its fast test does not accept every lane
+PB_KERNEL_INLINE bool accepted(const EvalJob& job, const Vec3<Floats>& wi, const Vec3<Floats>& wo) {
+    return !job.check.enabled || all(surely_unit_length(wi, job.check) & surely_unit_length(wo, job.check));
+}
+
 // One batch at i; false, with nothing stored, when the fast direction test
 // does not accept it.
 template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes>
 PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const PreparedOf<output, compensated>& uniform) {
     Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
     Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
-    if (job.check.enabled && !all(surely_unit_length(wi, job.check) & surely_unit_length(wo, job.check))) return false;
+    if (!accepted(job, wi, wo)) return false;
     if constexpr (per_element && compensated) {
         // the lobes' constants as locals: a CompensatedPrepared built per batch was copied whole (rep movs)
         RawMaterial m = load_material(job.params, i);
@@ -221,6 +226,23 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
         eval_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, uniform);
     }
     return true;
+}
+
+// The batches at i and i + kLanes of a uniform material, in one step: -1, or
+// the start of the first one the fast direction test does not accept (every
+// element before it written). The two batches' loads come first and their
+// work is independent: one batch's chain of dependent operations (square
+// roots and divisions among them) is longer than the out-of-order window
+// can cover with the next batch's work when the batches come one per step.
+template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes>
+PB_KERNEL_INLINE std::int64_t eval_two_batches(const EvalJob& job, std::int64_t i, const PreparedOf<output, compensated>& uniform) {
+    Vec3<Floats> wi = load_vec3<layouts>(job.wi, i), wo = load_vec3<layouts>(job.wo, i);
+    Vec3<Floats> next_wi = load_vec3<layouts>(job.wi, i + kLanes), next_wo = load_vec3<layouts>(job.wo, i + kLanes);
+    if (!accepted(job, wi, wo)) return i;
+    eval_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, uniform);
+    if (!accepted(job, next_wi, next_wo)) return i + kLanes;
+    eval_batch<model, output, layouts, compensated, lobes>(job, i + kLanes, next_wi, next_wo, uniform);
+    return -1;
 }
 
 // The last pad.count < kLanes elements, as one batch.
@@ -265,6 +287,12 @@ std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end)
         if constexpr (compensated) row.use_for(uniform.ms);
     }
     std::int64_t i = begin;
+    if constexpr (!per_element) {
+        for (; i + 2 * kLanes <= end; i += 2 * kLanes) {
+            const std::int64_t stopped = eval_two_batches<model, output, layouts, compensated, lobes>(job, i, uniform);
+            if (stopped >= 0) return stopped;
+        }
+    }
     for (; i + kLanes <= end; i += kLanes)
         if (!eval_one_batch<model, output, per_element, layouts, compensated, lobes>(job, i, uniform)) return i;
     if (i < end && !eval_tail<model, output, per_element, compensated, lobes>(job, Padding{i, end - i}, uniform)) return i;

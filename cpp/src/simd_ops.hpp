@@ -72,6 +72,8 @@ PB_KERNEL_INLINE Floats neg_mul_add(Floats a, Floats b, Floats c) { return xsimd
 PB_KERNEL_INLINE Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
 // sqrt(x), 0 for x <= 0 (and for NaN on x86, where max returns its second operand)
 PB_KERNEL_INLINE Floats square_root(Floats x) { return xsimd::sqrt(xsimd::max(x, Floats(0.0f))); }
+// sqrt(x) for x >= 0 by construction (a sum of squares): no clamp
+PB_KERNEL_INLINE Floats square_root_nonnegative(Floats x) { return xsimd::sqrt(x); }
 
 #if defined(__AVX512F__)
 

@@ -26,7 +26,7 @@ struct LogAlphaPartials {
 // Smith denominator in its stretched squared length q
 template <class F>
 PB_MODEL_INLINE F log_smith_denominator_partial(F cos_theta, F q) {
-    F root = square_root(q);
+    F root = square_root_nonnegative(q);
     return reciprocal(F(2.0) * root * (cos_theta + root));
 }
 
@@ -47,9 +47,13 @@ struct Ggx {
         d.alpha_y = ay;
         d.alpha_x2 = ax * ax;
         d.alpha_y2 = ay * ay;
-        d.inv_alpha_x2 = reciprocal(d.alpha_x2);
-        d.inv_alpha_y2 = reciprocal(d.alpha_y2);
-        d.norm = F(kInvPi) * reciprocal(ax * ay);
+        // one division for the three (a per-batch cost for per-element materials):
+        // 1/ax² = (ay / (ax ay))², 1/ay² = (ax / (ax ay))²
+        F inv_product = reciprocal(ax * ay);
+        F inv_alpha_x = ay * inv_product, inv_alpha_y = ax * inv_product;
+        d.inv_alpha_x2 = inv_alpha_x * inv_alpha_x;
+        d.inv_alpha_y2 = inv_alpha_y * inv_alpha_y;
+        d.norm = F(kInvPi) * inv_product;
         return d;
     }
 
@@ -77,7 +81,7 @@ struct Ggx {
     PB_MODEL_INLINE F distribution_pdf(F d_h, const HalfVector<F>& h) const { return d_h * h.hz / (F(2.0) * h.h_len2); }
 
     // cos θ + sqrt(q): the Smith denominator given q (the stretched squared length)
-    static PB_MODEL_INLINE F smith_denominator_of(F cos_theta, F q) { return square_root(q) + cos_theta; }
+    static PB_MODEL_INLINE F smith_denominator_of(F cos_theta, F q) { return square_root_nonnegative(q) + cos_theta; }
 
     // log-derivatives of D: with tx = Hx²/ax², ty = Hy²/ay², s = tx + ty + Hz² and
     // D ∝ (|H|²/s)² / (ax ay):  ax ∂ln D/∂ax = 4 tx / s - 1, ay ∂ln D/∂ay = 4 ty / s - 1
@@ -103,7 +107,7 @@ struct Ggx {
     // and is +inf at cos θ = 0, its value there
     PB_MODEL_INLINE F lambda(const Vec3<F>& w) const {
         F p2 = projected_length2(w);
-        return p2 / (F(2.0) * w.z * (w.z + square_root(mul_add(w.z, w.z, p2))));
+        return p2 / (F(2.0) * w.z * (w.z + square_root_nonnegative(mul_add(w.z, w.z, p2))));
     }
 
     // G1(w) = 1 / (1 + Λ(w)) = 2 n·w / smith_denominator(w), n·w >= 0
@@ -112,7 +116,7 @@ struct Ggx {
     // height-correlated G2 = 1 / (1 + Λ(wi) + Λ(wo)) (Heitz 2014 eq. 99) =
     // 2 cos θi cos θo / (cos θi |Vo| + cos θo |Vi|), V the stretched direction
     PB_MODEL_INLINE F g2_height_correlated(const Vec3<F>& wi, const Vec3<F>& wo) const {
-        F length_i = square_root(stretched_length2(wi)), length_o = square_root(stretched_length2(wo));
+        F length_i = square_root_nonnegative(stretched_length2(wi)), length_o = square_root_nonnegative(stretched_length2(wo));
         F denominator = mul_add(wi.z, length_o, wo.z * length_i);
         // a quotient, not a reciprocal: the denominator may be subnormal
         return select(denominator > F(0.0), F(2.0) * wi.z * wo.z / denominator, F(0.0));
@@ -137,7 +141,7 @@ struct Ggx {
     PB_MODEL_INLINE Vec3<F> sample_visible(const Vec3<F>& wo, F sin_phi, F cos_phi, F u2) const {
         Vec3<F> v = stretch(wo);
         F length2 = squared_length(v);
-        F scaled_cos = cap_scaled_cos(u2, square_root(length2), v.z);
+        F scaled_cos = cap_scaled_cos(u2, square_root_nonnegative(length2), v.z);
         F scaled_sin = square_root(neg_mul_add(scaled_cos, scaled_cos, length2));
         return {alpha_x * mul_add(scaled_sin, cos_phi, v.x), alpha_y * mul_add(scaled_sin, sin_phi, v.y),
                 max(scaled_cos + v.z, F(0.0))};

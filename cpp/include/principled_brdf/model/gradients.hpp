@@ -87,7 +87,7 @@ PB_MODEL_INLINE MaterialPartials<F> material_partials_of(const F* p) {
     F alpha = roughness * roughness;
     MaskOf<F> x_active = alpha * inv_aspect > F(0.001), y_active = alpha * (aspect2 * inv_aspect) > F(0.001);
     F log_roughness = F(2.0) * reciprocal(select(x_active | y_active, roughness, one));
-    F log_aspect = F(0.45) * reciprocal(aspect2);
+    F log_aspect = F(0.45) * (inv_aspect * inv_aspect);
     F x_roughness = select(x_active, log_roughness, zero), y_roughness = select(y_active, log_roughness, zero);
     F x_anisotropic = select(x_active, log_aspect, zero), y_anisotropic = select(y_active, -log_aspect, zero);
     F half(0.5);

@@ -27,7 +27,7 @@ PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
     g.hz2 = g.hz * g.hz;
     g.h_len2 = g.hx2 + g.hy2 + g.hz2;
     g.finite = g.h_len2 <= largest_finite(g.h_len2);
-    g.cos_theta_d = F(0.5) * square_root(g.h_len2);
+    g.cos_theta_d = F(0.5) * square_root_nonnegative(g.h_len2);
     F dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
     F d_len2 = mul_add(dx, dx, mul_add(dy, dy, dz * dz));
     g.one_minus_cos_theta_d = d_len2 / mul_add(F(4.0), g.cos_theta_d, F(4.0));

@@ -248,7 +248,7 @@ PB_MODEL_INLINE Direction<F> sample_direction(const Vec3<F>& wo, const Uniforms<
     // cos θv + L is the View's smith_visible, which the weight needs anyway
     Vec3<F> stretched = ggx.stretch(wo);
     F length2 = squared_length(stretched);
-    F length = square_root(length2);
+    F length = square_root_nonnegative(length2);
     F smith_visible = wo.z + length;
     const auto [sin_phi, cos_phi] = sincos_turns(u.u1);
     if (all(lobe.cosine)) {

@@ -13,6 +13,7 @@ inline double neg_mul_add(double a, double b, double c) { return c - a * b; }
 inline double reciprocal(double x) { return 1.0 / x; }
 inline double reciprocal_sqrt(double x) { return 1.0 / std::sqrt(x); }
 inline double square_root(double x) { return std::sqrt(std::max(x, 0.0)); }
+inline double square_root_nonnegative(double x) { return std::sqrt(x); }
 inline double select(bool mask, double a, double b) { return mask ? a : b; }
 // as x86's minps and maxps: the second operand where either is NaN
 inline double min(double a, double b) { return a < b ? a : b; }
