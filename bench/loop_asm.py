@@ -9,9 +9,10 @@ regular expression matched against the demangled names of its functions
 (the first match is taken). The loop reported is the function's largest
 natural loop (the blocks that reach a back edge's source without passing its
 target, which dominates it), wherever the compiler placed those blocks: the
-loop of an eval loop (two batches a step for a uniform material, one per
-element), the pipelined loop (three batches) of a sample loop. Counts are static: every block counts once, both sides of a skipped
-lobe's branch included, the same measure before and after a change.
+loop of an eval loop (two batches a step for a uniform material, one for
+per-element materials), the pipelined loop (three batches) of a sample loop.
+Counts are static: every block counts once, both sides of a skipped lobe's
+branch included, the same measure before and after a change.
 """
 import re
 import subprocess
