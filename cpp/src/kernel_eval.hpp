@@ -104,7 +104,7 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
         store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
         store_rgb<layouts>(job.out[4], i, masked(ms.rgb(multiple_scattering)));
     } else if constexpr (output != Output::kPdf) {
-        store_rgb<layouts>(job.out[0], i, masked(ms.added_to(values.template total<lobes>(s), multiple_scattering)));
+        store_rgb<layouts, true>(job.out[0], i, masked(ms.added_to(values.template total<lobes>(s), multiple_scattering)));
     }
 }
 
@@ -149,7 +149,7 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
             store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
             store_rgb<layouts>(job.out[4], i, zero);
         } else {
-            store_rgb<layouts>(job.out[0], i, masked(values.template total<lobes>(s)));
+            store_rgb<layouts, true>(job.out[0], i, masked(values.template total<lobes>(s)));
         }
     }
 }
@@ -279,7 +279,7 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, 
 // -1 with every element of [begin, end) written, or the start of the first
 // batch the fast direction test did not accept (see run_checked).
 template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes>
-std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+std::int64_t eval_batches(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     PreparedOf<output, compensated> uniform{};
     BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
@@ -297,6 +297,37 @@ std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end)
         if (!eval_one_batch<model, output, per_element, layouts, compensated, lobes>(job, i, uniform)) return i;
     if (i < end && !eval_tail<model, output, per_element, compensated, lobes>(job, Padding{i, end - i}, uniform)) return i;
     return -1;
+}
+
+// The elements before the first whose (N, 3) output starts at a register-aligned
+// address: k in [0, kLanes), since kLanes elements fill three registers and
+// 12 k takes every multiple of 4 modulo a register's bytes; -1 for an address
+// that is not a float's.
+inline std::int64_t elements_to_register_alignment(const float* p) {
+    const auto address = reinterpret_cast<std::uintptr_t>(p);
+    for (std::int64_t k = 0; k < kLanes; ++k)
+        if ((address + 3 * sizeof(float) * k) % sizeof(Floats) == 0) return k;
+    return -1;
+}
+
+// eval_batches, f written by non-temporal stores when the batch layer asks
+// for them: the elements before the first register-aligned output as a padded
+// batch with ordinary stores, then every batch from there aligned.
+template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes>
+std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    if (!job.out[0].streaming) return eval_batches<model, output, per_element, layouts, compensated, lobes>(job, begin, end);
+    EvalJob plain = job;
+    plain.out[0].streaming = false;
+    const std::int64_t head = elements_to_register_alignment(job.out[0].data + 3 * begin);
+    if (head < 0) return eval_batches<model, output, per_element, layouts, compensated, lobes>(plain, begin, end);
+    if (head > 0) {
+        const std::int64_t stopped =
+                eval_batches<model, output, per_element, layouts, compensated, lobes>(plain, begin, std::min(end, begin + head));
+        if (stopped >= 0 || begin + head >= end) return stopped;
+    }
+    const std::int64_t stopped = eval_batches<model, output, per_element, layouts, compensated, lobes>(job, begin + head, end);
+    streaming_fence();
+    return stopped;
 }
 
 inline Layouts layouts_of(const EvalJob& job) {

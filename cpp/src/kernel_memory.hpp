@@ -30,10 +30,15 @@ PB_KERNEL_INLINE Vec3<Floats> load_vec3(const Vec3Array& a, std::int64_t i) {
     }
 }
 
-template <Layouts layouts = Layouts::kMixed>
+// (may_stream: for eval's f, the only output the batch layer may ask to stream)
+template <Layouts layouts = Layouts::kMixed, bool may_stream = false>
 PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const Rgb<Floats>& c) {
     if (layouts == Layouts::kInterleaved || (layouts == Layouts::kMixed && a.layout == Vec3Layout::kInterleaved)) {
-        store_interleaved(a.data + 3 * i, c.r, c.g, c.b);
+        if (may_stream && a.streaming) {  // (a.data + 3 i register-aligned: eval_loop)
+            stream_interleaved(a.data + 3 * i, c.r, c.g, c.b);
+        } else {
+            store_interleaved(a.data + 3 * i, c.r, c.g, c.b);
+        }
     } else {
         c.r.store_unaligned(a.data + i);
         c.g.store_unaligned(a.data + a.row_stride + i);

@@ -137,6 +137,13 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
     _mm512_storeu_ps(p + 32, scatter_register<2>(x, y, z));
 }
 
+// store_interleaved by non-temporal stores, p aligned to a register (64 bytes)
+PB_KERNEL_INLINE void stream_interleaved(float* p, Floats x, Floats y, Floats z) {
+    _mm512_stream_ps(p, scatter_register<0>(x, y, z));
+    _mm512_stream_ps(p + 16, scatter_register<1>(x, y, z));
+    _mm512_stream_ps(p + 32, scatter_register<2>(x, y, z));
+}
+
 #elif defined(__AVX2__)
 
 PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
@@ -191,13 +198,23 @@ PB_KERNEL_INLINE __m256 scatter_register(__m256 px, __m256 py, __m256 pz) {
     return _mm256_blend_ps(_mm256_blend_ps(px, py, lanes_of_component<r, 1>()), pz, lanes_of_component<r, 2>());
 }
 
-PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) {
+// The three registers of 8 interleaved elements (x0 y0 z0 x1 ...), in memory order
+PB_KERNEL_INLINE std::array<__m256, 3> interleaved_registers(Floats x, Floats y, Floats z) {
     const __m256 px = _mm256_permutevar8x32_ps(x, interleave_store_permutation<0>());
     const __m256 py = _mm256_permutevar8x32_ps(y, interleave_store_permutation<1>());
     const __m256 pz = _mm256_permutevar8x32_ps(z, interleave_store_permutation<2>());
-    _mm256_storeu_ps(p, scatter_register<0>(px, py, pz));
-    _mm256_storeu_ps(p + 8, scatter_register<1>(px, py, pz));
-    _mm256_storeu_ps(p + 16, scatter_register<2>(px, py, pz));
+    return {scatter_register<0>(px, py, pz), scatter_register<1>(px, py, pz), scatter_register<2>(px, py, pz)};
+}
+
+PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) {
+    std::array<__m256, 3> registers = interleaved_registers(x, y, z);
+    for (int r = 0; r < 3; ++r) _mm256_storeu_ps(p + 8 * r, registers[r]);
+}
+
+// store_interleaved by non-temporal stores, p aligned to a register (32 bytes)
+PB_KERNEL_INLINE void stream_interleaved(float* p, Floats x, Floats y, Floats z) {
+    std::array<__m256, 3> registers = interleaved_registers(x, y, z);
+    for (int r = 0; r < 3; ++r) _mm256_stream_ps(p + 8 * r, registers[r]);
 }
 
 #else  // SSE2, NEON: exact division and square root, transposes through memory
@@ -228,7 +245,17 @@ PB_KERNEL_INLINE void store_interleaved(float* p, Floats x, Floats y, Floats z) 
     }
 }
 
+// (no non-temporal stores here: the ordinary ones, at any address)
+PB_KERNEL_INLINE void stream_interleaved(float* p, Floats x, Floats y, Floats z) { store_interleaved(p, x, y, z); }
+
 #endif
+
+// Non-temporal stores made visible to other threads before a loop returns.
+PB_KERNEL_INLINE void streaming_fence() {
+#if defined(__SSE2__)
+    _mm_sfence();
+#endif
+}
 
 // ---------------------------------------------------------------- rows to elements
 // out[width * lane + r] = rows[r][lane] for r < width and every lane: a batch's

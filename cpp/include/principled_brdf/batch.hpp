@@ -29,6 +29,9 @@ struct MutableVec3Array {
     float* data = nullptr;
     Vec3Layout layout = Vec3Layout::kInterleaved;  // kInterleaved or kRows
     std::int64_t row_stride = 0;
+    // written past the caches by non-temporal stores (kInterleaved; eval's f
+    // of a call larger than the last-level cache, which the batch layer decides)
+    bool streaming = false;
 };
 
 // One material parameter slot: a value for the whole batch, or one value per
