@@ -207,12 +207,13 @@ void native_loop(benchmark::State& state, bool soa) {
     state.SetItemsProcessed(state.iterations() * d.n);
 }
 
-// Reads wi and wo, writes 3 floats per pair: the bytes eval moves.
-void copy_kernel(benchmark::State& state) {
+// Reads wi and wo, writes 3 floats per pair: the bytes eval moves; streaming:
+// by non-temporal stores, as eval writes a call's f past 32 MB.
+void copy_kernel(benchmark::State& state, bool streaming) {
     Data& d = data_for(state.range(0));
     const int threads = threads_of(state);
     for (auto _ : state) {
-        pb::add_pairs(d.wi_aos.data(), d.wo_aos.data(), d.out.data(), d.n, threads);
+        pb::add_pairs(d.wi_aos.data(), d.wo_aos.data(), d.out.data(), d.n, threads, streaming);
         benchmark::ClobberMemory();
     }
     state.SetItemsProcessed(state.iterations() * d.n);
@@ -317,8 +318,10 @@ void register_all() {
     for (std::int64_t n : kSizes) {
         benchmark::RegisterBenchmark("native_loop/aos", native_loop, false)->Args({n, 1})->Unit(benchmark::kMicrosecond);
         benchmark::RegisterBenchmark("native_loop/soa", native_loop, true)->Args({n, 1})->Unit(benchmark::kMicrosecond);
-        for (int threads : {1, all})
-            benchmark::RegisterBenchmark("copy", copy_kernel)->Args({n, threads})->UseRealTime()->Unit(benchmark::kMicrosecond);
+        for (int threads : {1, all}) {
+            benchmark::RegisterBenchmark("copy", copy_kernel, false)->Args({n, threads})->UseRealTime()->Unit(benchmark::kMicrosecond);
+            benchmark::RegisterBenchmark("copy_streaming", copy_kernel, true)->Args({n, threads})->UseRealTime()->Unit(benchmark::kMicrosecond);
+        }
     }
 }
 

@@ -57,6 +57,9 @@ def main(path: str) -> None:
     print(f"| in cache, (3,N) vs the -march=native -ffast-math loop, (3,N) (>= 1.0x) | {ratio(in_cache['soa'], native['soa'])} |")
     print(f"| in cache, best layout vs the compiler's best layout | {ratio(max(in_cache.values()), native_best)} |")
     print(f"| 16M pairs, all threads, (N,3), vs the copy kernel (>= 0.85x) | {ratio(big_all, copy_all)} |")
+    copy_streaming = find(rates, f"copy_streaming/{large}/{threads}/")
+    if copy_streaming:  # the copy with eval's non-temporal stores for a call past the caches
+        print(f"| same, vs the copy by non-temporal stores | {ratio(big_all, copy_streaming)} |")
     for size, threads_used in ((small, 1), (65536, 1), (large, threads)):
         for material in ("uniform", "per_element"):
             aos = find(rates, f"eval/{best}/aos/{material}/{size}/{threads_used}/")

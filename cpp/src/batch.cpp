@@ -8,6 +8,10 @@
 #include <cmath>
 #include <thread>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "dispatch.hpp"
 #include "thread_pool.hpp"
 
@@ -99,12 +103,20 @@ void counter_uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n, fl
         for (int k = 0; k < 3; ++k) out[3 * i + k] = rng::counter_uniform(static_cast<std::uint64_t>(first) + static_cast<std::uint64_t>(i), mixed, k);
 }
 
-void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int threads) {
+void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int threads, bool streaming) {
     const int thread_count = resolve_threads(threads);
     const Chunks chunks = split(n, thread_count);
     parallel_for(chunks.count, thread_count, [&](int c) {
-        const std::int64_t begin = 3 * c * chunks.size, end = 3 * std::min(n, (c + 1) * chunks.size);
-        for (std::int64_t i = begin; i < end; ++i) out[i] = wi[i] + wo[i];
+        std::int64_t i = 3 * c * chunks.size;
+        const std::int64_t end = 3 * std::min(n, (c + 1) * chunks.size);
+#if defined(__SSE2__)
+        if (streaming) {
+            for (; i < end && reinterpret_cast<std::uintptr_t>(out + i) % 16 != 0; ++i) out[i] = wi[i] + wo[i];
+            for (; i + 4 <= end; i += 4) _mm_stream_ps(out + i, _mm_add_ps(_mm_loadu_ps(wi + i), _mm_loadu_ps(wo + i)));
+            _mm_sfence();
+        }
+#endif
+        for (; i < end; ++i) out[i] = wi[i] + wo[i];
     });
 }
 

@@ -155,7 +155,8 @@ void counter_uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n, fl
 int hardware_threads();
 
 // The memory roofline: out[i] = wi[i] + wo[i] over 3 n floats each, moving
-// the bytes an (N, 3) eval moves (reads 24, writes 12 per pair).
-void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int threads);
+// the bytes an (N, 3) eval moves (reads 24, writes 12 per pair); streaming:
+// out written by non-temporal stores, as eval writes a large call's f.
+void add_pairs(const float* wi, const float* wo, float* out, std::int64_t n, int threads, bool streaming = false);
 
 }  // namespace principled_brdf
