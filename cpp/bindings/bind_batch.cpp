@@ -228,7 +228,7 @@ void memory_roofline(const Float32Array& wi, const Float32Array& wo, Float32Arra
     output_view(out, 0, n, "out");
     float* out_data = out.mutable_data();
     py::gil_scoped_release release;
-    add_pairs(wi.data(), wo.data(), out_data, n, threads);
+    add_pairs(wi.data(), wo.data(), out_data, n, threads, streaming_output(n));  // the stores eval would use
 }
 
 py::dict cpu_info() {
@@ -269,7 +269,7 @@ void bind_batch(py::module_& m) {
     m.def("direction_length2_bounds", &direction_length2_bounds, py::arg("tolerance"),
           "(lowest, highest): a direction passes the check when its float64 squared length lies within.");
     m.def("memory_roofline", &memory_roofline, py::arg("wi"), py::arg("wo"), py::arg("out"), py::arg("threads"),
-          "out = wi + wo over (N, 3) float32 arrays: the bytes eval moves, at memory speed.");
+          "out = wi + wo over (N, 3) float32 arrays: the bytes eval moves, by the stores eval uses, at memory speed.");
     m.def("cpu_info", &cpu_info, "Instruction set in use, the available ones, SIMD width, hardware threads.");
     m.def("float_lanes", &float_lanes, py::arg("isa"));
 }

@@ -75,16 +75,10 @@ const kernel::KernelTable& kernels_for(const std::string& isa) {
     return isa.empty() ? kernel::active() : kernel::by_name(isa, "isa");
 }
 
-// f of at least this many bytes is written by non-temporal stores: it would
-// not stay in the last-level cache (32 MB on this project's machine kind), and
-// a store that bypasses the caches does not first read its line from memory.
-constexpr std::int64_t kStreamingBytes = std::int64_t{32} << 20;
-
 std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa) {
     const kernel::KernelTable& kernels = kernels_for(isa);
     EvalJob streamed = job;
-    streamed.out[0].streaming = job.output == Output::kTotal && job.out[0].layout == Vec3Layout::kInterleaved &&
-                                n * 3 * static_cast<std::int64_t>(sizeof(float)) >= kStreamingBytes;
+    streamed.out[0].streaming = job.output == Output::kTotal && job.out[0].layout == Vec3Layout::kInterleaved && streaming_output(n);
     return run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) { return kernels.eval_range(streamed, begin, end); });
 }
 

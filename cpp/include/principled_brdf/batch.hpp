@@ -154,6 +154,13 @@ void counter_uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n, fl
 
 int hardware_threads();
 
+// An (N, 3) float32 output of at least this many bytes is written by
+// non-temporal stores (eval's f, and the roofline copy below): it would not
+// stay in the last-level cache (32 MB on this project's machine kind), and a
+// store that bypasses the caches does not first read its line from memory.
+inline constexpr std::int64_t kStreamingBytes = std::int64_t{32} << 20;
+inline bool streaming_output(std::int64_t pairs) { return pairs * 3 * static_cast<std::int64_t>(sizeof(float)) >= kStreamingBytes; }
+
 // The memory roofline: out[i] = wi[i] + wo[i] over 3 n floats each, moving
 // the bytes an (N, 3) eval moves (reads 24, writes 12 per pair); streaming:
 // out written by non-temporal stores, as eval writes a large call's f.
