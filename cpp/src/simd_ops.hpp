@@ -399,7 +399,7 @@ PB_KERNEL_INLINE Floats log(Floats x) {
     // getmant halves a mantissa of 1.5 or more, so that its exponent is getexp's plus one
     const __m512 exponent = _mm512_getexp_ps(x);
     const __m512 e = _mm512_mask_add_ps(exponent, _mm512_cmp_ps_mask(m, one, _CMP_LT_OQ), exponent, one);
-    Floats s = Floats(_mm512_sub_ps(m, one)) * reciprocal(Floats(_mm512_add_ps(m, one)));
+    Floats s = Floats(_mm512_sub_ps(m, one)) / Floats(_mm512_add_ps(m, one));
     Floats s2 = s * s;
     Floats series(1.0f / 9.0f);
     for (float coefficient : {1.0f / 7.0f, 1.0f / 5.0f, 1.0f / 3.0f, 1.0f})

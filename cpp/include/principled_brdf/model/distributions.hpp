@@ -230,7 +230,7 @@ PB_MODEL_INLINE F smith_denominator_iso(const Vec3<F>& w, F a2) {
 template <class F>
 PB_MODEL_INLINE F ratio_exp_minus_one(F x, F exp_minus_one_of_x) {
     MaskOf<F> zero = x == F(0.0);
-    return select(zero, F(1.0), exp_minus_one_of_x * reciprocal(select(zero, F(1.0), x)));
+    return select(zero, F(1.0), exp_minus_one_of_x / select(zero, F(1.0), x));
 }
 
 template <class F>

@@ -102,11 +102,11 @@ PB_MODEL_INLINE MultipleScatteringLobe<F> multiple_scattering_of(const F* p, con
     // specular past the physical range, where 1 - F_avg (1 - E_avg) could reach 0)
     auto factor = [&](F f0) {
         F f_avg = min(mul_add(F(20.0 / 21.0), f0, F(1.0 / 21.0)), F(1.0));
-        return f_avg * f_avg * e_average * reciprocal(neg_mul_add(f_avg, missing_average, one));
+        return f_avg * f_avg * e_average / neg_mul_add(f_avg, missing_average, one);
     };
     Rgb<F> tint{factor(s.specular.f0.r), factor(s.specular.f0.g), factor(s.specular.f0.b)};
     ms.albedo_scale = luminance_of(tint);
-    F norm = F(kInvPi) * reciprocal(max(missing_average, F(1e-7)));
+    F norm = F(kInvPi) / max(missing_average, F(1e-7));
     ms.color = norm * tint;
     return ms;
 }
