@@ -270,8 +270,10 @@ PB_MODEL_INLINE Direction<F> sample_direction(const Vec3<F>& wo, const Uniforms<
     }
     if (any(clearcoat)) sin2_theta = select(clearcoat, s.clearcoat.gtr1.draw_sin2(u.u2), sin2_theta);
     F sin_theta = square_root(sin2_theta);
-    // m.z: L cosθ + V.z for the visible-normal specular, else cosθ from sin²θ
-    F height = select(visible_specular, scaled_cos + stretched.z, square_root(one - sin2_theta));
+    // m.z: L cosθ + V.z for the visible-normal specular, else cosθ from sin²θ (a
+    // square root that a batch of visible-normal draws alone, a metal's, skips)
+    F height = scaled_cos + stretched.z;
+    if (!all(visible_specular)) height = select(visible_specular, height, square_root(one - sin2_theta));
     F stretch_x = select(lobe.specular, ggx.alpha_x, one);
     F stretch_y = select(lobe.specular, ggx.alpha_y, one);
     Vec3<F> d{stretch_x * mul_add(sin_theta, cos_phi, centre_x), stretch_y * mul_add(sin_theta, sin_phi, centre_y), height};
