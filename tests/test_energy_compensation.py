@@ -123,6 +123,24 @@ def test_table_is_continuous_and_its_average_the_integral(model):
         assert abs(MISSING_AVERAGE[m, j] - expected) <= 1e-6, (model, j, MISSING_AVERAGE[m, j], expected)
 
 
+def test_rows_that_may_be_read_from_zero():
+    """A uniform material's kernels read the lines of its blended row written
+    from μ = 0, 1 - E = v0 + μ s, where rows j and j + 1 both allow it
+    (cpp/include/principled_brdf/energy_intercepts.hpp): on every interval
+    |v0| + μ_end |s| within 16 of the line's smaller end value. The 2014
+    model's kernels take that form for every row without asking, so every row
+    of its table must allow it; in the 2012 model the rows from 23/64 do."""
+    ends, starts = energy_tables.interval_ends(), energy_tables.cosine_nodes()
+    value, slope = MISSING[..., 0].astype(np.float64), MISSING[..., 1].astype(np.float64)
+    intercept = value - ends * slope
+    smaller = np.minimum(value, value - (ends - starts) * slope)
+    assert np.all(smaller > 0)
+    cancellation = ((np.abs(intercept) + ends * np.abs(slope)) / smaller).max(axis=-1)
+    allowed = cancellation <= 16.0
+    assert allowed[0].all(), np.flatnonzero(~allowed[0])
+    assert np.array_equal(np.flatnonzero(allowed[1]), np.arange(23, energy_tables.ROUGHNESSES)), cancellation[1]
+
+
 def test_generator_quadrature_is_converged():
     for model in MODELS:
         for r, mu in ((0.2, 0.05), (0.05, 0.3), (1.0, 0.6), (0.6, 0.1)):
@@ -333,6 +351,15 @@ def test_simd_matches_reference(accuracy_case, isa):
         assert errors.max() <= max_bound, (isa, model, name, errors.max())
 
 
+def compensated_lobes_against_reference(material, wi, wo, isa, model):
+    """(name, SIMD, float64 reference) of the multiple-scattering lobe and the total"""
+    options = dict(model=model, energy_compensation=True)
+    ref = pb.reference.eval_lobes(material, wi.astype(np.float64), wo.astype(np.float64), **options)
+    got = pb.eval_lobes(material, wi, wo, isa=isa, **options)
+    return (("multiple_scattering", got.multiple_scattering, ref.multiple_scattering),
+            ("total", got.total(), ref.total()))
+
+
 @pytest.mark.parametrize("isa", ISAS)
 @pytest.mark.parametrize("regime", REGIMES)
 def test_simd_matches_reference_for_uniform_materials(isa, regime):
@@ -347,14 +374,60 @@ def test_simd_matches_reference_for_uniform_materials(isa, regime):
     materials += [pb.Material(**WHITE, roughness=r) for r in (0.0, 0.01, 1 / 64, 0.03, 0.0781, 0.15, 0.5, 0.77, 1.0)]
     for model in MODELS:
         for material in materials:
-            options = dict(model=model, energy_compensation=True)
-            ref = pb.reference.eval_lobes(material, wi.astype(np.float64), wo.astype(np.float64), **options)
-            got = pb.eval_lobes(material, wi, wo, isa=isa, **options)
-            for name, simd, expected in (("multiple_scattering", got.multiple_scattering, ref.multiple_scattering),
-                                         ("total", got.total(), ref.total())):
+            for name, simd, expected in compensated_lobes_against_reference(material, wi, wo, isa, model):
                 errors = relative_errors(simd, expected)
                 assert np.percentile(errors, 99.99) <= percentile_bound, (model, material, name, np.percentile(errors, 99.99))
                 assert errors.max() <= max_bound, (model, material, name, errors.max())
+
+
+def cosines_beside_the_nodes() -> np.ndarray:
+    """Every node of the tables' μ (each interval's start) and the float32 values
+    up to 3 ulps either side, within [0, 1]."""
+    nodes = energy_tables.cosine_nodes().astype(np.float32)
+    out = [nodes]
+    for direction in (np.float32(-1.0), np.float32(2.0)):
+        x = nodes.copy()
+        for _ in range(3):
+            x = np.nextafter(x, direction)
+            out.append(x)
+    mu = np.concatenate(out)
+    return np.unique(mu[(mu >= 0) & (mu <= 1)])
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("per_element", [False, True], ids=["uniform", "per-element"])
+def test_lookups_beside_the_nodes(isa, per_element):
+    # at a node two lines meet with different slopes: ν = μ + 1/8 rounded up onto
+    # the next interval (μ = 1 - 2^-24 onto the flat one at μ = 1) continues the
+    # wrong line, by 2e-3 of 1 - E at low roughness in the 2012 model; a uniform
+    # material's row written from μ = 0 (2014; 2012 from roughness 0.36) rounds
+    # relative to its intercept, whose ratio to 1 - E the kernels bound. White metals
+    # on, between and beside the rows (1/64 apart), both sides of the 2012 model's
+    # switch, the lookups at every node and its neighbours, μo random.
+    rng = seeded_rng("energy-compensation-nodes", isa, per_element)
+    mu = cosines_beside_the_nodes()
+    repeats = 8
+    wi_z = np.repeat(mu, repeats)
+    wo_z = rng.uniform(0.05, 1.0, len(wi_z)).astype(np.float32)
+    wo_z[::repeats] = mu  # both lookups on a node's neighbourhood
+
+    def directions(z):
+        phi = rng.uniform(0, 2 * np.pi, len(z))
+        r = np.sqrt(np.maximum(0.0, 1.0 - z.astype(np.float64) ** 2))
+        return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1).astype(np.float32)
+
+    wi, wo = directions(wi_z), directions(wo_z)
+    wi[:, 2], wo[:, 2] = wi_z, wo_z  # z exactly the float32 cosine (lengths within 1e-7 of 1)
+    for model in MODELS:
+        for r in (0.0, 1 / 64, 0.03, 0.06, 0.1, 0.2, 0.3, 22 / 64, 0.35, 23 / 64, 0.37, 0.5, 0.77, 1.0):
+            material = pb.Material(**WHITE, roughness=np.full(len(wi), r, np.float32) if per_element else r)
+            for name, simd, expected in compensated_lobes_against_reference(material, wi, wo, isa, model):
+                errors = relative_errors(simd, expected)
+                # the maximum bounds of README "What is checked": at cos θ >= 0.05, and below
+                steep = (wi_z >= 0.05) & (wo_z >= 0.05)
+                for bound, where in ((5e-5, steep), (1e-3, ~steep)):
+                    worst = int(np.argmax(np.where(where, errors.max(axis=1), 0)))
+                    assert errors[where].max() <= bound, (model, r, name, wi_z[worst], wo_z[worst], errors[worst])
 
 
 @pytest.mark.parametrize("isa", ISAS)
@@ -450,7 +523,8 @@ def test_sampling_chi_square(case):
     # the weights are f cos θl / pdf of the compensated f
     f = pb.reference.eval(material, s.wi[:2000], wo, model=model, energy_compensation=True)
     ok = s.pdf[:2000] > 0
-    np.testing.assert_allclose(s.weight[:2000][ok], (f * s.wi[:2000, 2:3] / s.pdf[:2000, None])[ok], rtol=1e-10)
+    expected = f[ok] * s.wi[:2000, 2:3][ok] / s.pdf[:2000, None][ok]
+    np.testing.assert_allclose(s.weight[:2000][ok], expected, rtol=1e-10)
 
 
 def test_lobe_probabilities_include_the_lobe():

@@ -26,6 +26,7 @@
 
 #include "kernel_api.hpp"
 #include "principled_brdf/energy_corners.hpp"
+#include "principled_brdf/energy_intercepts.hpp"
 
 namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS {
 

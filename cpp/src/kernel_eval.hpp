@@ -284,7 +284,7 @@ std::int64_t eval_batches(const EvalJob& job, std::int64_t begin, std::int64_t e
     BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
         uniform = prepare_for<model, output, compensated>(load_material(job.params, 0));
-        if constexpr (compensated) row.use_for(uniform.ms);
+        if constexpr (compensated) row.template use_for<model>(uniform.ms);
     }
     std::int64_t i = begin;
     if constexpr (!per_element) {

@@ -33,29 +33,45 @@ PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shadi
 // table's two rows about its r_eff blended into one (values and slopes, so
 // linear in r like the lookup of two rows), so that a lookup reads one
 // interval instead of two. The lobe reads `values` from then on.
+//
+// Where the two rows allow it (energy_intercepts.hpp), the blended row's lines
+// are written from μ = 0, 1 - E = v0 + μ s, which spares each lookup the
+// interval's end and μ's offset in it (four vector operations). Every row of
+// the 2014 model does (its worst cancellation 14.1, at roughness 0; tested),
+// so its loops hold that form alone; the 2012 model's rows below roughness
+// 23/64 = 0.36 do not (70,000 at roughness 1/32, where 1 - E falls from 5e-3
+// to 2e-6 over μ's last interval before 1) and keep the lines from their ends.
 struct BlendedEnergyRow {
     alignas(64) float values[2 * 64];  // laid out by row_value_at and row_slope_at (simd_ops.hpp)
 
+    template <Model model>
     PB_KERNEL_INLINE void use_for(MultipleScatteringLobe<Floats>& ms) {
         alignas(64) std::int32_t offset[kLanes];
         alignas(64) float fraction[kLanes];
         ms.row.offset.store_aligned(offset);
         ms.row.fraction.store_aligned(fraction);
-        fill(ms.missing + 2 * offset[0], fraction[0]);
+        const int m = static_cast<int>(model), row = offset[0] / energy::kIntervals;
+        // (a constant for the 2014 model, which the compiler propagates into the loops)
+        const bool from_zero = model == Model::kDisney2014 || energy::kInterceptRows[m][row];
+        ms.lookup = from_zero ? EnergyLookup::kRowFromZero : EnergyLookup::kRowFromEnd;
+        fill((from_zero ? energy::kMissingIntercepts[m] : ms.missing) + 2 * offset[0], fraction[0]);
         ms.missing = values;
-        ms.single_row = true;
     }
 
-    // The row at below ((value, slope) an interval) blended with the next one by t.
-    // Out of line: it runs once per call, and its loop then stays out of the
-    // batch loops' functions, whose largest loop bench/loop_asm.py reports.
+    // The row at below ((value, slope) an interval) blended with the next one
+    // by t, in float64 and rounded once. Out of line: it runs once per call,
+    // and its loops then stay out of the batch loops' functions, whose largest
+    // loop bench/loop_asm.py reports.
     __attribute__((noinline)) void fill(const float* below, float t) {
         const float* above = below + 2 * energy::kIntervals;
-        auto blend = [&](int at) { return below[at] * (1.0f - t) + above[at] * t; };
-        for (int b = 0; b < 64; ++b) {  // the slots past the last interval (μ = 1, flat) repeat it
-            int interval = std::min(b, energy::kIntervals - 1);
-            values[row_value_at(b)] = blend(2 * interval);
-            values[row_slope_at(b)] = blend(2 * interval + 1);
+        const double weight = t, weight_below = 1.0 - weight;
+        for (int b = 0; b < energy::kIntervals; ++b) {
+            values[row_value_at(b)] = static_cast<float>(below[2 * b] * weight_below + above[2 * b] * weight);
+            values[row_slope_at(b)] = static_cast<float>(below[2 * b + 1] * weight_below + above[2 * b + 1] * weight);
+        }
+        for (int b = energy::kIntervals; b < 64; ++b) {  // the slots past the last interval (μ = 1, flat) repeat it
+            values[row_value_at(b)] = values[row_value_at(energy::kIntervals - 1)];
+            values[row_slope_at(b)] = values[row_slope_at(energy::kIntervals - 1)];
         }
     }
 };

@@ -207,7 +207,7 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
         uniform = shading_of(m);
         if constexpr (compensated) {
             uniform_ms = multiple_scattering_of(m.slot, uniform, model);
-            row.use_for(uniform_ms);
+            row.template use_for<model>(uniform_ms);
         }
     }
     CounterSeed seed = counter_seed(job.seed);

@@ -422,7 +422,11 @@ PB_KERNEL_INLINE Ints min(Ints a, Ints b) { return xsimd::min(a, b); }
 // end: ν's exponent and top four mantissa bits, plus one. Any μ in [0, 1 + 1/16)
 // (a unit vector's z, rounded up included) finds its own interval; any other ν
 // (μ < 0, where the lobe is discarded) some interval of the table, never an
-// index outside it.
+// index outside it. The interval is that of the exact sum: ν rounded to nearest
+// may round up onto the next interval's start, where the two lines meet but
+// may have very different slopes; at μ = 1 - 2^-24, which rounds to ν = 9/8,
+// the flat last interval would then stand for a line that, at low roughness in
+// the 2012 model, falls 2e-3 of 1 - E over that last ulp.
 constexpr int kIntervalShift = 23 - 4;
 constexpr std::int32_t kFirstIntervalBits = 0x3E000000 >> kIntervalShift;  // 1/8's bits
 static_assert(energy::kCosineOffset == 0.125f, "the first interval starts at 1/8");
@@ -433,17 +437,28 @@ PB_KERNEL_INLINE Floats interval_end(Ints bits) {
 // Here the interval comes as ν's bits >> 19, the interval plus 31 · 64: the
 // permutes of a row read it modulo 64 (a row's slots past the last interval
 // repeat it, kernel_material.hpp), without a subtraction or a clamp;
-// gather_corners takes the offset off and clamps.
+// gather_corners takes the offset off and clamps. ν is the sum rounded toward
+// zero (the instruction's own rounding mode), so never past the exact one.
 static_assert(kFirstIntervalBits % 64 == 0, "1/8's bits >> 19 are 0 modulo 64");
-PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
-    Ints bits = xsimd::bitwise_cast<Ints>(nu);
+PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats mu) {
+    const __m512 nu = _mm512_add_round_ps(mu, Floats(energy::kCosineOffset), _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
+    Ints bits = xsimd::bitwise_cast<Ints>(Floats(nu));
     return {bits >> kIntervalShift, interval_end(bits)};
 }
 #else
-// ν clamped to [1/8, 9/8] first, where μ = 1 starts its interval, a NaN to
-// 1/8: x86's max returns its second operand for a NaN, NEON's the NaN
-PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats nu) {
+// ν = μ + (1/8 - 2^-27), the float below 1/8, rounded to nearest, lies in
+// the interval of the exact μ + 1/8 for every μ >= 0: the shift puts each sum
+// of a μ inside an interval strictly between the rounding midpoints about the
+// interval's ends (2^-27 is half the spacing of floats in [1/8, 1/4) and no
+// more than a μ >= 1/8 moves by its last bit, while a sum's spacing is at most
+// twice its μ's), and a μ at a boundary at most into the interval before, whose
+// line meets the next one there. Then ν is clamped to [1/8, 9/8], where μ = 1
+// starts its interval, a NaN to 1/8: x86's max returns its second operand for
+// a NaN, NEON's the NaN.
+constexpr float kBelowCosineOffset = 0.125f - 0x1p-27f;
+PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats mu) {
     Floats offset(energy::kCosineOffset);
+    Floats nu = mu + Floats(kBelowCosineOffset);
 #if defined(__ARM_NEON)
     Floats at_least_first = select(nu > offset, nu, offset);
 #else

@@ -14,9 +14,9 @@
 //   ∫ f_ms cos θl dωl = lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))) (1 - E(μo))
 // (since 2 ∫ (1 - E(μ)) μ dμ = 1 - E_avg), added to the cosine lobe's w0.
 // The ops of the number type provide truncate_to_index (x >= 0), index_to_real,
-// energy_interval (the interval of ν = μ + 1/8 that holds a lane, 16 an
-// octave from 1/8, and that interval's end: ν's exponent and top four
-// mantissa bits, plus one; no division), value_and_slope_in_row (an interval's
+// energy_interval (the interval of ν = μ + 1/8, the exact sum, that holds a
+// lane, 16 an octave from 1/8, and that interval's end: ν's exponent and top
+// four mantissa bits, plus one; no division), value_and_slope_in_row (an interval's
 // value and slope from a blended row that every lane shares, which the AVX-512
 // kernel reads by register permutes instead of gathers), gather_pair_in_row
 // ((row[index], row[index + 1]) from a row of intervals + 1 nodes, the table
@@ -26,13 +26,16 @@
 
 // The roughness rows' spacing is a power of two, so that r (kRoughnesses - 1)
 // is exact in float32 and so is the interpolation weight between rows; within
-// an interval, μ - μ_b+1 is exact (μ_b+1 = ν_b+1 - 1/8 has few bits; ν's own
-// rounding only picks the interval, where the lines meet): the float32 lookup
+// an interval, μ - μ_b+1 is exact (μ_b+1 = ν_b+1 - 1/8 has few bits), and the
+// interval is the exact sum's (the lines meet at its ends, but near μ = 1 at low
+// roughness a line continued one ulp past its end errs by 2e-3): the float32 lookup
 // then differs from the float64 one by its roundings alone, also where 1 - E
 // is small and steep (near μ = 1 at low roughness in the 2012 model, where a
 // rounded μ would move it by 1e-4 of itself). Each line is written from its
 // interval's end, where 1 - E is the smaller near μ = 1: from the start, it
-// would there be the difference of nearly equal terms.
+// would there be the difference of nearly equal terms. (A uniform material's
+// blended row is written from μ = 0 where no interval cancels by more than a
+// bounded factor: kRowFromZero, energy_intercepts.hpp.)
 static_assert(((energy::kRoughnesses - 1) & (energy::kRoughnesses - 2)) == 0, "kRoughnesses - 1 is a power of two");
 static_assert(energy::kIntervalsPerOctave == 16 && energy::kIntervals == 51, "3 octaves of ν from 1/8, [1, 1 + 1/8], then μ = 1");
 
@@ -46,22 +49,31 @@ struct EnergyRow {
     F fraction;         // r_eff's position between rows j and j + 1
 };
 
+// How missing_energy reads its table: two rows by corners (the float64 path and
+// per-element materials), or one row blended between them (a uniform
+// material), its lines written from each interval's end like the table's, or
+// from μ = 0 where that is well conditioned (energy_intercepts.hpp).
+enum class EnergyLookup { kCorners, kRowFromEnd, kRowFromZero };
+
 template <class F>
 struct MultipleScatteringLobe {
-    const float* missing;  // the model's 1 - E table, or one blended row of it (single_row)
+    const float* missing;  // the model's 1 - E table, or one blended row of it (lookup != kCorners)
     const float* corners;  // the same table by corners (energy_corners.hpp), which the lookup reads otherwise
     EnergyRow<F> row;
-    bool single_row = false;  // missing is 1 - E at r_eff already, blended between the rows (a uniform material)
+    EnergyLookup lookup = EnergyLookup::kCorners;
     Rgb<F> color;          // F_avg² E_avg / (1 - F_avg (1 - E_avg)) / (π (1 - E_avg))
     F albedo_scale;        // lum(F_avg² E_avg / (1 - F_avg (1 - E_avg))): w3 = albedo_scale (1 - E(μo))
 
     // 1 - E(μ) at r_eff: linear in μ within each interval, linear in r between the rows
     // (for μ in [0, 1 + 1/16); below the surface, where the lobe is discarded, some finite value)
     PB_MODEL_INLINE F missing_energy(F mu) const {
-        F offset(energy::kCosineOffset);
-        const auto [interval, end] = energy_interval(mu + offset);
-        F along = mu - (end - offset);  // <= 0
-        if (single_row) {
+        const auto [interval, end] = energy_interval(mu);
+        if (lookup == EnergyLookup::kRowFromZero) {  // value at μ = 0: no interval end, no offset
+            const auto [value, slope] = value_and_slope_in_row(missing, interval);
+            return mul_add(mu, slope, value);
+        }
+        F along = mu - (end - F(energy::kCosineOffset));  // <= 0
+        if (lookup == EnergyLookup::kRowFromEnd) {
             const auto [value, slope] = value_and_slope_in_row(missing, interval);
             return mul_add(along, slope, value);
         }

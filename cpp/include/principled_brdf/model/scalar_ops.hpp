@@ -40,9 +40,10 @@ inline std::pair<double, double> sincos_turns(double u) {
 inline int truncate_to_index(double x) { return static_cast<int>(x); }
 inline double index_to_real(int i) { return static_cast<double>(i); }
 inline int min(int a, int b) { return a < b ? a : b; }
-// the interval of ν = μ + 1/8, 16 an octave from 1/8, and its end: ν's exponent
-// and top four mantissa bits, plus one; ν clamped to [1/8, 9/8] first (NaN to 1/8)
-inline std::pair<int, double> energy_interval(double nu) {
+// the interval of ν = μ + 1/8 (the exact sum: one ulp lower where it rounded up),
+// 16 an octave from 1/8, and its end: ν's exponent and top four mantissa bits,
+// plus one; ν clamped to [1/8, 9/8] first (NaN to 1/8)
+inline std::pair<int, double> energy_interval(double mu) {
     constexpr int shift = 52 - 4;
     auto bits_of = [](double x) {
         std::uint64_t bits;
@@ -50,6 +51,8 @@ inline std::pair<int, double> energy_interval(double nu) {
         return bits;
     };
     const double first = energy::kCosineOffset, last = first + 1.0;
+    const double nearest = mu + first;
+    const double nu = nearest - mu > first ? std::nextafter(nearest, 0.0) : nearest;
     const double clamped = nu > first ? (nu < last ? nu : last) : first;
     const std::uint64_t bits = bits_of(clamped), end_bits = (bits & ~((std::uint64_t(1) << shift) - 1)) + (std::uint64_t(1) << shift);
     double end;
