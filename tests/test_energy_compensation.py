@@ -124,12 +124,12 @@ def test_table_is_continuous_and_its_average_the_integral(model):
 
 
 def test_rows_that_may_be_read_from_zero():
-    """A uniform material's kernels read the lines of its blended row written
-    from μ = 0, 1 - E = v0 + μ s, where rows j and j + 1 both allow it
-    (cpp/include/principled_brdf/energy_intercepts.hpp): on every interval
-    |v0| + μ_end |s| within 16 of the line's smaller end value. The 2014
-    model's kernels take that form for every row without asking, so every row
-    of its table must allow it; in the 2012 model the rows from 23/64 do."""
+    """A uniform material's kernels read the 2014 model's blended row as lines
+    written from μ = 0, 1 - E = v0 + μ s, whose roundings stay within 2e-6 of
+    1 - E where on every interval |v0| + μ_end |s| is within 16 of the line's
+    smaller end value (cpp/include/principled_brdf/energy_intercepts.hpp):
+    every row of the 2014 table must allow it. The 2012 model's kernels keep
+    the lines from the intervals' ends: its rows below 23/64 do not."""
     ends, starts = energy_tables.interval_ends(), energy_tables.cosine_nodes()
     value, slope = MISSING[..., 0].astype(np.float64), MISSING[..., 1].astype(np.float64)
     intercept = value - ends * slope

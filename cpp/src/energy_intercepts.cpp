@@ -2,7 +2,6 @@
 // the generated tables when the library is loaded.
 #include "principled_brdf/energy_intercepts.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 namespace principled_brdf::energy {
@@ -15,26 +14,14 @@ double cosine_at(int b) {
 
 struct InterceptTables {
     alignas(64) float values[2][kRoughnesses * kIntervals * 2] = {};
-    bool rows[2][kRoughnesses] = {};
 
     InterceptTables() {
-        for (int model = 0; model < 2; ++model) {
-            bool well_conditioned[kRoughnesses];
-            for (int j = 0; j < kRoughnesses; ++j) {
-                well_conditioned[j] = true;
-                for (int b = 0; b < kIntervals; ++b) {
-                    const int at = 2 * (j * kIntervals + b);
-                    const double value = kMissing[model][at], slope = kMissing[model][at + 1];
-                    const double end = cosine_at(b + 1), start_value = value - (end - cosine_at(b)) * slope;
-                    const double intercept = value - end * slope;
-                    values[model][at] = static_cast<float>(intercept);
-                    values[model][at + 1] = kMissing[model][at + 1];
-                    const double smaller = std::min(value, start_value);
-                    well_conditioned[j] &= smaller > 0.0 && std::abs(intercept) + end * std::abs(slope) <= kMaxCancellation * smaller;
-                }
+        for (int model = 0; model < 2; ++model)
+            for (int at = 0; at < kRoughnesses * kIntervals; ++at) {
+                const double value = kMissing[model][2 * at], slope = kMissing[model][2 * at + 1];
+                values[model][2 * at] = static_cast<float>(value - cosine_at(at % kIntervals + 1) * slope);
+                values[model][2 * at + 1] = kMissing[model][2 * at + 1];
             }
-            for (int j = 0; j + 1 < kRoughnesses; ++j) rows[model][j] = well_conditioned[j] && well_conditioned[j + 1];
-        }
     }
 };
 
@@ -43,6 +30,5 @@ const InterceptTables tables;
 }  // namespace
 
 const float* const kMissingIntercepts[2] = {tables.values[0], tables.values[1]};
-const bool* const kInterceptRows[2] = {tables.rows[0], tables.rows[1]};
 
 }  // namespace principled_brdf::energy

@@ -34,13 +34,14 @@ PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shadi
 // linear in r like the lookup of two rows), so that a lookup reads one
 // interval instead of two. The lobe reads `values` from then on.
 //
-// Where the two rows allow it (energy_intercepts.hpp), the blended row's lines
-// are written from μ = 0, 1 - E = v0 + μ s, which spares each lookup the
-// interval's end and μ's offset in it (four vector operations). Every row of
-// the 2014 model does (its worst cancellation 14.1, at roughness 0; tested),
-// so its loops hold that form alone; the 2012 model's rows below roughness
-// 23/64 = 0.36 do not (70,000 at roughness 1/32, where 1 - E falls from 5e-3
-// to 2e-6 over μ's last interval before 1) and keep the lines from their ends.
+// For the 2014 model the blended row's lines are written from μ = 0, 1 - E =
+// v0 + μ s (energy_intercepts.hpp), which spares each lookup the interval's
+// end and μ's offset in it (four vector operations): every row of its table
+// allows that (its worst cancellation 14.1, at roughness 0; tested). The 2012
+// model's rows below roughness 23/64 = 0.36 do not (70,000 at roughness 1/32,
+// where 1 - E falls from 5e-3 to 2e-6 over μ's last interval before 1), and
+// its rows keep the lines from their ends: a loop that held both forms, chosen
+// per call, ran 4 % slower for the rows that keep them.
 struct BlendedEnergyRow {
     alignas(64) float values[2 * 64];  // laid out by row_value_at and row_slope_at (simd_ops.hpp)
 
@@ -50,11 +51,10 @@ struct BlendedEnergyRow {
         alignas(64) float fraction[kLanes];
         ms.row.offset.store_aligned(offset);
         ms.row.fraction.store_aligned(fraction);
-        const int m = static_cast<int>(model), row = offset[0] / energy::kIntervals;
-        // (a constant for the 2014 model, which the compiler propagates into the loops)
-        const bool from_zero = model == Model::kDisney2014 || energy::kInterceptRows[m][row];
+        // one form a model (a constant the compiler carries into the loops, which then hold it alone)
+        constexpr bool from_zero = model == Model::kDisney2014;
         ms.lookup = from_zero ? EnergyLookup::kRowFromZero : EnergyLookup::kRowFromEnd;
-        fill((from_zero ? energy::kMissingIntercepts[m] : ms.missing) + 2 * offset[0], fraction[0]);
+        fill((from_zero ? energy::kMissingIntercepts[static_cast<int>(model)] : ms.missing) + 2 * offset[0], fraction[0]);
         ms.missing = values;
     }
 
