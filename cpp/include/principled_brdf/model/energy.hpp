@@ -33,9 +33,9 @@
 // is small and steep (near μ = 1 at low roughness in the 2012 model, where a
 // rounded μ would move it by 1e-4 of itself). Each line is written from its
 // interval's end, where 1 - E is the smaller near μ = 1: from the start, it
-// would there be the difference of nearly equal terms. (A uniform material's
-// blended row is written from μ = 0 where no interval cancels by more than a
-// bounded factor: kRowFromZero, energy_intercepts.hpp.)
+// would there be the difference of nearly equal terms. (The kernels write a
+// uniform material's blended row from μ = 0 in the 2014 model, whose lines
+// cancel little there: kRowFromZero, energy_intercepts.hpp.)
 static_assert(((energy::kRoughnesses - 1) & (energy::kRoughnesses - 2)) == 0, "kRoughnesses - 1 is a power of two");
 static_assert(energy::kIntervalsPerOctave == 16 && energy::kIntervals == 51, "3 octaves of ν from 1/8, [1, 1 + 1/8], then μ = 1");
 
@@ -52,7 +52,7 @@ struct EnergyRow {
 // How missing_energy reads its table: two rows by corners (the float64 path and
 // per-element materials), or one row blended between them (a uniform
 // material), its lines written from each interval's end like the table's, or
-// from μ = 0 where that is well conditioned (energy_intercepts.hpp).
+// from μ = 0 (energy_intercepts.hpp).
 enum class EnergyLookup { kCorners, kRowFromEnd, kRowFromZero };
 
 template <class F>
