@@ -1,8 +1,10 @@
-// The intercept tables of principled_brdf/energy_intercepts.hpp, derived from
-// the generated tables when the library is loaded.
+// The intercept table of principled_brdf/energy_intercepts.hpp, derived from
+// the generated table when the library is loaded.
 #include "principled_brdf/energy_intercepts.hpp"
 
 #include <cmath>
+
+#include "principled_brdf/params.hpp"  // Model
 
 namespace principled_brdf::energy {
 namespace {
@@ -12,23 +14,23 @@ double cosine_at(int b) {
     return std::ldexp(1.0 + (b % kIntervalsPerOctave) / double(kIntervalsPerOctave), b / kIntervalsPerOctave - 3) - kCosineOffset;
 }
 
-struct InterceptTables {
-    alignas(64) float values[2][kRoughnesses * kIntervals * 2] = {};
+struct InterceptTable {
+    alignas(64) float values[kRoughnesses * kIntervals * 2] = {};
 
-    InterceptTables() {
-        for (int model = 0; model < 2; ++model)
-            for (int at = 0; at < kRoughnesses * kIntervals; ++at) {
-                const double value = kMissing[model][2 * at], slope = kMissing[model][2 * at + 1];
-                values[model][2 * at] = static_cast<float>(value - cosine_at(at % kIntervals + 1) * slope);
-                values[model][2 * at + 1] = kMissing[model][2 * at + 1];
-            }
+    InterceptTable() {
+        const float* missing = kMissing[static_cast<int>(Model::kDisney2014)];
+        for (int at = 0; at < kRoughnesses * kIntervals; ++at) {
+            const double value = missing[2 * at], slope = missing[2 * at + 1];
+            values[2 * at] = static_cast<float>(value - cosine_at(at % kIntervals + 1) * slope);
+            values[2 * at + 1] = missing[2 * at + 1];
+        }
     }
 };
 
-const InterceptTables tables;
+const InterceptTable table;
 
 }  // namespace
 
-const float* const kMissingIntercepts[2] = {tables.values[0], tables.values[1]};
+const float* const kMissingIntercepts2014 = table.values;
 
 }  // namespace principled_brdf::energy

@@ -54,7 +54,7 @@ struct BlendedEnergyRow {
         // one form a model (a constant the compiler carries into the loops, which then hold it alone)
         constexpr bool from_zero = model == Model::kDisney2014;
         ms.lookup = from_zero ? EnergyLookup::kRowFromZero : EnergyLookup::kRowFromEnd;
-        fill((from_zero ? energy::kMissingIntercepts[static_cast<int>(model)] : ms.missing) + 2 * offset[0], fraction[0]);
+        fill((from_zero ? energy::kMissingIntercepts2014 : ms.missing) + 2 * offset[0], fraction[0]);
         ms.missing = values;
     }
 

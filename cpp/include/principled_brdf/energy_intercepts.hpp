@@ -1,6 +1,6 @@
-// The tables of energy_tables.hpp with each interval's line written from μ = 0:
-//   kMissingIntercepts[model][2 (j kIntervals + b)] = v - μ_b+1 s (the line's 1 - E at μ = 0),
-//   kMissingIntercepts[model][2 (j kIntervals + b) + 1] = s,
+// The 2014 model's table of energy_tables.hpp with each interval's line written from μ = 0:
+//   kMissingIntercepts2014[2 (j kIntervals + b)] = v - μ_b+1 s (the line's 1 - E at μ = 0),
+//   kMissingIntercepts2014[2 (j kIntervals + b) + 1] = s,
 // for the value v and slope s of kMissing, computed in float64 and rounded once.
 // A lookup fma(μ, s, v0) errs by the roundings of v0 and s, 2^-24 (|v0| +
 // μ |s|), not 2^-24 |1 - E|, which is small where the line cancels. A row may
@@ -18,6 +18,6 @@
 
 namespace principled_brdf::energy {
 
-extern const float* const kMissingIntercepts[2];
+extern const float* const kMissingIntercepts2014;
 
 }  // namespace principled_brdf::energy
