@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 MODELS = ("disney2014", "disney2012")
+SMALLEST_TINTED_LUMINANCE = 2.0 ** -126  # below it Ctint = 1 (float32 cannot hold 1/Cdlum)
 
 DEFAULTS = {
     "base_color": (0.82, 0.67, 0.16),
@@ -130,10 +131,10 @@ def _evaluate(material, wi, wo, model):
         sin2_h = (H[..., 0] ** 2 + H[..., 1] ** 2) / H2
 
         # Colours
+        # Ctint = base / Cdlum, 1 where Cdlum < 2^-126 (float32's smallest normal number)
         cd_lum = 0.3 * base[..., 0] + 0.6 * base[..., 1] + 0.1 * base[..., 2]
-        c_tint = np.where(
-            _scalar(cd_lum) > 0.0, base / np.where(cd_lum > 0.0, cd_lum, 1.0)[..., None], 1.0
-        )
+        tinted = cd_lum >= SMALLEST_TINTED_LUMINANCE
+        c_tint = np.where(_scalar(tinted), base / np.where(tinted, cd_lum, 1.0)[..., None], 1.0)
         c_spec0 = mix(specular * 0.08 * mix(1.0, c_tint, specular_tint), base, metallic)
         c_sheen = mix(1.0, c_tint, sheen_tint)
 

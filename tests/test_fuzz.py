@@ -32,7 +32,11 @@ ISAS = pb.cpu_info()["available"]
 ARGUMENT_NAMES = ("wi", "wo", "u", "out", "material", "model", "layout", "threads", "check", "cosine", "isa",
                   "seed", "specular_sampler", "n", "first", "samples", "cos_theta_o", "resolution", "light",
                   "light_intensity", "ambient", "leading shapes", "h", "w", "u1", "u2", "alpha", "alpha_x",
-                  "alpha_y", "gamma", "cos_theta_h", "closed_forms", "params", *pb.PARAMETERS)
+                  "alpha_y", "gamma", "cos_theta_h", "closed_forms", "params", "energy_compensation", "wrt",
+                  "out[0]", "out[1]", "measured", "weights", "bounds", "fit", "init", "loss", "max_iterations",
+                  "precision", "normal", "tangent", "frame", "theta", "phi", "theta_h", "phi_h", "theta_d", "phi_d",
+                  "color", "linear", "exposure", "curve", "table", "brdf", "interpolation", "theta_o", "phi_d",
+                  "angles", "channel", "lobes", *pb.PARAMETERS)
 
 
 def assert_names_an_argument(error: Exception) -> None:
@@ -436,3 +440,189 @@ def test_fuzz_sees_every_isa(isa):
     # the option draws include each available isa; make sure each one ran at least on good input
     wi = unit_vectors(rng_from(1), (33,)).astype(np.float32)
     assert np.isfinite(pb.eval(pb.Material(), wi, wi[::-1].copy(), isa=isa)).all()
+
+
+# ------------------------------------------------------------------ the entry points added since
+
+@FUZZ
+@given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1),
+       entry=st.sampled_from(("eval_pdf", "eval_pdf_out", "eval_grad_wrt", "eval_grad_out", "sample_n",
+                              "compensated_eval", "compensated_sample")))
+def test_fuzz_paired_outputs_counts_and_compensation(data, leading, seed, entry):
+    rng = rng_from(seed)
+    n = int(np.prod(leading))
+    opts = data.draw(options(["model", "threads", "check", "isa", "layout"]))
+    layout = opts.get("layout", "aos")
+    wi = soa(data.draw(direction_argument(leading, rng)), layout)
+    wo = soa(data.draw(direction_argument(leading, rng)), layout)
+    material = outcome(lambda: pb.Material(**data.draw(material_argument(n, rng))))
+    if material is None:
+        return
+    value_shape = tuple(leading) + (3,) if layout == "aos" else (3,) + tuple(leading)
+    wrt = data.draw(st.sampled_from((None, "roughness", ["base_color", "sheen"], [], "albedo", ["metallic", 3])))
+    width = len(pb._gradient.columns(wrt)) if outcome(lambda: pb._gradient.columns(wrt)) is not None else 13
+    second_shape = {"eval_pdf_out": tuple(leading),
+                    "eval_grad_out": tuple(leading) + (3, width) if layout == "aos" else (3, width) + tuple(leading)}
+    out = None
+    if entry in second_shape:
+        kind = data.draw(st.sampled_from(("fresh", "fresh", "none_second", "overlap_wi", "same", "wrong_shape")))
+        first, second = np.full(value_shape, np.nan, np.float32), np.full(second_shape[entry], np.nan, np.float32)
+        if kind == "none_second":
+            second = None
+        elif kind == "overlap_wi" and isinstance(wi, np.ndarray) and wi.dtype == np.float32 and second.size:
+            second = wi.reshape(-1)[: second.size].reshape(second.shape) if wi.size >= second.size else second
+        elif kind == "same":
+            second = first
+        elif kind == "wrong_shape":
+            second = second[..., :0] if second.ndim else second
+        out = (first, second)
+    wi_before = np.array(wi, copy=True) if isinstance(wi, np.ndarray) else None
+    compensation = data.draw(st.sampled_from((True, True, False, 1, None)))
+    call = {"eval_pdf": lambda: pb.eval_pdf(material, wi, wo, **opts),
+            "eval_pdf_out": lambda: pb.eval_pdf(material, wi, wo, out=out, **opts),
+            "eval_grad_wrt": lambda: pb.eval_grad(material, wi, wo, wrt=wrt, **opts),
+            "eval_grad_out": lambda: pb.eval_grad(material, wi, wo, wrt=wrt, out=out, **opts),
+            "sample_n": lambda: pb.sample(material, wo, n=data.draw(st.sampled_from((0, 1, 3, -1, 2.0, None))),
+                                          seed=3, **opts),
+            "compensated_eval": lambda: pb.eval(material, wi, wo, energy_compensation=compensation, **opts),
+            "compensated_sample": lambda: pb.sample(material, wo, energy_compensation=compensation, seed=1,
+                                                    **opts)}[entry]
+    result = outcome(call)
+    if wi_before is not None and entry.endswith("_out"):
+        np.testing.assert_array_equal(np.asarray(wi), wi_before, err_msg="an input was overwritten")
+    if result is None:
+        return
+    arrays = [result.wi, result.pdf, result.weight] if entry.startswith(("sample", "compensated_sample")) \
+        else [result] if entry == "compensated_eval" else list(result[:2])
+    for array in arrays:
+        assert np.isfinite(array).all(), "non-finite output for accepted input"
+    if out is not None:
+        assert result[0] is out[0] and result[1] is out[1]
+
+
+@FUZZ
+@given(data=st.data(), seed=st.integers(0, 2**32 - 1),
+       entry=st.sampled_from(("frame", "to_local", "to_world", "spherical", "half_diff", "wiwo", "gamma22",
+                              "srgb", "tone")))
+def test_fuzz_frames_and_colors(data, seed, entry):
+    rng = rng_from(seed)
+    leading = data.draw(LEADING)
+    vector = data.draw(direction_argument(leading, rng))
+    scalar = data.draw(st.sampled_from(SCALAR_VALUES + (rng.random(leading) * 3,)))
+    frame = data.draw(st.sampled_from(("good", "scaled", "nan", "2x2", "str")))
+    frames = {"good": pb.frames.frame_from_normal([0.0, 0.6, 0.8]), "scaled": 2.0 * np.eye(3),
+              "nan": np.full((3, 3), np.nan), "2x2": np.eye(2), "str": "eye"}[frame]
+    tangent = data.draw(st.sampled_from((None, [1.0, 0.0, 0.0], [1e200, 0, 0], [0, 0, 1], [np.nan, 0, 0], "x")))
+    color = data.draw(st.sampled_from((0.5, 1e300, -1.0, np.nan, [0.2, 0.4, 0.9], "red", np.inf,
+                                       rng.random((4, 3)) * 1e3)))
+    opposite = -vector if data.draw(st.booleans()) and isinstance(vector, np.ndarray) and vector.dtype.kind == "f" \
+        else vector
+    call = {"frame": lambda: pb.frames.frame_from_normal(vector, tangent=tangent),
+            "to_local": lambda: pb.frames.to_local(vector, frames),
+            "to_world": lambda: pb.frames.to_world(vector, frames),
+            "spherical": lambda: pb.frames.spherical_to_direction(scalar, scalar),
+            "half_diff": lambda: pb.frames.half_diff_to_wiwo(scalar, 0.3, scalar, 1.0),
+            "wiwo": lambda: pb.frames.wiwo_to_half_diff(vector, opposite),
+            "gamma22": lambda: pb.gamma22_to_linear(color),
+            "srgb": lambda: pb.srgb_to_linear(color),
+            "tone": lambda: pb.render.to_srgb8(color,
+                                               exposure=data.draw(st.sampled_from((1.0, 0.0, -1.0, np.inf))),
+                                               curve=data.draw(st.sampled_from(("filmic", "reinhard", "clip", "x"))))
+            }[entry]
+    result = outcome(call)
+    if result is None:
+        return
+    for array in result if isinstance(result, tuple) else [result]:
+        array = np.asarray(array)
+        assert np.isfinite(array.astype(np.float64)).all(), f"{entry}: non-finite result for accepted input"
+    if entry == "frame":
+        rows = np.asarray(result)
+        np.testing.assert_allclose(np.einsum("...ij,...kj->...ik", rows, rows), np.broadcast_to(np.eye(3), rows.shape),
+                                   atol=1e-12)
+
+
+MERL_TABLE = np.full((3,) + pb.measured.MERL_SHAPE, 0.1)
+
+
+@FUZZ
+@given(data=st.data(), seed=st.integers(0, 2**32 - 1),
+       entry=st.sampled_from(("merl_eval", "merl_table", "save_merl", "fit")))
+def test_fuzz_measured_and_fit(data, seed, entry, tmp_path_factory):
+    rng = rng_from(seed)
+    leading = data.draw(st.sampled_from([(1,), (5,), (2, 3)]))
+    wi = data.draw(direction_argument(leading, rng))
+    wo = data.draw(direction_argument(leading, rng))
+    if entry == "merl_eval":
+        interpolation = data.draw(st.sampled_from(("nearest", "linear", "cubic", None)))
+        table = pb.measured.MerlBRDF(MERL_TABLE)
+        result = outcome(lambda: table.eval(wi, wo, interpolation=interpolation))
+    elif entry == "merl_table":
+        table = MERL_TABLE.copy()
+        table.reshape(-1)[int(rng.integers(table.size))] = data.draw(st.sampled_from((np.nan, np.inf, -1.0, 0.0)))
+        result = outcome(lambda: pb.measured.MerlBRDF(data.draw(st.sampled_from((table, table[:2], "table")))).table)
+        if result is not None:
+            result = np.nan_to_num(result)  # NaN marks cells without data
+    elif entry == "save_merl":
+        bad = data.draw(st.sampled_from((0.5, -1.0, np.inf, np.nan)))
+        path = tmp_path_factory.mktemp("merl") / "table.binary"
+        result = outcome(lambda: pb.measured.save_merl(path, lambda a, b: np.where(a[:, :1] > 0.99, bad, 0.5)
+                                                       * np.ones((len(a), 3))))
+        if result is None and path.exists():
+            pytest.fail("save_merl wrote a file for a call it refused")
+        return
+    else:
+        n = 24
+        wi_fit = unit_vectors(rng, (n,))
+        wo_fit = unit_vectors(rng, (n,))
+        measured = pb.reference.eval(pb.Material(roughness=0.4), wi_fit, wo_fit)
+        fault = data.draw(st.sampled_from(("none", "nan_row", "zeros", "negative", "inf", "shape")))
+        if fault == "nan_row":
+            measured[:] = np.nan
+        elif fault == "zeros":
+            measured[:] = 0.0
+        elif fault == "negative":
+            measured[3, 1] = -1.0
+        elif fault == "inf":
+            measured[5, 2] = np.inf
+        elif fault == "shape":
+            measured = measured[:, :2]
+        kwargs = {"fit": data.draw(st.sampled_from((["roughness"], ["roughness", "base_color"], "sheen", ["bogus"])))}
+        if data.draw(st.booleans()):
+            kwargs["loss"] = data.draw(st.sampled_from(("log", "relative", "linear", "l1")))
+        if data.draw(st.booleans()):
+            kwargs["bounds"] = data.draw(st.sampled_from(({"roughness": (0.1, 0.9)}, {"roughness": (0.5, 0.5)},
+                                                          {"roughness": (0.9, 0.1)}, {"roughness": 0.5},
+                                                          {"roughness": (np.nan, 1.0)}, {"bogus": (0, 1)})))
+        if data.draw(st.booleans()):
+            kwargs["max_iterations"] = data.draw(st.sampled_from((5, 0, -1, 2.5, "5")))
+        if data.draw(st.booleans()):
+            kwargs["weights"] = data.draw(st.sampled_from((np.ones(n), np.ones(n + 1), -np.ones(n), "w")))
+        fitted = outcome(lambda: pb.fit(wi_fit, wo_fit, measured, **kwargs))
+        result = None if fitted is None else np.concatenate([np.ravel(getattr(fitted.material, name))
+                                                             for name in pb.PARAMETERS])
+    if result is not None:
+        assert np.isfinite(np.asarray(result, dtype=np.float64)).all(), f"{entry}: non-finite result"
+
+
+@FUZZ
+@given(data=st.data(), entry=st.sampled_from(("brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves")))
+def test_fuzz_plot_arguments(data, entry):
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    material = data.draw(st.sampled_from((pb.Material(), "gold", "nonsense", 3, None)))
+    resolution = data.draw(st.sampled_from((8, 1, 0, -4, 2.5, 10**9, "8")))
+    call = {"brdf_slice": lambda: pb.plot.brdf_slice(material, resolution=resolution,
+                                                     phi_d=data.draw(st.sampled_from((90.0, np.nan, 400.0, "x")))),
+            "polar_lobes": lambda: pb.plot.polar_lobes(material, data.draw(st.sampled_from((30.0, 95.0, np.nan, -1.0)))),
+            "lit_sphere": lambda: pb.plot.lit_sphere(material, resolution=resolution),
+            "albedo_curves": lambda: pb.plot.albedo_curves(material, samples=data.draw(st.sampled_from((64, 1, 0, 2**40))),
+                                                           angles=data.draw(st.sampled_from(([0.0, 45.0], [np.nan],
+                                                                                             [120.0], "a"))))}[entry]
+    try:
+        outcome(call)
+    finally:
+        plt.close("all")

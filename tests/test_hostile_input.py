@@ -351,3 +351,148 @@ def test_the_kernels_never_see_misaligned_data():
     with pytest.raises(ValueError, match="out: array data is not aligned"):
         pb._core.batch_eval(wi.copy(), 0, np.float32([0, 0, 1]), 2, params,
                             [misaligned(np.empty((n, 3), np.float32))], 0, n, 0, False, False, 0.0, 1, "")
+
+
+# ------------------------------------------------------------------ tiny colors, long vectors, frames, helpers
+
+SUBNORMAL_COLORS = [(1e-39,) * 3, (1e-45, 0.0, 0.0), (0.0, 1e-40, 3e-39), (2e-38, 0.0, 0.0)]
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", ["disney2014", "disney2012"])
+@pytest.mark.parametrize("base_color", SUBNORMAL_COLORS)
+def test_a_color_of_subnormal_luminance_is_finite_and_matches_the_reference(isa, model, base_color):
+    m = pb.Material(base_color=base_color, specular_tint=1.0, sheen=1.0, sheen_tint=1.0)
+    rng = np.random.default_rng(31)
+    wi, wo = directions_at_length(rng, 64, 1.0), directions_at_length(rng, 64, 1.0)
+    f = pb.eval(m, wi, wo, model=model, isa=isa)
+    reference = pb.reference.eval(m, wi, wo, model=model)
+    assert np.isfinite(f).all() and np.isfinite(reference).all()
+    np.testing.assert_allclose(f, reference, rtol=1e-4, atol=1e-30)
+    assert np.isfinite(pb.pdf(m, wi, wo, model=model, isa=isa)).all()
+    value, pdf = pb.eval_pdf(m, wi, wo, model=model, isa=isa)
+    assert np.isfinite(value).all() and (pdf > 0).all()
+    for lobe in pb.eval_lobes(m, wi, wo, model=model, isa=isa):
+        assert np.isfinite(lobe).all()
+    gradient = pb.eval_grad(m, wi, wo, model=model, isa=isa)
+    assert np.isfinite(gradient.jacobian).all()
+    s = pb.sample(m, wo, seed=5, model=model, isa=isa)
+    assert np.isfinite(s.weight).all() and np.isfinite(s.pdf).all() and (s.pdf > 0).mean() > 0.5
+
+
+def test_the_reference_takes_a_subnormal_color_as_untinted():
+    rng = np.random.default_rng(32)
+    wi, wo = directions_at_length(rng, 16, 1.0), directions_at_length(rng, 16, 1.0)
+    tinted = dict(specular_tint=1.0, sheen=1.0, sheen_tint=1.0)
+    for base_color in [(1e-310, 0.0, 0.0), (0.0, 0.0, 1e-39)]:
+        f = pb.reference.eval(pb.Material(base_color=base_color, **tinted), wi, wo)
+        black = pb.reference.eval(pb.Material(base_color=(0.0, 0.0, 0.0), **tinted), wi, wo)
+        assert np.isfinite(f).all()
+        np.testing.assert_allclose(f, black, rtol=1e-12, atol=1e-300)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("model", ["disney2014", "disney2012"])
+def test_unchecked_long_vectors_give_zeros_not_nan(isa, model):
+    m = pb.Material(roughness=1e4, subsurface=0.5, sheen=1.0, clearcoat=1.0)
+    long = np.float32([[1e19, 0, 1], [1e12, 0, 1], [3.0, 0.0, 1.0], [0, 2.7, 0.1]])
+    up = np.broadcast_to(UP, long.shape)
+    for wi, wo in [(long, up), (up, long)]:
+        f = pb.eval(m, wi, wo, model=model, isa=isa, check=False)
+        assert np.isfinite(f).all() and (f == 0).all()
+        assert (pb.pdf(m, wi, wo, model=model, isa=isa, check=False) == 0).all()
+        gradient = pb.eval_grad(m, wi, wo, model=model, isa=isa, check=False)
+        assert np.isfinite(gradient.jacobian).all() and (gradient.jacobian == 0).all()
+    # within the bound, a non-unit pair is evaluated as given, the same on every instruction set
+    wi, wo = np.float32([[1.5, 0.0, 1.0]]), np.float32([[0.0, 0.5, 1.5]])
+    f = pb.eval(m, wi, wo, model=model, isa=isa, check=False)
+    assert (f > 0).all()
+    np.testing.assert_allclose(f, pb.eval(m, wi, wo, model=model, isa="sse2", check=False), rtol=1e-5)
+
+
+def test_a_huge_tangent_gives_an_orthonormal_frame():
+    frame = pb.frames.frame_from_normal([0, 0, 1], tangent=[1e200, 0, 0])
+    np.testing.assert_allclose(frame, np.eye(3), atol=1e-15)
+    frame = pb.frames.frame_from_normal([0, 0, 1], tangent=[1e-300, 1e-300, 0])
+    np.testing.assert_allclose(frame @ frame.T, np.eye(3), atol=1e-15)
+
+
+def test_a_normal_within_the_tolerance_is_normalised():
+    frame = pb.frames.frame_from_normal([0.0, 0.0009, 1.0009])
+    np.testing.assert_allclose(frame @ frame.T, np.eye(3), atol=1e-14)
+    frame = pb.frames.frame_from_normal([0.0, 0.0, 1.0009], tangent=[1.0, 0.0, 0.3])
+    np.testing.assert_allclose(frame @ frame.T, np.eye(3), atol=1e-14)
+
+
+@pytest.mark.parametrize("tangent, message", [([0, 0, 2], r"tangent: zero or parallel"),
+                                              ([np.nan, 0, 0], r"tangent\[0\]: nan"),
+                                              ([[1, 0, 0], [0, 0, 0]], r"tangent\[1\]: zero or parallel")])
+def test_bad_tangents_are_named(tangent, message):
+    with pytest.raises(ValueError, match=message):
+        pb.frames.frame_from_normal([0, 0, 1], tangent=tangent)
+
+
+@pytest.mark.parametrize("convert", [pb.frames.to_local, pb.frames.to_world])
+def test_frames_and_vectors_are_checked(convert):
+    good = pb.frames.frame_from_normal([[0, 0, 1], [0, 1, 0]])
+    np.testing.assert_allclose(convert([0, 0, 1], good)[0], [0, 0, 1], atol=1e-15)
+    with pytest.raises(ValueError, match=r"frame\[1\]: rows not orthonormal"):
+        convert([0, 0, 1], np.stack([good[0], 2 * good[1]]))
+    with pytest.raises(ValueError, match=r"frame\[1, 0\]: nan"):
+        convert([0, 0, 1], np.where(np.arange(9).reshape(3, 3) == 3, np.nan, good[0]))
+    with pytest.raises(ValueError, match=r"frame: expected shape"):
+        convert([0, 0, 1], np.eye(2))
+    with pytest.raises(ValueError, match=r"w\[1\]: inf"):
+        convert([0, np.inf, 1], good[0])
+
+
+def test_angle_helpers_refuse_nan_and_opposite_directions():
+    with pytest.raises(ValueError, match=r"theta: nan"):
+        pb.frames.spherical_to_direction(np.nan)
+    with pytest.raises(ValueError, match=r"phi\[1\]: inf"):
+        pb.frames.spherical_to_direction(0.5, [0.0, np.inf])
+    with pytest.raises(ValueError, match=r"theta_d: nan"):
+        pb.frames.half_diff_to_wiwo(0.1, 0.0, np.nan, 0.0)
+    w = np.array([[0.6, 0.0, 0.8], [0.0, 0.6, 0.8]])
+    with pytest.raises(ValueError, match=r"wi\[1\], wo\[1\]: opposite directions"):
+        pb.frames.wiwo_to_half_diff(w, np.array([[0.0, 0.0, 1.0], -w[1]]))
+
+
+def test_display_colors_beyond_float64_are_refused():
+    with pytest.raises(ValueError, match=r"color\[1\]: 1e\+300 \*\* 2.2 is beyond"):
+        pb.gamma22_to_linear([0.5, 1e300])
+    np.testing.assert_allclose(pb.gamma22_to_linear([0.5, 1e100]), [0.5 ** 2.2, 1e220])
+
+
+def test_tone_mapping_takes_infinity_as_white_and_refuses_nan():
+    pixels = np.array([[[np.inf, np.inf, np.inf], [np.inf, 0.0, 0.0], [0.5, 0.5, 0.5]]])
+    srgb = pb.render.to_srgb8(pixels)
+    assert (srgb[0, 0] == 255).all()
+    assert srgb[0, 1, 0] == 255
+    for curve in pb.render.TONE_CURVES:
+        assert np.isfinite(pb.render.tone_map(pixels, curve=curve)).all()
+    with pytest.raises(ValueError, match=r"linear\[0, 2, 1\]: nan"):
+        pb.render.to_srgb8(np.where(np.arange(9).reshape(1, 3, 3) == 7, np.nan, pixels))
+
+
+def test_linear_merl_lookups_at_cell_centres_ignore_neighbours_of_weight_zero():
+    m = pb.Material(roughness=0.4)
+    wi, wo = pb.measured.merl_pairs()
+    table = pb.measured.MerlBRDF(pb.reference.eval(m, wi, wo).T.reshape((3,) + pb.measured.MERL_SHAPE))
+    table.table[:, 40, 30, 90] = np.nan
+    above = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+    linear = table.eval(wi[above], wo[above], interpolation="linear")
+    nearest = table.eval(wi[above], wo[above], interpolation="nearest")
+    missing = np.isnan(nearest).any(axis=1)
+    assert missing.sum() == 1
+    np.testing.assert_allclose(linear[~missing], nearest[~missing], rtol=1e-9)
+
+
+def test_merl_tables_hold_brdf_values_or_nan():
+    table = np.zeros((3,) + pb.measured.MERL_SHAPE)
+    table[1, 2, 3, 4] = np.inf
+    with pytest.raises(ValueError, match=r"table\[1, 2, 3, 4\]: inf is not a BRDF value"):
+        pb.measured.MerlBRDF(table)
+    with pytest.raises(ValueError, match=r"brdf\[5, 0\]: -1.0 is not a BRDF value"):
+        pb.measured.save_merl("/nonexistent/never-written.binary",
+                              lambda wi, wo: np.where(np.arange(len(wi))[:, None] == 5, -1.0, np.ones((len(wi), 3))))

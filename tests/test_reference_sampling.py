@@ -99,7 +99,8 @@ def readme_clearcoat_alpha(p):
 def readme_lobe_probabilities(p, wo):
     base = p["base_color"]
     cd_lum = luminance(base)
-    tint = np.where(cd_lum[:, None] > 0, base / np.where(cd_lum > 0, cd_lum, 1.0)[:, None], 1.0)
+    tinted = cd_lum >= 2.0 ** -126
+    tint = np.where(tinted[:, None], base / np.where(tinted, cd_lum, 1.0)[:, None], 1.0)
     spec0 = mix(p["specular"][:, None] * 0.08 * mix(1.0, tint, p["specular_tint"][:, None]), base,
                 p["metallic"][:, None])
     sheen_color = mix(1.0, tint, p["sheen_tint"][:, None])

@@ -156,7 +156,11 @@ class _Directions:
         if self.leading == ():
             return array.reshape(3), _SINGLE
         if self.leading != leading:
-            target = leading + (3,) if self.layout == "aos" else (3,) + leading
+            if self.layout == "aos":
+                target = leading + (3,)
+            else:  # numpy aligns trailing axes: the vector axis must lead the leading ones
+                array = array.reshape((3,) + (1,) * (len(leading) - len(self.leading)) + self.leading)
+                target = (3,) + leading
             array = np.ascontiguousarray(np.broadcast_to(array, target))
         n = _size(leading)
         return (array.reshape(n, 3), _INTERLEAVED) if self.layout == "aos" else (array.reshape(3, n), _ROWS)
@@ -262,6 +266,10 @@ def _require_no_partial_overlap(out: NDArray[Any], inputs: dict[str, NDArray[Any
                              "(only an exact alias computes in place)")
 
 
+def _as_array(value: object) -> NDArray[Any] | None:
+    return value if isinstance(value, np.ndarray) else None
+
+
 def _require_material(material: object) -> None:
     if not isinstance(material, Material):
         raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
@@ -311,8 +319,9 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     value: Float32Array | None  # f: the output (gradient), or eval_pdf's optional one
     if gradient:
         value, jacobian = outputs
+        width = len(GRADIENT_NAMES)
         bad = _core.batch_eval_grad(wi_flat, wi_code, wo_flat, wo_code, params, _flat_vec3(value, layout)[0],
-                                    jacobian.reshape((n, 3, -1) if layout == "aos" else (3, -1, n)), out_layout, n,
+                                    jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)), out_layout, n,
                                     model_id, cosine, tolerance, thread_count, isa_name)
     elif pdf_sampler is not None:
         value = _flat_vec3(outputs[1], layout)[0] if len(outputs) == 2 else None  # eval_pdf: f in the same pass
@@ -373,6 +382,10 @@ def _require_pair(out: object, second: str) -> None:
 def _output_pair(out: tuple[object, object] | None, value_shape: tuple[int, ...], second_shape: tuple[int, ...],
                  second: str) -> tuple[Float32Array, Float32Array]:
     """The two result arrays: fresh, or ``out``'s checked (shapes, dtype, no overlap)."""
+    if out is not None:
+        for i, array in enumerate(out):
+            if array is None:
+                raise TypeError(f"out[{i}]: expected a float32 array, got None (out= takes both arrays)")
     value = _output(None if out is None else out[0], value_shape, "out[0]")
     other = _output(None if out is None else out[1], second_shape, "out[1]")
     if out is not None and np.may_share_memory(value, other):
@@ -409,7 +422,11 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
         value, jacobian = _output_pair(out, _vec3_shape(leading, layout), _jacobian_shape(leading, layout, len(wanted)),
                                        "jacobian")
-        return [value, jacobian if full else np.empty(_jacobian_shape(leading, layout, len(GRADIENT_NAMES)), np.float32)]
+        if full:
+            return [value, jacobian]
+        # the selected columns are copied into out[1] after the pass: it must not overlap the inputs either
+        _require_no_partial_overlap(jacobian, {"wi": _as_array(wi), "wo": _as_array(wo)}, "out[1]")
+        return [value, np.empty(_jacobian_shape(leading, layout, len(GRADIENT_NAMES)), np.float32)]
 
     value, jacobian_all = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
                                     gradient=True, energy_compensation=energy_compensation)

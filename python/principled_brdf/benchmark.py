@@ -37,7 +37,7 @@ def numpy_eval(m: Mapping[str, Any], wi: Float32Array, wo: Float32Array) -> Floa
 
     fl, fv, fh = schlick(lz), schlick(vz), schlick(cos_d)
     lum = f32(0.3) * base[0] + f32(0.6) * base[1] + f32(0.1) * base[2]
-    tint = base / lum if lum > 0 else np.ones(3, f32)
+    tint = base / lum if lum >= 2.0 ** -126 else np.ones(3, f32)
     spec0 = (m["specular"] * 0.08 * (1 + (tint - 1) * m["specular_tint"])) * (1 - m["metallic"]) + base * m["metallic"]
     sheen_color = 1 + (tint - 1) * m["sheen_tint"]
     r = f32(m["roughness"])

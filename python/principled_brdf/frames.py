@@ -26,6 +26,8 @@ def spherical_to_direction(theta: RealArrayLike, phi: RealArrayLike = 0.0) -> Fl
     """(sin θ cos φ, sin θ sin φ, cos θ) ``(..., 3)``: θ from the normal, φ from the tangent."""
     theta, phi = np.broadcast_arrays(np.asarray(_validate.as_real_array("theta", theta), dtype=np.float64),
                                      np.asarray(_validate.as_real_array("phi", phi), dtype=np.float64))
+    _validate.require_finite("theta", theta)
+    _validate.require_finite("phi", phi)
     sin_theta = np.sin(theta)
     return np.stack([sin_theta * np.cos(phi), sin_theta * np.sin(phi), np.cos(theta)], axis=-1)
 
@@ -43,8 +45,11 @@ def frame_from_normal(normal: RealArrayLike, tangent: RealArrayLike | None = Non
     Without ``tangent``, the tangent is the branchless construction of Duff et
     al. 2017 ("Building an Orthonormal Basis, Revisited"), continuous except
     across n.z = 0's sign change; with one, the tangent is its part
-    orthogonal to the normal (Gram-Schmidt), so anisotropic materials follow it."""
+    orthogonal to the normal (Gram-Schmidt), so anisotropic materials follow it.
+    The normal passes the direction check (README "Bad input") and is then
+    normalised, so the frames are orthonormal to float64's rounding."""
     n = _validate.directions("normal", normal)
+    n = n / np.sqrt(np.sum(n * n, axis=-1, keepdims=True))
     if tangent is None:
         sign = np.where(n[..., 2] >= 0.0, 1.0, -1.0)
         a = -1.0 / (sign + n[..., 2])
@@ -52,24 +57,53 @@ def frame_from_normal(normal: RealArrayLike, tangent: RealArrayLike | None = Non
         t = np.stack([1.0 + sign * n[..., 0] ** 2 * a, sign * b, -sign * n[..., 0]], axis=-1)
     else:
         t = np.asarray(_validate.as_real_array("tangent", tangent), dtype=np.float64)
+        if t.ndim == 0 or t.shape[-1] != 3:
+            raise ValueError(f"tangent: expected shape (..., 3), got {t.shape}")
+        _validate.require_finite("tangent", t)
         t, n = np.broadcast_arrays(t, n)
+        # scaled to its largest component first, so that squares neither overflow nor underflow
+        largest = np.max(np.abs(t), axis=-1, keepdims=True)
+        t = t / np.where(largest > 0.0, largest, 1.0)
         t = t - np.sum(t * n, axis=-1, keepdims=True) * n
         length = np.linalg.norm(t, axis=-1, keepdims=True)
-        if np.any(~(length > 1e-12)):
-            raise ValueError("tangent: parallel to the normal (or zero, or not finite) at element "
-                             f"{_validate.first_true(~(length > 1e-12).reshape(-1))}")
+        parallel = ~(length > 1e-12)
+        if parallel.any():
+            i = _validate.first_true(parallel[..., 0])
+            raise ValueError(f"{_validate.element_name('tangent', i, t.shape[:-1])}: zero or parallel to the normal")
         t = t / length
     bitangent = np.cross(n, t)
     return np.stack(np.broadcast_arrays(t, bitangent, n), axis=-2)
 
 
+def _vectors_and_frames(w: RealArrayLike, frame: RealArrayLike) -> tuple[Float64Array, Float64Array]:
+    """``w`` finite ``(..., 3)``; ``frame`` ``(..., 3, 3)`` orthonormal rows within the
+    direction check's tolerance (1e-3 on every entry of frame frameᵀ - I)."""
+    w = _validate.as_real_array("w", w)
+    if w.ndim == 0 or w.shape[-1] != 3:
+        raise ValueError(f"w: expected shape (..., 3), got {w.shape}")
+    _validate.require_finite("w", w)
+    frame = _validate.as_real_array("frame", frame)
+    if frame.ndim < 2 or frame.shape[-2:] != (3, 3):
+        raise ValueError(f"frame: expected shape (..., 3, 3) with rows (tangent, bitangent, normal), got {frame.shape}")
+    _validate.require_finite("frame", frame)
+    error = np.abs(np.einsum("...ij,...kj->...ik", frame, frame) - np.eye(3)).max(axis=(-2, -1))
+    bad = error > _validate.DIRECTION_LENGTH_TOLERANCE
+    if bad.any():
+        i = _validate.first_true(bad)
+        raise ValueError(f"{_validate.element_name('frame', i, frame.shape[:-2])}: rows not orthonormal "
+                         f"(frame frameᵀ is {float(error.ravel()[i]):.3g} off the identity; "
+                         f"within {_validate.DIRECTION_LENGTH_TOLERANCE:g})")
+    return w, frame
+
+
 def to_local(w: RealArrayLike, frame: RealArrayLike) -> Float64Array:
-    """World directions ``(..., 3)`` in the frames ``(..., 3, 3)`` of :func:`frame_from_normal`."""
-    w = np.asarray(_validate.as_real_array("w", w), dtype=np.float64)
-    return np.einsum("...ij,...j->...i", np.asarray(frame, dtype=np.float64), w)
+    """World directions ``(..., 3)`` in the frames ``(..., 3, 3)`` of :func:`frame_from_normal`
+    (orthonormal rows, checked; finite ``w``)."""
+    w, frame = _vectors_and_frames(w, frame)
+    return np.einsum("...ij,...j->...i", frame, w)
 
 
 def to_world(w: RealArrayLike, frame: RealArrayLike) -> Float64Array:
     """Local directions ``(..., 3)`` back to world coordinates (the frames' transpose)."""
-    w = np.asarray(_validate.as_real_array("w", w), dtype=np.float64)
-    return np.einsum("...ji,...j->...i", np.asarray(frame, dtype=np.float64), w)
+    w, frame = _vectors_and_frames(w, frame)
+    return np.einsum("...ji,...j->...i", frame, w)

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _core
-from ._validate import as_real_array, broadcast_leading, flag, require_in_domain
+from ._validate import as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -254,4 +254,11 @@ def gamma22_to_linear(color: RealArrayLike) -> Float64Array:
     """Display (gamma 2.2) colour to linear RGB, the BRDF Explorer's ``mon2lin``: ``c ** 2.2``."""
     array = as_real_array("color", color)
     require_in_domain("color", array, 0.0, np.inf)
-    return np.power(array, 2.2)
+    with np.errstate(over="ignore"):
+        linear = np.power(array, 2.2)
+    overflow = np.isinf(linear)
+    if overflow.any():
+        i = first_true(overflow)
+        raise ValueError(f"{element_name('color', i, array.shape)}: {float(array.ravel()[i])!r} ** 2.2 is beyond "
+                         "float64's range")
+    return linear

@@ -40,6 +40,7 @@ _CELLS = MERL_SHAPE[0] * MERL_SHAPE[1] * MERL_SHAPE[2]
 _HEADER_BYTES = 3 * 4
 _FILE_BYTES = _HEADER_BYTES + 3 * _CELLS * 8
 _HALF_PI = 0.5 * np.pi
+_CENTRE_SNAP = 1e-9  # in cells: trilinear weights this close to 0 or 1 are taken as 0 or 1
 
 
 def _rotate_z(v: Float64Array, angle: Float64Array) -> Float64Array:
@@ -61,7 +62,12 @@ def wiwo_to_half_diff(wi: RealArrayLike,
     wo = _validate.directions("wo", wo).astype(np.float64)
     wi, wo = np.broadcast_arrays(wi, wo)
     half = wi + wo
-    half = half / np.linalg.norm(half, axis=-1, keepdims=True)
+    length = np.linalg.norm(half, axis=-1, keepdims=True)
+    opposite = ~(length[..., 0] > 0.0)
+    if opposite.any():
+        where = _validate.element_name("", _validate.first_true(opposite), opposite.shape)
+        raise ValueError(f"wi{where}, wo{where}: opposite directions have no half vector")
+    half = half / length
     # polar angles by atan2, which keeps its digits near 0 where arccos does not
     theta_h = np.arctan2(np.hypot(half[..., 0], half[..., 1]), half[..., 2])
     phi_h = np.arctan2(half[..., 1], half[..., 0])
@@ -74,8 +80,11 @@ def wiwo_to_half_diff(wi: RealArrayLike,
 def half_diff_to_wiwo(theta_h: RealArrayLike, phi_h: RealArrayLike, theta_d: RealArrayLike,
                       phi_d: RealArrayLike) -> tuple[Float64Array, Float64Array]:
     """(wi, wo) ``(..., 3)`` from Rusinkiewicz's angles, the inverse of :func:`wiwo_to_half_diff`."""
-    theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64)
-                                                            for a in (theta_h, phi_h, theta_d, phi_d)))
+    angles = {"theta_h": theta_h, "phi_h": phi_h, "theta_d": theta_d, "phi_d": phi_d}
+    for name, value in angles.items():
+        angles[name] = _validate.as_real_array(name, value)
+        _validate.require_finite(name, angles[name])
+    theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(*angles.values())
     diff = np.stack([np.sin(theta_d) * np.cos(phi_d), np.sin(theta_d) * np.sin(phi_d), np.cos(theta_d)], axis=-1)
     half = np.stack([np.sin(theta_h) * np.cos(phi_h), np.sin(theta_h) * np.sin(phi_h), np.cos(theta_h)], axis=-1)
     wi = _rotate_z(_rotate_y(diff, theta_h), phi_h)
@@ -121,9 +130,10 @@ class MerlBRDF:
     table: Float64Array
 
     def __init__(self, table: RealArrayLike) -> None:
-        array = np.array(table, dtype=np.float64)
+        array = np.array(_validate.as_real_array("table", table), dtype=np.float64)
         if array.shape != (3,) + MERL_SHAPE:
             raise ValueError(f"table: expected shape {(3,) + MERL_SHAPE} (channel, θh, θd, φd), got {array.shape}")
+        _require_brdf_values("table", array)
         self.table = array
 
     def values(self) -> Float64Array:
@@ -134,8 +144,9 @@ class MerlBRDF:
              interpolation: Literal["nearest", "linear"] = "nearest") -> Float64Array:
         """f(wi, wo) ``(..., 3)`` in 1/sr from the table: the cell the format's indices name
         (``"nearest"``), or trilinear between cell centres (``"linear"``, φd periodic with
-        period π, the other axes clamped). NaN where a cell used has no data; 0 where wi or
-        wo lies at or below the horizon."""
+        period π, the other axes clamped; at a cell's centre, within 1e-9 of a cell, that
+        cell alone). NaN where a cell used (of weight > 0) has no data; 0 where wi or wo
+        lies at or below the horizon."""
         if interpolation not in ("nearest", "linear"):
             raise ValueError(f"interpolation: expected 'nearest' or 'linear', got {interpolation!r}")
         theta_h, _, theta_d, phi_d = wiwo_to_half_diff(wi, wo)
@@ -155,7 +166,9 @@ class MerlBRDF:
         for x, size, periodic in ((x_h, MERL_SHAPE[0], False), (x_d, MERL_SHAPE[1], False), (x_p, MERL_SHAPE[2], True)):
             position = x - 0.5  # centres sit at i + 0.5
             low = np.floor(position)
+            # a lookup at a cell's centre (to the rounding of the angles' round trip) reads that cell alone
             weight = position - low
+            weight = np.where(weight < _CENTRE_SNAP, 0.0, np.where(weight > 1.0 - _CENTRE_SNAP, 1.0, weight))
             low = low.astype(np.int64)
             high = low + 1
             if periodic:
@@ -167,8 +180,19 @@ class MerlBRDF:
             for index_d, weight_d in corners[1]:
                 for index_p, weight_p in corners[2]:
                     cell = np.moveaxis(self.table[:, index_h, index_d, index_p], 0, -1)
-                    result = result + (weight_h * weight_d * weight_p)[..., None] * cell
+                    weight = (weight_h * weight_d * weight_p)[..., None]
+                    # a corner of weight 0 adds nothing, even where it has no data (NaN)
+                    result = result + np.where(weight > 0.0, weight * cell, 0.0)
         return result
+
+
+def _require_brdf_values(name: str, values: Float64Array) -> None:
+    """f >= 0 and finite, or NaN (no data): a negative value would be written as "no data"."""
+    bad = ~((values >= 0.0) & (values < np.inf)) & ~np.isnan(values)
+    if bad.any():
+        i = _validate.first_true(bad)
+        raise ValueError(f"{_validate.element_name(name, i, values.shape)}: {float(values.ravel()[i])!r} is not a "
+                         "BRDF value (finite and >= 0, or NaN for no data)")
 
 
 def load_merl(path: str | os.PathLike[str]) -> MerlBRDF:
@@ -200,6 +224,7 @@ def save_merl(path: str | os.PathLike[str],
         values = np.asarray(brdf(wi, wo), dtype=np.float64)
         if values.shape != (_CELLS, 3):
             raise ValueError(f"brdf: expected the callable to return ({_CELLS}, 3) values, got {values.shape}")
+        _require_brdf_values("brdf", values)
         table = values.T.reshape((3,) + MERL_SHAPE)
     else:
         raise TypeError(f"brdf: expected a MerlBRDF or a callable f(wi, wo), got {type(brdf).__name__}")

@@ -266,11 +266,19 @@ def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "
     :data:`FILMIC_WHITE`; ``"reinhard"``: the extended Reinhard curve ``Y (1 +
     Y / W²) / (1 + Y)``, white ``W`` = :data:`REINHARD_WHITE` (darker
     midtones); ``"clip"``: each channel clipped to [0, 1]. All after
-    multiplying by ``exposure``."""
+    multiplying by ``exposure``. Negative values count as 0 and +inf as white;
+    NaN is a ValueError naming the pixel."""
     if curve not in TONE_CURVES:
         raise ValueError(f"curve: expected one of {', '.join(TONE_CURVES)}, got {curve!r}")
     exposure = _non_negative("exposure", exposure)
-    c = np.maximum(np.asarray(linear, dtype=np.float64) * exposure, 0.0)
+    c = _validate.as_real_array("linear", linear)
+    if c.ndim == 0 or c.shape[-1] != 3:
+        raise ValueError(f"linear: expected RGB values of shape (..., 3), got {c.shape}")
+    if np.isnan(c).any():
+        i = _validate.first_true(np.isnan(c))
+        raise ValueError(f"{_validate.element_name('linear', i, c.shape)}: nan is not a color")
+    # far above any white point, and small enough that the curves' squares stay finite
+    c = np.clip(c * exposure, 0.0, 1e30)
     if curve == "clip":
         return np.minimum(c, 1.0)
     luminance = c @ np.array([0.2126, 0.7152, 0.0722])

@@ -49,10 +49,8 @@ PB_MODEL_INLINE MaterialPartials<F> material_partials_of(const F* p) {
     Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
     F metallic = p[kMetallic], dielectric = one - metallic;
     F luminance = luminance_of(base);
-    MaskOf<F> has_luminance = luminance > zero;
-    F inv_luminance = reciprocal(select(has_luminance, luminance, one));
-    Rgb<F> tint{select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
-                      select(has_luminance, base.b * inv_luminance, one)};
+    Tint<F> tinted = tint_of(base, luminance);
+    Rgb<F> tint = tinted.color;
     const F weight_of[3] = {F(0.3), F(0.6), F(0.1)};  // lum's weights
     F sheen = p[kSheen], sheen_tint = p[kSheenTint];
     F specular_scale = F(0.08) * p[kSpecular], specular_tint = p[kSpecularTint];
@@ -68,8 +66,8 @@ PB_MODEL_INLINE MaterialPartials<F> material_partials_of(const F* p) {
     d.specular_tint_scale = dielectric * specular_scale * specular_tint;
     for (int c = 0; c < 3; ++c)
         for (int k = 0; k < 3; ++k)
-            d.tint_base[c][k] = select(has_luminance, neg_mul_add(channel_of(tint, c), weight_of[k], c == k ? one : zero) *
-                                                              inv_luminance, zero);
+            d.tint_base[c][k] = select(tinted.defined, neg_mul_add(channel_of(tint, c), weight_of[k], c == k ? one : zero) *
+                                                               tinted.inverse_luminance, zero);
     d.diffuse_metallic = F(-kInvPi) * base;
     d.sheen_metallic = -sheen * sheen_mix;
     d.f0_metallic = {neg_mul_add(specular_scale, specular_mix.r, base.r), neg_mul_add(specular_scale, specular_mix.g, base.g),

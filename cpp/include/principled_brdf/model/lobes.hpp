@@ -12,8 +12,15 @@ struct Geometry : HalfVector<F> {
     Vec3<F> wi, wo;
     F cos_theta_d;            // |H| / 2 (= wi·h = wo·h for unit vectors)
     F one_minus_cos_theta_d;  // |wi - wo|² / (4 (1 + cos θd)): no cancellation as wi -> wo
-    MaskOf<F> finite;         // false where a direction held NaN, infinity or a huge value (checks off)
+    MaskOf<F> finite;         // |wi|² + |wo|² <= kLargestDirectionsLength2: false for NaN, infinities and long vectors
 };
+
+// With the direction check off, a pair is evaluated as given while
+// |wi|² + |wo|² <= 8 (a unit vector beside one of length up to √7), and gives
+// f = 0 beyond: within it every term of the model stays finite in float32 for
+// parameters within the kernels' range (Fd90 grows with |H|², the distributions
+// with |H|⁴ / |H|² ratios), beyond it they need not (README "Bad input").
+inline constexpr double kLargestDirectionsLength2 = 8.0;
 
 template <class F>
 PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
@@ -26,10 +33,11 @@ PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
     g.hy2 = hy * hy;
     g.hz2 = g.hz * g.hz;
     g.h_len2 = g.hx2 + g.hy2 + g.hz2;
-    g.finite = g.h_len2 <= largest_finite(g.h_len2);
     g.cos_theta_d = F(0.5) * square_root_nonnegative(g.h_len2);
     F dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
     F d_len2 = mul_add(dx, dx, mul_add(dy, dy, dz * dz));
+    // |H|² + |wi - wo|² = 2 (|wi|² + |wo|²) (the parallelogram law)
+    g.finite = g.h_len2 + d_len2 <= F(2.0 * kLargestDirectionsLength2);
     g.one_minus_cos_theta_d = d_len2 / mul_add(F(4.0), g.cos_theta_d, F(4.0));
     return g;
 }

@@ -21,12 +21,8 @@ PB_MODEL_INLINE Shading<F> shading_of(const F* p) {
     F metallic = p[kMetallic];
     F dielectric = one - metallic;
 
-    // Ctint: hue and saturation at unit luminance (1 where the luminance is 0)
     F luminance = luminance_of(base);
-    MaskOf<F> has_luminance = luminance > F(0.0);
-    F inv_luminance = reciprocal(select(has_luminance, luminance, one));
-    Rgb<F> tint{select(has_luminance, base.r * inv_luminance, one), select(has_luminance, base.g * inv_luminance, one),
-                      select(has_luminance, base.b * inv_luminance, one)};
+    Rgb<F> tint = tint_of(base, luminance).color;
     Rgb<F> white{one, one, one};
 
     Shading<F> s;

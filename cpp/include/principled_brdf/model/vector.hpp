@@ -62,5 +62,30 @@ PB_MODEL_INLINE F schlick_weight(F u) { return schlick_weight_of_complement(F(1.
 template <class F>
 PB_MODEL_INLINE F luminance_of(const Rgb<F>& c) { return mul_add(F(0.3), c.r, mul_add(F(0.6), c.g, F(0.1) * c.b)); }
 
+// Ctint = base_color / Cdlum, the color's hue and saturation at unit
+// luminance; 1 where Cdlum is below float32's smallest normal number 2^-126
+// (1/Cdlum would overflow float32 there, and a subnormal color is black to
+// any renderer). The float64 instantiation applies the same threshold, so
+// the two agree (README "The model").
+inline constexpr double kSmallestTintedLuminance = 0x1p-126;
+
+template <class F>
+struct Tint {
+    Rgb<F> color;             // Ctint
+    MaskOf<F> defined;        // Cdlum >= 2^-126
+    F inverse_luminance;      // 1/Cdlum where defined, else 1
+};
+
+template <class F>
+PB_MODEL_INLINE Tint<F> tint_of(const Rgb<F>& base, F luminance) {
+    F one(1.0);
+    Tint<F> t;
+    t.defined = luminance >= F(kSmallestTintedLuminance);
+    t.inverse_luminance = reciprocal(select(t.defined, luminance, one));
+    t.color = {select(t.defined, base.r * t.inverse_luminance, one), select(t.defined, base.g * t.inverse_luminance, one),
+               select(t.defined, base.b * t.inverse_luminance, one)};
+    return t;
+}
+
 inline constexpr double kInvPi = 0.318309886183790671538;
 inline constexpr double kSqrtPi = 1.772453850905516027298;
