@@ -496,3 +496,61 @@ def test_merl_tables_hold_brdf_values_or_nan():
     with pytest.raises(ValueError, match=r"brdf\[5, 0\]: -1.0 is not a BRDF value"):
         pb.measured.save_merl("/nonexistent/never-written.binary",
                               lambda wi, wo: np.where(np.arange(len(wi))[:, None] == 5, -1.0, np.ones((len(wi), 3))))
+
+
+# ------------------------------------------------------------------ empty calls, soa broadcasting, out= pairs
+
+@pytest.mark.parametrize("layout", ["aos", "soa"])
+def test_eval_grad_of_no_pairs(layout):
+    empty = np.zeros((0, 3) if layout == "aos" else (3, 0), np.float32)
+    gradient = pb.eval_grad(pb.Material(), empty, empty, layout=layout)
+    assert gradient.value.shape == empty.shape
+    assert gradient.jacobian.shape == ((0, 3, 13) if layout == "aos" else (3, 13, 0))
+    assert pb.eval_grad(pb.Material(), empty, empty, wrt="roughness", layout=layout).jacobian.size == 0
+
+
+def test_soa_arguments_of_lower_rank_broadcast_as_in_aos():
+    rng = np.random.default_rng(40)
+    a = directions_at_length(rng, 6, 1.0)
+    b = directions_at_length(rng, 24, 1.0).reshape(4, 6, 3)
+    roughness = rng.random(6)
+    m = pb.Material(roughness=roughness)
+    aos = pb.eval(m, a, b)
+    soa = pb.eval(m, np.moveaxis(a, -1, 0), np.moveaxis(b, -1, 0), layout="soa")
+    np.testing.assert_array_equal(np.moveaxis(soa, 0, -1), aos)
+    np.testing.assert_array_equal(np.moveaxis(pb.eval(m, np.moveaxis(b, -1, 0), a[0][:, None], layout="soa"), 0, -1),
+                                  pb.eval(m, b, a[0]))
+    grad_aos = pb.eval_grad(m, a, b).jacobian
+    grad_soa = pb.eval_grad(m, np.moveaxis(a, -1, 0), np.moveaxis(b, -1, 0), layout="soa").jacobian
+    np.testing.assert_array_equal(np.moveaxis(grad_soa, (0, 1), (-2, -1)), grad_aos)
+    u = rng.random((6, 3)).astype(np.float32)
+    s_aos = pb.sample(m, b, u=u)
+    s_soa = pb.sample(m, np.moveaxis(b, -1, 0), u=np.moveaxis(u, -1, 0), layout="soa")
+    np.testing.assert_array_equal(np.moveaxis(s_soa.wi, 0, -1), s_aos.wi)
+    s_n = pb.sample(pb.Material(), np.moveaxis(a, -1, 0), n=2, layout="soa", seed=1)
+    np.testing.assert_array_equal(np.moveaxis(s_n.wi, 0, -1), pb.sample(pb.Material(), a, n=2, seed=1).wi)
+
+
+def test_a_selected_jacobian_out_overlapping_wi_is_refused():
+    rng = np.random.default_rng(41)
+    buffer = np.empty(288, np.float32)
+    wi = buffer[:192].reshape(64, 3)
+    wi[...] = directions_at_length(rng, 64, 1.0)
+    jacobian = buffer[96:].reshape(64, 3, 1)  # roughness's column only, over wi's second half
+    before = wi.copy()
+    with pytest.raises(ValueError, match=r"out\[1\]: overlaps wi"):
+        pb.eval_grad(pb.Material(), wi, directions_at_length(rng, 64, 1.0), wrt="roughness",
+                     out=(np.empty((64, 3), np.float32), jacobian))
+    np.testing.assert_array_equal(wi, before)
+
+
+@pytest.mark.parametrize("call", ["eval_grad", "eval_pdf"])
+@pytest.mark.parametrize("missing", [0, 1])
+def test_out_pairs_take_both_arrays(call, missing):
+    wi = directions_at_length(np.random.default_rng(42), 8, 1.0)
+    value = np.empty((8, 3), np.float32)
+    second = np.empty((8, 3, 13) if call == "eval_grad" else (8,), np.float32)
+    out = [value, second]
+    out[missing] = None
+    with pytest.raises(TypeError, match=rf"out\[{missing}\]: expected a float32 array, got None"):
+        getattr(pb, call)(pb.Material(), wi, wi, out=tuple(out))

@@ -411,7 +411,6 @@ PB_KERNEL_INLINE Floats log(Floats x) {
 PB_KERNEL_INLINE Floats log(Floats x) { return xsimd::log(x); }
 #endif
 PB_KERNEL_INLINE Floats exp(Floats x) { return xsimd::exp(x); }
-PB_KERNEL_INLINE Floats largest_finite(Floats) { return Floats(std::numeric_limits<float>::max()); }
 // table lookups (model/energy.hpp): the integer part of x >= 0 (truncation), back to
 // floats, and (table[i], table[i + 1]) per lane, the two nodes of a linear interpolation
 PB_KERNEL_INLINE Ints truncate_to_index(Floats x) { return xsimd::to_int(x); }

@@ -28,7 +28,6 @@ inline double exp_minus_one(double x) { return std::expm1(x); }
 inline double log_one_plus(double x) { return std::log1p(x); }
 inline double pow(double x, double y) { return std::pow(x, y); }
 inline double erfc(double x) { return std::erfc(x); }
-inline double largest_finite(double) { return std::numeric_limits<double>::max(); }
 
 // (sin 2πu, cos 2πu)
 inline std::pair<double, double> sincos_turns(double u) {
