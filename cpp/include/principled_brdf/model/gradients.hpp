@@ -17,7 +17,7 @@
 // ClearcoatLobe::unit_value, Gtr1::log_d_partial_alpha2, ...). Where the model
 // clamps (alpha = max(0.001, ...)) the derivative is the active branch's;
 // Ctint = 1 where lum(base_color) <= 0 has derivative 0.
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 template <class F>
 PB_MODEL_INLINE F channel_of(const Rgb<F>& colour, int c) { return c == 0 ? colour.r : c == 1 ? colour.g : colour.b; }

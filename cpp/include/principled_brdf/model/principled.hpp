@@ -2,7 +2,7 @@
 // its lobes, over a number type F: the material's constants, f and its lobes,
 // the sampling mixture's weights and density, the lobe choice, the draw of wi
 // and the weight of a drawn sample (README "The model", "Sampling and pdf").
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // Everything the lobes need of a material, independent of the directions.
 template <class F>

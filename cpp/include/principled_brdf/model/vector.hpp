@@ -2,7 +2,7 @@
 // the operations of its number types. Vectors, colours and the small helpers
 // every part uses, over a number type F: double (the reference) or
 // xsimd::batch<float, Arch> (the kernels).
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // What a comparison of two F gives: bool for double, a batch_bool for a batch.
 template <class F>
