@@ -98,7 +98,7 @@ PB_MODEL_INLINE View<F> view_of(const Vec3<F>& wo, const Shading<F>& s) {
     return view_of<model, lobes>(wo, s, s.specular.ggx.smith_denominator(wo), schlick_weight(wo.z));
 }
 
-// The lobes as scalar factors of the material's colours:
+// The lobes as scalar factors of the material's colors:
 //   diffuse   = D  base_color (1 - metallic) / π     (s.diffuse.color)
 //   sheen     = FH sheen Csheen (1 - metallic)       (s.sheen.color)
 //   specular  = S  mix(Cspec0, 1, FH),  S = Gs Ds
