@@ -67,6 +67,10 @@ def test_the_model_twice_in_one_translation_unit_is_a_compile_error(tmp_path):
                    '#include "principled_brdf/model/model.hpp"\n}\n'):
         result = preprocess(source)
         assert result.returncode != 0, source
-        assert "is already included in another namespace of this translation unit" in result.stderr, result.stderr
+        assert "is included a second time in this translation unit" in result.stderr, result.stderr
+    family_twice = preprocess('#include "principled_brdf/model/f64_family.hpp"\nnamespace other {\n'
+                              '#include "principled_brdf/model/distribution_family.hpp"\n}\n')
+    assert family_twice.returncode != 0
+    assert "distribution_family.hpp is already included in this translation unit" in family_twice.stderr
     once = '#include "principled_brdf/model/f64.hpp"\n#include "principled_brdf/model/f64_family.hpp"\n'
     assert preprocess(once + once).returncode == 0

@@ -14,7 +14,7 @@
 // kernels) would find them already seen and leave that namespace without the
 // model. This guard makes it a compile error instead.
 #ifdef PRINCIPLED_BRDF_MODEL_INCLUDED
-#error "principled_brdf: the model (model/model.hpp) is already included in another namespace of this translation unit; f64.hpp and each kernel_<isa>.cpp need translation units of their own"
+#error "principled_brdf: the model (model/model.hpp) is included a second time in this translation unit; it can live in one namespace only, so f64.hpp and each kernel_<isa>.cpp need translation units of their own"
 #endif
 #define PRINCIPLED_BRDF_MODEL_INCLUDED
 
