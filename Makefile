@@ -21,7 +21,7 @@ deps:
 wheel: deps
 	bash scripts/build-wheel.sh
 
-# Google Benchmark executable (not part of the wheel); results in bench/results.json
+# Google Benchmark executable (not part of the wheel); its results go to bench/results.json (not tracked)
 bench: deps
 	cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release -DPRINCIPLED_BRDF_BENCH=ON \
 	  -Dpybind11_DIR="$$($(PYTHON) -c 'import pybind11; print(pybind11.get_cmake_dir())')"

@@ -1,5 +1,5 @@
-"""Summarise a Google Benchmark JSON of principled_brdf_bench as the tables of
-bench/RESULTS.md: items/s per benchmark and the ratios the issues target.
+"""Summarize a Google Benchmark JSON of principled_brdf_bench: items/s per
+benchmark, then the ratios that the performance targets are stated in.
 
     python bench/summarize.py bench/results.json
 """

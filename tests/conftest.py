@@ -198,7 +198,7 @@ def random_material_arrays(rng: np.random.Generator, n: int, edge_fraction: floa
 
     Values cover the domains of README "The model"; a fraction ``edge_fraction`` of each
     parameter is set to an edge value (roughness 0 and 1, anisotropic 1,
-    specular 2, clearcoat_gloss 0 and 1, metallic 0 and 1, black base colour,
+    specular 2, clearcoat_gloss 0 and 1, metallic 0 and 1, black base color,
     sheen and clearcoat up to 2, ...), drawn independently per parameter.
     """
     params = {"base_color": random_base_color(rng, n, edge_fraction)}

@@ -50,7 +50,7 @@ class Lobes(NamedTuple):
 
 def mix(a, b, t):
     """a + (b - a) t, written a (1 - t) + b t: the same number, without the loss of
-    b's digits when b << a and t -> 1 (e.g. a saturated colour's Ctint at tint 1)."""
+    b's digits when b << a and t -> 1 (e.g. a saturated color's Ctint at tint 1)."""
     return a * (1.0 - t) + b * t
 
 
@@ -130,8 +130,7 @@ def _evaluate(material, wi, wo, model):
         cos2_h = H[..., 2] ** 2 / H2
         sin2_h = (H[..., 0] ** 2 + H[..., 1] ** 2) / H2
 
-        # Colours
-        # Ctint = base / Cdlum, 1 where Cdlum < 2^-126 (float32's smallest normal number)
+        # Colors; Ctint = base / Cdlum, 1 where Cdlum < 2^-126 (float32's smallest normal number)
         cd_lum = 0.3 * base[..., 0] + 0.6 * base[..., 1] + 0.1 * base[..., 2]
         tinted = cd_lum >= SMALLEST_TINTED_LUMINANCE
         c_tint = np.where(_scalar(tinted), base / np.where(tinted, cd_lum, 1.0)[..., None], 1.0)

@@ -7,7 +7,7 @@
 - white furnace (metallic 1, base_color 1: F_avg = 1): the directional albedo
   of specular + multiple scattering is 1 within 2e-3 for roughness in [0, 1]
   and θv in [0°, 87°], by quadrature and by Monte Carlo, both models; the
-  anisotropic materials' error (r_eff = (ax ay)^(1/4)) at what is measured;
+  anisotropic materials' error (r_eff = (ax ay)^(1/4)) held at its known size;
 - reciprocity, no φ dependence, the F_avg tint, and f_ms -> 0 as r -> 0;
 - SIMD against the float64 reference with the accuracy bounds of
   tests/test_simd_accuracy.py, on every instruction set here;
@@ -207,7 +207,7 @@ def test_white_furnace_by_monte_carlo(model):
     print(f"{model}: white furnace by QMC, worst |albedo - 1| = {worst[0]:.2e} at (r, θv) = {worst[1]}")
 
 
-# measured |albedo - 1| of anisotropic white metals (quasi-Monte Carlo) at anisotropic 1,
+# |albedo - 1| of anisotropic white metals (quasi-Monte Carlo) at anisotropic 1,
 # the worst over the cases below: 2014 model 0.42 (roughness 1, θv 87°, ax = 3.2, ay = 0.32),
 # 2012 model 0.96 (its isotropic Gs with the anisotropic Ds: the single-scattering
 # lobe alone reaches 1.42 there); README "Energy compensation". The isotropic

@@ -49,7 +49,7 @@ def test_srgb_to_linear_is_the_exact_piecewise_curve():
         pb.srgb_to_linear([200.0, 0.0, 0.0])
 
 
-def test_uint8_and_bright_base_colours_are_not_taken_silently():
+def test_uint8_and_bright_base_colors_are_not_taken_silently():
     with pytest.raises(TypeError, match="base_color: a uint8 colour"):
         pb.Material(base_color=np.array([200, 100, 50], np.uint8))
     with pytest.warns(pb.BrightColorWarning, match="base_color: 200 > 1"):
@@ -66,8 +66,8 @@ def test_uint8_and_bright_base_colours_are_not_taken_silently():
 def test_material_indexing_slicing_and_reshaping():
     rng = np.random.default_rng(5)
     roughness = rng.uniform(0.1, 0.9, (4, 6))
-    colour = rng.uniform(0, 1, (4, 6, 3))
-    m = pb.Material(roughness=roughness, base_color=colour, clearcoat=0.5)
+    color = rng.uniform(0, 1, (4, 6, 3))
+    m = pb.Material(roughness=roughness, base_color=color, clearcoat=0.5)
     wi = np.broadcast_to(np.float32([0.3, 0.2, 0.9327379]), (4, 6, 3))
     wo = np.float32([-0.1, 0.4, 0.9110434])
     f = pb.eval(m, wi, wo)

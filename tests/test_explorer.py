@@ -166,17 +166,17 @@ def test_preset_sets_every_slider_in_one_update(explorer, monkeypatch):
     assert explorer.material.roughness == 1.5
 
 
-def test_colour_picker_is_srgb(explorer):
+def test_color_picker_is_srgb(explorer):
     explorer.base_color.value = "#ff8000"
     np.testing.assert_allclose(explorer.material.base_color, pb.srgb_to_linear(np.array([255, 128, 0], np.uint8)))
     explorer.base_color.value = "#fff"
     np.testing.assert_array_equal(explorer.material.base_color, (1.0, 1.0, 1.0))
     explorer.base_color.value = "red"  # the picker's text field takes CSS names too
     np.testing.assert_array_equal(explorer.material.base_color, (1.0, 0.0, 0.0))
-    # a preset's linear colour is kept exactly, not rounded through the picker's 8 bits
+    # a preset's linear color is kept exactly, not rounded through the picker's 8 bits
     explorer.preset.value = "gold"
     np.testing.assert_array_equal(explorer.material.base_color, pb.presets.get("gold").base_color)
-    explorer.base_color.value = "#c08040"  # a colour picked: no longer the preset
+    explorer.base_color.value = "#c08040"  # a color picked: no longer the preset
     assert explorer.preset.value == explorer_module.CUSTOM
 
 

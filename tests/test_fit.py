@@ -19,7 +19,7 @@ def pairs(n, key="fit"):
 @pytest.mark.parametrize("precision", ["float32", "float64"])
 def test_fit_reproduces_measurements_of_the_model(precision):
     """Every parameter fitted from the default start: f is matched to the precision's
-    rounding (the colour parameters are not all identifiable from f: Cspec0 spans only
+    rounding (the color parameters are not all identifiable from f: Cspec0 spans only
     base_color and grey, so the fitted f is checked, and the identifiable ones below)."""
     wi, wo = pairs(6000)
     truth = pb.Material(**TRUTH)

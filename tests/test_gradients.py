@@ -1,7 +1,7 @@
 """The Jacobian of f in the material's parameters (README "Gradients").
 
 float64 against central differences of the float64 reference, the clamps'
-derivatives, the linearity of f in sheen, clearcoat and the diffuse colour,
+derivatives, the linearity of f in sheen, clearcoat and the diffuse color,
 and the API (names, wrt, cosine, shapes, the horizon).
 """
 
@@ -79,9 +79,9 @@ def test_gradient_at_the_alpha_clamp_is_the_active_branch():
     np.testing.assert_allclose(g.jacobian[..., 0], numeric, rtol=1e-6, atol=1e-9 * np.abs(numeric).max())
 
 
-def test_black_base_colour_tint_has_no_derivative():
+def test_black_base_color_tint_has_no_derivative():
     """lum(base_color) = 0 gives Ctint = 1 (a constant): with metallic 0 only the diffuse
-    colour (1 - metallic) base / π moves with base_color."""
+    color (1 - metallic) base / π moves with base_color."""
     rng = seeded_rng("gradient-black")
     wi, wo = random_direction_pairs(rng, 400, min_cos=0.05)
     m = pb.Material(base_color=(0.0, 0.0, 0.0), specular_tint=1.0, sheen=1.0, sheen_tint=1.0)

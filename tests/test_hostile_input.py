@@ -1,8 +1,8 @@
-"""Regression tests for hostile input (README "Bad input"): every element or an
+"""Hostile input (README "Bad input"): every element or an
 error, the direction check decided once, aliasing, alignment, the edges of the
 integer options, and finite float32 results over the whole parameter range.
 
-Each test here failed before the fix it guards.
+Each test holds one behavior at the edge of what a caller can pass.
 """
 
 from __future__ import annotations

@@ -269,7 +269,7 @@ def test_gamma22_to_linear_is_not_applied_implicitly():
     np.testing.assert_allclose(f, 0.5 / np.pi, rtol=1e-14)
 
 
-def test_gamma22_to_linear_rejects_bad_colours():
+def test_gamma22_to_linear_rejects_bad_colors():
     with pytest.raises(ValueError, match=r"color\[1\]"):
         pb.gamma22_to_linear([0.5, -0.1, 0.2])
     with pytest.raises(ValueError, match=r"color\[2\]"):

@@ -1,4 +1,5 @@
-"""The microfacet toolkit, principled_brdf.microfacet (README "The model"; checks §6.4, §6.5, §6.7, §6.9, §7).
+"""The microfacet toolkit, principled_brdf.microfacet (README "The model"; README "What is checked":
+every D integrates to 1, the weak white furnace, samplers by chi-square, finite everywhere).
 
 Integrals over the hemisphere of half vectors use a product rule in (θ, ψ):
 ψ is the stretched azimuth, tan φ = (αy/αx) tan ψ, in which GGX and Beckmann
@@ -90,7 +91,7 @@ def direction(theta_deg, phi=0.0):
 
 
 # --------------------------------------------------------------------------
-# §6.4 normalisation: ∫ D(h) cos θh dω_h = 1 (stated bound 1e-4; the quadrature reaches ~1e-15)
+# normalization: ∫ D(h) cos θh dω_h = 1 (stated bound 1e-4; the quadrature reaches ~1e-15)
 
 NORMALISATION_TOLERANCE = 1e-9
 GTR_ALPHAS = (0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 0.9, 0.99, 1.0 - 1e-9, 1.0)
@@ -135,7 +136,7 @@ def test_quadrature_is_not_blind():
 
 
 # --------------------------------------------------------------------------
-# §6.5 weak white furnace: ∫ G1(wo) D(h) / (4 |wo_z|) dwi = 1 over the sphere of wi.
+# weak white furnace: ∫ G1(wo) D(h) / (4 |wo_z|) dwi = 1 over the sphere of wi.
 # With wi = 2 (wo·h) h - wo, dwi = 4 |wo·h| dω_h on {wo·h > 0}: the integral is
 # ∫ G1(wo) D(h) max(0, wo·h) / |wo_z| dω_h.
 
@@ -603,7 +604,7 @@ def test_samplers_at_the_ends_of_the_unit_interval():
 
 
 # --------------------------------------------------------------------------
-# §6.9: finite everywhere in the domain
+# finite everywhere in the domain (README "What is checked")
 
 
 def test_no_nan_or_inf_anywhere():

@@ -230,7 +230,7 @@ def test_beckmann_lambda_matches_its_definition():
 
 def test_blinn_phong_lambda_is_beckmanns_approximation():
     # Beckmann's Λ for Blinn-Phong's own D (Walter et al. 2007 §5.2): G1 against the Smith G1 of
-    # that D (1/(1 + Λ) with Λ by the definition), measured: 2.2e-5 at α = 0.05, 2.2e-2 at 0.3,
+    # that D (1/(1 + Λ) with Λ by the definition) is off by 2.2e-5 at α = 0.05, 2.2e-2 at 0.3,
     # 0.13 at 0.6, 0.64 at 1 (worst at 85°): good for smooth surfaces only
     for alpha, bound in [(0.3, 2.5e-2), (0.6, 0.14), (1.0, 0.66)]:
         for theta_deg, phi in LAMBDA_VIEWS:
@@ -266,7 +266,7 @@ def test_weak_white_furnace(member):
 
 
 def test_blinn_phong_weak_white_furnace_with_beckmanns_lambda():
-    # not exact (Beckmann's Λ is not Blinn-Phong's): measured misses 2.8e-4 at α = 0.05,
+    # not exact (Beckmann's Λ is not Blinn-Phong's): it misses 1 by 2.8e-4 at α = 0.05,
     # 2.9e-2 at 0.3, 0.15 at 0.6 and 0.73 at 1, each at the 88° view
     for alpha, bound in [(0.05, 1e-3), (0.3, 3e-2), (0.6, 0.16), (1.0, 0.75)]:
         for theta_deg, phi in FURNACE_VIEWS:
@@ -275,7 +275,7 @@ def test_blinn_phong_weak_white_furnace_with_beckmanns_lambda():
 
 
 def test_walter_weak_white_furnace():
-    # Beckmann's D with Walter's rational G1: measured misses up to 3.0e-3 (α = 0.3, 88°)
+    # Beckmann's D with Walter's rational G1: it misses 1 by up to 3.0e-3 (α = 0.3, 88°)
     for alpha in (0.05, 0.3, 1.0):
         for theta_deg, phi in FURNACE_VIEWS:
             wo = direction(theta_deg, phi)
@@ -448,7 +448,7 @@ def test_hyp2f1_against_mpmath():
 
 
 # --------------------------------------------------------------------------
-# the approximations' error bounds, measured
+# the approximations' error bounds, over dense grids
 
 
 def cot_grid():
@@ -462,7 +462,7 @@ def test_walter_lambda_error():
     exact_g1 = mf.beckmann_g1(w, 1.0)
     walter_g1 = mf.beckmann_g1(w, 1.0, approximation="walter")
     relative = np.abs(walter_g1 / exact_g1 - 1.0)
-    # Walter et al. 2007 eq. 27: measured 3.13e-3 relative in G1 at most (at a = 1.33)
+    # Walter et al. 2007 eq. 27: at most 3.13e-3 relative in G1 (at a = 1.33)
     assert relative.max() < 3.2e-3, relative.max()
     # in Λ: the same bound relative to 1 + Λ, and 1.8e-3 absolutely beyond the cut at a = 1.6
     exact = mf.beckmann_lambda(w, 1.0)
@@ -496,7 +496,7 @@ def test_ggx_g2_over_4cos():
         k = alpha / 2.0
         karis_g1 = mi / (mi * (1.0 - k) + k)
         assert np.all(np.abs(karis_g1 / mf.ggx_g1(wi, alpha) - 1.0) < 0.185)
-    # the docstring's measured bounds: Karis (separable) down to -82% of the height-correlated V
+    # the docstring's bounds: Karis (separable) down to -82% of the height-correlated V
     # (both directions grazing, α = 1), Hammon down to -27.6% (grazing, α = 0.05)
     assert low["karis"] > -0.82 and low["hammon"] > -0.276, low
     # anisotropic exact form equals G2 / (4 μi μo) too

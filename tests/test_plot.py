@@ -135,7 +135,7 @@ def test_brdf_slice_rgb_channel_and_existing_axes():
     rgba = image_of(left)
     assert rgba.shape == (32, 32, 4) and np.all(np.isfinite(rgba)) and rgba[..., :3].std() > 0.05
     assert pbplot.brdf_slice("gold", resolution=32, channel="r", log=False, ax=right) is right
-    assert len(fig.axes) == 4  # two panels, each with a colour bar (grey for rgb: the brightness scale)
+    assert len(fig.axes) == 4  # two panels, each with a color bar (grey for rgb: the brightness scale)
 
 
 def test_a_linear_slice_is_not_black_and_exposure_brightens():
@@ -148,7 +148,7 @@ def test_a_linear_slice_is_not_black_and_exposure_brightens():
     brighter = image_of(pbplot.brdf_slice("car_paint", resolution=64, channel="rgb", log=False, exposure=4))[..., :3]
     assert np.mean(rgb.max(-1) > 0.2) > 0.25
     assert np.all(brighter >= rgb - 1e-12) and brighter.mean() > rgb.mean() * 1.3
-    # the colour bar of an exposed slice is in f's units: its top is the range divided by the exposure
+    # the color bar of an exposed slice is in f's units: its top is the range divided by the exposure
     ax = pbplot.brdf_slice("car_paint", resolution=64, log=False, exposure=4)
     assert ax.images[-1].norm.vmax == pytest.approx(norm.vmax / 4)
     with pytest.raises(ValueError, match="percentile"):
@@ -290,7 +290,7 @@ def test_lit_sphere_sky_is_the_default_seeded_and_brightens():
 
 def test_the_default_sky_picture_is_less_noisy_than_independent_samples():
     # Lattice points: a rough dielectric under the sky at the default 64 samples is closer to a
-    # 4096-sample picture than one from as many independent uniforms (by half, measured).
+    # 4096-sample picture than one from as many independent uniforms (about half the error).
     material = pb.Material(base_color=(0.8, 0.8, 0.8), roughness=0.4)
     n, samples = 48, pb.render.DEFAULT_SAMPLES
     inside = pb.render.sphere_frames(n)[0]

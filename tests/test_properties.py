@@ -1,4 +1,4 @@
-"""README "What is checked" and §6.9 on the float64 reference: properties over random materials.
+"""README "What is checked" on the float64 reference: properties over random materials.
 
 Hypothesis draws one uniform material per example over the domains of README "The model"
 (edge values included) plus an explicit direction pair; each example also
@@ -282,7 +282,7 @@ def test_diffuse_and_sheen_lobe_bounds(params, pairs):
     smooth = pb.reference.eval_lobes(pb.Material(**dict(params, subsurface=0.0)), wi, wo).diffuse
     upper = max(1.0, 0.5 + 2.0 * params["roughness"]) ** 2
     assert np.all(smooth >= 0.25 * lambert * (1 - 1e-14))
-    assert np.all(smooth <= upper * lambert * (1 + 1e-14) + 1e-300)  # + 1e-300: denormal base colours
+    assert np.all(smooth <= upper * lambert * (1 + 1e-14) + 1e-300)  # + 1e-300: denormal base colors
     lum = 0.3 * base[0] + 0.6 * base[1] + 0.1 * base[2]
     tint = base / lum if lum >= 2.0 ** -126 else np.ones(3)
     c_sheen = 1.0 + (tint - 1.0) * params["sheen_tint"]

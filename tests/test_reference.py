@@ -1,4 +1,5 @@
-"""README "What is checked": the float64 reference against an independent numpy transcription of §3.
+"""README "What is checked": the float64 reference against an independent numpy transcription of
+README "The model" (tests/numpy_model.py).
 
 Tolerance (stated once, used throughout): every channel of every lobe and of the
 sum must satisfy

@@ -1,4 +1,4 @@
-"""The float64 reference sampler and pdf (README "Sampling and pdf", README "Sampling and pdf", §6.6-6.9).
+"""The float64 reference sampler and pdf (README "Sampling and pdf", README "What is checked").
 
 - the definition itself: a numpy transcription of the README (lobe probabilities,
   lobe choice by u0, the direction maps driven by u1, u2, the per-lobe pdfs built

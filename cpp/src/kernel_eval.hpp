@@ -14,7 +14,7 @@ struct Prepared {
 
 template <Output output>
 PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
-    // built in place: assigning into a default-constructed one copied the whole Shading per batch
+    // built in place: assigning into a default-constructed one would copy the whole Shading per batch
     if constexpr (output == Output::kGradient) {
         return {shading_of(m), material_partials_of(m.slot)};
     } else {
@@ -23,8 +23,8 @@ PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
 }
 
 // With the energy compensation (model/energy.hpp): the multiple-scattering
-// lobe's constants as well (its own type, so that the loops without it are
-// the same code as before the option existed).
+// lobe's constants as well (its own type, so that the loops without the
+// option hold none of its code).
 template <Output output>
 struct CompensatedPrepared : Prepared<output> {
     MultipleScatteringLobe<Floats> ms;
@@ -190,7 +190,7 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
     Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
     if (!accepted(job, wi, wo)) return false;
     if constexpr (per_element && compensated) {
-        // the lobes' constants as locals: a CompensatedPrepared built per batch was copied whole (rep movs)
+        // the lobes' constants as locals: a CompensatedPrepared built per batch would be copied whole (rep movs)
         RawMaterial m = load_material(job.params, i);
         Shading<Floats> s = shading_of(m);
         MultipleScatteringLobe<Floats> ms = multiple_scattering_of(m.slot, s, model);

@@ -40,8 +40,8 @@ PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shadi
 // allows that (its worst cancellation 14.1, at roughness 0; tested). The 2012
 // model's rows below roughness 23/64 = 0.36 do not (70,000 at roughness 1/32,
 // where 1 - E falls from 5e-3 to 2e-6 over μ's last interval before 1), and
-// its rows keep the lines from their ends. One form a model, so that a loop
-// holds one (bench/RESULTS.md, run 20).
+// its rows keep the lines from their ends. One form a model, fixed at compile
+// time, so that a loop holds the code of one form only.
 struct BlendedEnergyRow {
     alignas(64) float values[2 * 64];  // laid out by row_value_at and row_slope_at (simd_ops.hpp)
 

@@ -193,7 +193,7 @@ PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const 
 // other copies of the code, to the same bits (no contraction, see
 // simd_ops.hpp). Uniform materials only: with per-element materials each
 // batch's Shading in flight would not fit in the registers, so their batches
-// run one after another (bench/RESULTS.md has the figures). Returns -1 with
+// run one after another. Returns -1 with
 // every element of [begin, end) written, or the start of the first batch the
 // fast direction test did not accept, every element before it written (see
 // run_checked).

@@ -50,9 +50,9 @@ inline constexpr Interleave3Permutation<L, k, for_store> kInterleave3Permutation
 // instruction set has them (two on SSE2). The kernels build with
 // -ffp-contract=off, so every rounding is one the code asks for and an
 // element's bits do not depend on the code around its batch: with contraction
-// the compiler fused a product in straight-line code but not the same product
-// hoisted out of a loop, and the pipelined loop's results changed with the
-// call's start, length and thread chunks. xsimd 8.1 has no AVX-512 fma of its
+// the compiler may fuse a product in straight-line code but not the same
+// product hoisted out of a loop, and the pipelined loop's results would change
+// with the call's start, length and thread chunks. xsimd 8.1 has no AVX-512 fma of its
 // own (it writes x * y + z).
 #if defined(__AVX512F__)
 PB_KERNEL_INLINE Floats mul_add(Floats a, Floats b, Floats c) { return _mm512_fmadd_ps(a, b, c); }
@@ -68,7 +68,7 @@ PB_KERNEL_INLINE Floats neg_mul_add(Floats a, Floats b, Floats c) { return xsimd
 // set. The kernels are bound by the multiply and FMA pipes; the divide and
 // square-root unit works beside them, so an exact 1/x or sqrt(x) is cheaper
 // there than an rcp or rsqrt estimate refined by a Newton step, which takes 3
-// or 4 of the pipes' slots (bench/RESULTS.md, run 18).
+// or 4 of the pipes' slots.
 PB_KERNEL_INLINE Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
 // sqrt(x), 0 for x <= 0 (and for NaN on x86, where max returns its second operand)
 PB_KERNEL_INLINE Floats square_root(Floats x) { return xsimd::sqrt(xsimd::max(x, Floats(0.0f))); }
@@ -471,8 +471,9 @@ PB_KERNEL_INLINE std::pair<Ints, Floats> energy_interval(Floats mu) {
 // Non-negative 32-bit lane indices as integers for scalar loads' addresses, two
 // lanes at a time out of the register (vmovq, vpextrq) and apart by a shift:
 // half the vector-to-integer moves of GCC's way with a stored array, one
-// vmovd or vpextrd a lane on the FP pipes these kernels are bound by. (Forcing
-// the array through memory instead waited on store forwarding: bench/RESULTS.md.)
+// vmovd or vpextrd a lane on the FP pipes these kernels are bound by. (Reading
+// the indices back from a stored array instead would make each 4-byte load
+// wait on the forwarding of the 64-byte store.)
 struct LaneIndices {
     std::uint64_t pairs[kLanes / 2];
     PB_KERNEL_INLINE std::int64_t operator[](int lane) const {
@@ -543,7 +544,8 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
 #elif defined(__AVX2__)
 // Each lane's two adjacent floats as one 8-byte load, four lanes to a pair of
 // 128-bit halves, then split into the nodes below and above. Scalar loads, not
-// gathers, which measured slower on Zen 3 (bench/RESULTS.md).
+// gathers: a gather is no faster than its lanes' loads, and these wait only on
+// the index moves.
 PB_KERNEL_INLINE std::pair<Floats, Floats> gather_pair(const float* table, Ints i) {
     LaneIndices index = lane_indices(i);
     auto pairs = [&](int lane) {  // lanes l and l + 1: (t[i_l], t[i_l + 1], t[i_(l+1)], t[i_(l+1) + 1])
@@ -588,8 +590,9 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
 // corner table (energy_corners.hpp), one 16-byte load a lane. On AVX2
 // and AVX-512 the loads fill the 128-bit blocks of four registers, block b of
 // register r with lane 4 b + r, and a 4x4 transpose within the blocks leaves
-// corner c of lanes 4 b .. 4 b + 3 in block b of register c. No gathers: on
-// Zen 4 eight lanes' pairs by vgatherdpd cost about 17 cycles (bench/RESULTS.md).
+// corner c of lanes 4 b .. 4 b + 3 in block b of register c. No gathers: one
+// 16-byte load a lane fetches all four corners, where gathers of 8-byte pairs
+// would take two a register, each no faster than its lanes' loads.
 #if defined(__AVX512F__)
 // (the interval as energy_interval gives it here: offset by 1/8's bits >> 19,
 // any value below the surface; clamped, and the offset taken off in the

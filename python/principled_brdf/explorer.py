@@ -4,7 +4,7 @@
     explorer = pb.explorer()              # the last line of a cell shows it
     explorer = pb.explorer("car_paint", model="disney2012", resolution=256)
 
-A slider per material parameter (``base_color`` as a colour picker, sRGB
+A slider per material parameter (``base_color`` as a color picker, sRGB
 converted to linear by :func:`principled_brdf.srgb_to_linear`), the model,
 a preset menu that sets the sliders, the light and view directions (θ, φ in
 degrees, local frame: normal z, tangent x) and four pictures that follow
@@ -144,7 +144,7 @@ def _hex(linear: RealArrayLike) -> str:
 
 
 def _picked(value: str) -> tuple[float, ...]:
-    """The ColorPicker's value (``#rrggbb``, ``#rgb`` or a CSS colour name, sRGB) as linear RGB."""
+    """The ColorPicker's value (``#rrggbb``, ``#rgb`` or a CSS color name, sRGB) as linear RGB."""
     from matplotlib.colors import to_rgb
 
     srgb = np.round(np.asarray(to_rgb(value.strip())) * 255.0).astype(np.uint8)
@@ -399,7 +399,7 @@ class Explorer:
             return
         try:
             self._base_color = _picked(change["new"])
-        except ValueError:  # not a colour (yet): keep the last one
+        except ValueError:  # not a color (yet): keep the last one
             return
         self._changed(change)
 

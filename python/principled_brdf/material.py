@@ -240,7 +240,7 @@ class BrightColorWarning(UserWarning):
 
 
 def srgb_to_linear(color: RealArrayLike) -> Float64Array:
-    """sRGB-encoded colour to linear RGB by the exact piecewise curve (IEC 61966-2-1):
+    """sRGB-encoded color to linear RGB by the exact piecewise curve (IEC 61966-2-1):
     ``c / 12.92`` for ``c <= 0.04045``, else ``((c + 0.055) / 1.055) ** 2.4``. A uint8
     array is taken as 0-255 and scaled by 1/255 first; other values must lie in [0, 1]."""
     if isinstance(color, np.ndarray) and color.dtype == np.uint8:
@@ -251,7 +251,7 @@ def srgb_to_linear(color: RealArrayLike) -> Float64Array:
 
 
 def gamma22_to_linear(color: RealArrayLike) -> Float64Array:
-    """Display (gamma 2.2) colour to linear RGB, the BRDF Explorer's ``mon2lin``: ``c ** 2.2``."""
+    """Display (gamma 2.2) color to linear RGB, the BRDF Explorer's ``mon2lin``: ``c ** 2.2``."""
     array = as_real_array("color", color)
     require_in_domain("color", array, 0.0, np.inf)
     with np.errstate(over="ignore"):

@@ -413,7 +413,7 @@ def beckmann_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealArray
     (``a = 1 / (α_o tan θ)``); 0 at the normal, +inf at exactly grazing.
     ``approximation="walter"``: Walter et al. 2007 eq. 27's rational fit, as Λ,
     ``(1 - 1.259 a + 0.396 a²) / (3.535 a + 2.181 a²)`` for ``a < 1.6``, else 0:
-    within 3.2e-3 of the exact G1 relatively (measured: 3.13e-3 at a = 1.33), so
+    within 3.2e-3 of the exact G1 relatively (at most 3.13e-3, at a = 1.33), so
     within 3.2e-3 (1 + Λ) of the exact Λ, and 1.8e-3 absolutely beyond the cut at a = 1.6.
     """
     return _one_direction(_core_mf.beckmann_lambda, "w", w, alpha_x, alpha_y,
@@ -539,7 +539,7 @@ def blinn_phong_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: RealAr
     Blinn-Phong is not shape-invariant and has no exact Smith Λ; this one is an
     approximation, good for smooth surfaces only: against the Smith G1 of Blinn-Phong's own D,
     G1 is off by 2e-5 at α = 0.05, 2e-2 at 0.3, 0.13 at 0.6 and 0.64 at 1 (85° views), and the
-    weak white furnace misses 1 by 3e-4, 3e-2, 0.15 and 0.73 (88° views; measured in
+    weak white furnace misses 1 by 3e-4, 3e-2, 0.15 and 0.73 (88° views; checked in
     ``tests/test_microfacet_family.py``).
 
     Two-sided (reads ``|w·n|``); 0 at the normal, +inf at exactly grazing.
@@ -710,7 +710,7 @@ def exponential_power_lambda(w: RealArrayLike, alpha_x: RealArrayLike, alpha_y: 
         Λ(a) = (2/a) ∫_0^∞ f(sqrt(a² + t²)) (t - a atan(t/a)) t dt,   f(r) = p exp(-r^(2p)) / (π Γ(1/p))
 
     by 20-point Gauss-Legendre panels doubling in width out to where the integrand is
-    below e^-60 of its start: measured within 3.4e-10 relative of a fine two-dimensional
+    below e^-60 of its start: within 3.4e-10 relative of a fine two-dimensional
     quadrature of Smith's definition (p in [0.3, 4], 5° to 89.9°), and at p = 1 within 2e-14 of
     Beckmann's erf form (6e-11 where Λ ~ 1e-250).
 

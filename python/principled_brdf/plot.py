@@ -224,15 +224,15 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
     the bottom right. Pixels where the light or the view is at or below the
     horizon are masked (drawn in grey; NaN-free data underneath).
 
-    ``channel``: one of :data:`CHANNELS`, or ``"rgb"``: the colour of f, each
-    pixel's brightness set by its luminance on the colour scale and its
-    chromaticity kept (a grey colour bar gives the scale). The colour scale
+    ``channel``: one of :data:`CHANNELS`, or ``"rgb"``: the color of f, each
+    pixel's brightness set by its luminance on the color scale and its
+    chromaticity kept (a grey color bar gives the scale). The color scale
     runs over ``[vmin, vmax]`` in 1/sr; by default up to the ``percentile``-th
     percentile of the slice (default 99 with ``log``, 90 without: a sharp
     specular peak saturates instead of leaving the rest black) and, with
     ``log``, down to 6 decades below that or the smallest positive value
     (linear: from 0). ``exposure`` multiplies
-    f before it is mapped (above 1 brightens, the colour bar relabelled to
+    f before it is mapped (above 1 brightens, the color bar relabelled to
     match). Returns the Axes; the image is ``ax.images[-1]`` (``get_array()``
     gives the plotted values, indexed ``[θd, θh]`` with row 0 at θd ≈ 0).
     """
@@ -274,7 +274,7 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
 
     assert norm.vmin is not None  # set above (for type checkers: Normalize.vmin is float | None)
     if rgb_mode:
-        # display brightness (sRGB-encoded) = the luminance's place on the scale, as on the grey colour bar
+        # display brightness (sRGB-encoded) = the luminance's place on the scale, as on the grey color bar
         level = np.clip(np.ma.filled(norm(np.maximum(value, norm.vmin)), 0.0), 0.0, 1.0)
         scale = np.divide(_srgb_decode(level), value, out=np.zeros_like(value), where=value > 0.0)
         color = f * scale[..., None]
@@ -667,7 +667,7 @@ def microfacet_family(alpha: float = 0.3, *, student_t_gammas: Iterable[float] =
     radians = np.radians(theta)
     w = np.stack([np.sin(radians), np.zeros_like(radians), np.cos(radians)], axis=-1)
     exponent = 2.0 / a**2 - 2.0
-    # (label, colour, line style, D(h), Λ(w) or None)
+    # (label, color, line style, D(h), Λ(w) or None)
     curves: list[tuple[str, str, str | tuple[int, tuple[int, ...]], Float64Array, Float64Array | None]] = [
         ("GGX", "tab:blue", "-", mf.ggx_d(w, a), mf.ggx_lambda(w, a)),
         ("Beckmann", "tab:orange", "-", mf.beckmann_d(w, a), mf.beckmann_lambda(w, a)),

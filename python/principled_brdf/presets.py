@@ -1,4 +1,4 @@
-"""A small library of named materials (linear base colours, within the parameters' domains).
+"""A small library of named materials (linear base colors, within the parameters' domains).
 
     pb.presets.get("gold")            # a Material
     pb.presets.names()                # what there is
@@ -17,7 +17,7 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
 __all__ = ["get", "names", "parameters"]
 
 _PRESETS: dict[str, dict[str, float | tuple[float, float, float]]] = {
-    # Metals: base_color is the specular colour at normal incidence.
+    # Metals: base_color is the specular color at normal incidence.
     "gold": dict(base_color=(1.0, 0.766, 0.336), metallic=1.0, roughness=0.3),
     "copper": dict(base_color=(0.955, 0.638, 0.538), metallic=1.0, roughness=0.35),
     "chrome": dict(base_color=(0.55, 0.556, 0.554), metallic=1.0, roughness=0.08),

@@ -166,8 +166,8 @@ def sky_environment(direction: RealArrayLike, zenith: RealArrayLike = (0.65, 0.7
 
     y is up (as in :mod:`principled_brdf.render`): above the horizon the sky
     goes from ``horizon`` to ``zenith`` as ``sqrt(y)``; below it is ``ground``,
-    blended over a narrow band around the horizon. The default colours are
-    nearly neutral, so that a metal shows its own colour, and the ground is
+    blended over a narrow band around the horizon. The default colors are
+    nearly neutral, so that a metal shows its own color, and the ground is
     dark, so that its curvature shows.
     """
     up = np.asarray(direction, dtype=np.float32)[..., 1]
@@ -259,7 +259,7 @@ def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "
     """Scene-referred linear RGB ``(..., 3)`` to display-referred linear RGB in [0, 1].
 
     The curve maps each pixel's luminance ``Y`` (Rec. 709 weights) to ``Y'``;
-    the pixel's colour is scaled by ``Y'/Y`` and, where a channel would still
+    the pixel's color is scaled by ``Y'/Y`` and, where a channel would still
     exceed 1, divided by that channel, so a gold highlight stays gold and a
     white material keeps its shading instead of clipping flat. ``"filmic"``
     (default): the ACES fit of Narkowicz 2015, white at ``Y`` =

@@ -11,7 +11,12 @@
 // log_gamma), like Beckmann's erfc: no kernel instantiates these types.
 // Included, inside a namespace that defines the model's operations, after
 // distributions.hpp (model/f64_family.hpp does so for double).
-#pragma once  // (per namespace that includes the model)
+// Once a translation unit, like the model (model.hpp says why): a second
+// inclusion, under any namespace, is a compile error.
+#ifdef PRINCIPLED_BRDF_DISTRIBUTION_FAMILY_INCLUDED
+#error "principled_brdf: model/distribution_family.hpp is already included in this translation unit (include model/f64_family.hpp instead)"
+#endif
+#define PRINCIPLED_BRDF_DISTRIBUTION_FAMILY_INCLUDED
 
 // The stretch shared by the family: the per-direction a, the stretched tan²θh of a half vector.
 template <class F>

@@ -3,7 +3,7 @@
 // half vector H = wi + wo through the squares of its components, so that
 // cos²θh = Hz²/|H|² and sin²θh = (Hx² + Hy²)/|H|² keep full relative precision
 // at narrow peaks, where 1 - cos²θh would cancel.
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // The squares of the half vector's components that the distributions read.
 template <class F>

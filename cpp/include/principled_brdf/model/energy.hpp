@@ -22,7 +22,7 @@
 // ((row[index], row[index + 1]) from a row of intervals + 1 nodes, the table
 // of 1 - E_avg) and gather_corners (an interval's value and slope in two
 // adjacent rows of the 1 - E table at once, energy_corners.hpp).
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // The roughness rows' spacing is a power of two, so that r (kRoughnesses - 1)
 // is exact in float32 and so is the interpolation weight between rows; within

@@ -1,28 +1,28 @@
 // Part of the model (docs/model.md): the partial derivatives of f with respect
-// to the 13 parameter slots (params.hpp order, base colour expanded), over a
+// to the 13 parameter slots (params.hpp order, base color expanded), over a
 // number type F, written by hand beside the parts they differentiate.
 //
 // f is linear in most parameters (README "The model"): per channel c,
 //   f_c = D dc_c + FH sc_c + T f0_c + (S FH + C),   T = S (1 - FH),
-// with the material's colours dc (diffuse), sc (sheen), f0 (Cspec0) and the
+// with the material's colors dc (diffuse), sc (sheen), f0 (Cspec0) and the
 // scalars of the pair: D (diffuse, from roughness and subsurface), FH,
 // S (specular, from roughness and anisotropic) and C (clearcoat, linear in
 // clearcoat, through GTR1 in clearcoat_gloss). So the Jacobian is
 //   ∂f_c/∂p = ∂D/∂p dc_c + D ∂dc_c/∂p + FH ∂sc_c/∂p + ∂S/∂p ((1 - FH) f0_c + FH) + T ∂f0_c/∂p + ∂C/∂p:
-// the colours' partials are per-material constants (MaterialPartials, only
+// the colors' partials are per-material constants (MaterialPartials, only
 // the non-zero ones: Cspec0 and Csheen move with base_color through Ctint, the
-// diffuse colour only in its own channel), the
+// diffuse color only in its own channel), the
 // scalars' partials come from methods beside the lobes and distributions they
 // differentiate (diffuse_partials, SpecularLobe::log_value_partials,
 // ClearcoatLobe::unit_value, Gtr1::log_d_partial_alpha2, ...). Where the model
 // clamps (alpha = max(0.001, ...)) the derivative is the active branch's;
 // Ctint = 1 where lum(base_color) <= 0 has derivative 0.
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 template <class F>
 PB_MODEL_INLINE F channel_of(const Rgb<F>& colour, int c) { return c == 0 ? colour.r : c == 1 ? colour.g : colour.b; }
 
-// The material's constants of the Jacobian: its colours' non-zero partials and
+// The material's constants of the Jacobian: its colors' non-zero partials and
 // the partials of the roughnesses the lobes read.
 template <class F>
 struct MaterialPartials {

@@ -3,7 +3,7 @@
 // call for a uniform material, per batch otherwise) and what it contributes:
 // its value, its share of the lobe choice (a cheap estimate of its albedo at
 // wo) and its density.
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // What the lobes read of a pair (wi, wo): the half vector H = wi + wo kept
 // unnormalised (README "The model", numerics).

@@ -7,6 +7,17 @@
 //
 // Locals are not declared const: GCC 12 keeps a const aggregate that an inlined
 // call constructs in place in memory (docs/model.md, "No const locals").
+//
+// One namespace a translation unit. The model's files are `#pragma once`,
+// which holds per translation unit, not per namespace: a second inclusion
+// under another namespace (f64.hpp and kernel.hpp in one file, or two
+// kernels) would find them already seen and leave that namespace without the
+// model. This guard makes it a compile error instead.
+#ifdef PRINCIPLED_BRDF_MODEL_INCLUDED
+#error "principled_brdf: the model (model/model.hpp) is included a second time in this translation unit; it can live in one namespace only, so f64.hpp and each kernel_<isa>.cpp need translation units of their own"
+#endif
+#define PRINCIPLED_BRDF_MODEL_INCLUDED
+
 #include "vector.hpp"
 #include "distributions.hpp"
 #include "lobes.hpp"

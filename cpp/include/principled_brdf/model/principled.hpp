@@ -2,7 +2,7 @@
 // its lobes, over a number type F: the material's constants, f and its lobes,
 // the sampling mixture's weights and density, the lobe choice, the draw of wi
 // and the weight of a drawn sample (README "The model", "Sampling and pdf").
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // Everything the lobes need of a material, independent of the directions.
 template <class F>
@@ -94,7 +94,7 @@ PB_MODEL_INLINE View<F> view_of(const Vec3<F>& wo, const Shading<F>& s) {
     return view_of<model, lobes>(wo, s, s.specular.ggx.smith_denominator(wo), schlick_weight(wo.z));
 }
 
-// The lobes as scalar factors of the material's colours:
+// The lobes as scalar factors of the material's colors:
 //   diffuse   = D  base_color (1 - metallic) / π     (s.diffuse.color)
 //   sheen     = FH sheen Csheen (1 - metallic)       (s.sheen.color)
 //   specular  = S  mix(Cspec0, 1, FH),  S = Gs Ds

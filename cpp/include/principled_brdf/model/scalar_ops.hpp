@@ -3,7 +3,7 @@
 // (reciprocals, square roots, sin and cos of 2πu, e^x - 1, log), each
 // rounded as IEEE double.
 // Included inside the namespace that includes the model for double, before it.
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: f64.hpp includes it, in principled_brdf::f64
 
 // a b + c rounded twice: std::fma is a slow library call without FMA
 // instructions, and the float64 path needs no single rounding

@@ -1,8 +1,8 @@
 // Part of the model (docs/model.md): included inside a namespace that defines
-// the operations of its number types. Vectors, colours and the small helpers
+// the operations of its number types. Vectors, colors and the small helpers
 // every part uses, over a number type F: double (the reference) or
 // xsimd::batch<float, Arch> (the kernels).
-#pragma once  // (per namespace that includes the model)
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // What a comparison of two F gives: bool for double, a batch_bool for a batch.
 template <class F>
@@ -41,7 +41,7 @@ template <class F>
 PB_MODEL_INLINE F dot(const Vec3<F>& a, const Vec3<F>& b) { return mul_add(a.x, b.x, mul_add(a.y, b.y, a.z * b.z)); }
 
 // mix(a, b, t) = a (1 - t) + b t: for a, b >= 0 nothing cancels (a + (b - a) t
-// loses b's digits when b << a and t -> 1, e.g. Csheen of a saturated colour).
+// loses b's digits when b << a and t -> 1, e.g. Csheen of a saturated color).
 template <class F>
 PB_MODEL_INLINE F mix(F a, F b, F t) { return mul_add(b, t, a * (F(1.0) - t)); }
 template <class F>
