@@ -16,6 +16,7 @@ are rounded so that every instruction set prints them.
 import ast
 import pathlib
 import re
+import tempfile
 
 import pytest
 
@@ -79,17 +80,22 @@ def run_blocks(blocks: list, name: str) -> dict:
 
 @pytest.fixture
 def page_sandbox(monkeypatch, tmp_path):
-    """An empty working folder, examples/ importable, matplotlib headless; the folder must stay empty."""
+    """An empty working folder, examples/ importable, matplotlib headless; the folder must stay
+    empty. The examples' temporary folders (tempfile.mkdtemp()) are made inside pytest's own."""
     matplotlib = pytest.importorskip("matplotlib")
     matplotlib.use("Agg")
     monkeypatch.setenv("MPLBACKEND", "Agg")
     monkeypatch.syspath_prepend(str(EXAMPLES))  # evaluating.md imports examples/dask_scale_out.py
-    monkeypatch.chdir(tmp_path)
-    yield tmp_path
+    working, scratch = tmp_path / "working", tmp_path / "tmp"
+    working.mkdir()
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    monkeypatch.chdir(working)
+    yield working
     import matplotlib.pyplot as plt
 
     plt.close("all")
-    assert not list(tmp_path.iterdir()), "an example wrote into the current folder"
+    assert not list(working.iterdir()), "an example wrote into the current folder"
 
 
 def run_page(path: pathlib.Path) -> dict:
