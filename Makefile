@@ -3,7 +3,7 @@
 PYTHON ?= python3
 export PYTHON
 
-.PHONY: demo test install deps bench sanitize wheel
+.PHONY: demo test install deps bench sanitize wheel docs
 
 demo: install
 	$(PYTHON) -m principled_brdf demo
@@ -35,3 +35,7 @@ bench: deps
 # bad-input, batch, sampling and fuzz tests (scripts/sanitize.sh says how).
 sanitize: deps
 	bash scripts/sanitize.sh
+
+# The API reference from the docstrings (Sphinx, docs/api/), into build/docs; open build/docs/index.html
+docs: install
+	$(PYTHON) -m sphinx -b html -W --keep-going -q -d build/docs/.doctrees docs/api build/docs

@@ -44,7 +44,7 @@ a cluster needs:
 * ``principled_brdf`` installed on every worker (same version, built for each
   worker's CPU: the instruction set is picked at import time on the worker, so
   mixed AVX2 / AVX-512 nodes are fine and give the same results within the
-  accuracy bounds of the README);
+  accuracy bounds of docs/validation.md);
 * inputs the workers can read themselves (zarr/HDF5 on shared or object
   storage, or dask arrays generated on the workers); avoid ``da.from_array``
   of a large local numpy array, which ships it through the client;
