@@ -1,5 +1,5 @@
 """principled_brdf.eval against a straightforward numpy float32 implementation
-of the model (README "The model") on the same pairs (default 4M), uniform material, timed in one
+of the model (docs/model.md, "The model") on the same pairs (default 4M), uniform material, timed in one
 process. The implementation lives in principled_brdf.benchmark (also
 `python -m principled_brdf bench`).
 

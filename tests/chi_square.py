@@ -1,4 +1,4 @@
-"""Chi-square goodness of fit of a direction sampler against its pdf (README "What is checked").
+"""Chi-square goodness of fit of a direction sampler against its pdf (docs/validation.md).
 
 The upper hemisphere is cut into an equal-area grid of ``n_phi x n_cos`` cells
 in ``(φ, cos θ)`` (``dω = dφ d cos θ``, so every cell has solid angle
@@ -33,7 +33,7 @@ from scipy import stats
 
 SIGNIFICANCE = 0.01
 MIN_EXPECTED = 5.0
-GRID = (50, 50)  # (n_phi, n_cos): at least 50 x 50 (README "What is checked")
+GRID = (50, 50)  # (n_phi, n_cos): at least 50 x 50 (docs/validation.md)
 
 
 def sidak_threshold(cases: int, significance: float = SIGNIFICANCE) -> float:

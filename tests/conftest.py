@@ -23,7 +23,7 @@ LOBES = ("diffuse", "sheen", "specular", "clearcoat")
 
 SEED = 20240517
 
-# Values at (or on the edge of) the domains of README "The model" that random draws should
+# Values at (or on the edge of) the domains of docs/model.md, "The model" that random draws should
 # include. Unbounded parameters get a few values above the BRDF Explorer's UI
 # range, since the domains allow them.
 EDGE_VALUES = {
@@ -55,7 +55,7 @@ RANGES = {
 
 SCALAR_PARAMETERS = tuple(RANGES)
 
-# README "The model" domains restated for the tests (the library's own table is checked against it)
+# docs/model.md, "The model" domains restated for the tests (the library's own table is checked against it)
 TABLE_DOMAINS = {
     "base_color": (0.0, np.inf),
     "metallic": (0.0, 1.0),
@@ -196,7 +196,7 @@ def random_scalar_parameter(rng: np.random.Generator, name: str, n: int, edge_fr
 def random_material_arrays(rng: np.random.Generator, n: int, edge_fraction: float = 0.2) -> dict:
     """Per-element parameters for ``n`` materials: ``{name: (n,) array, base_color: (n, 3)}``.
 
-    Values cover the domains of README "The model"; a fraction ``edge_fraction`` of each
+    Values cover the domains of docs/model.md, "The model"; a fraction ``edge_fraction`` of each
     parameter is set to an edge value (roughness 0 and 1, anisotropic 1,
     specular 2, clearcoat_gloss 0 and 1, metallic 0 and 1, black base color,
     sheen and clearcoat up to 2, ...), drawn independently per parameter.

@@ -1,10 +1,10 @@
-"""An independent float64 numpy transcription of README "The model" (the third implementation).
+"""An independent float64 numpy transcription of docs/model.md, "The model" (the third implementation).
 
-Written from README "The model" and Disney's BRDF Explorer shader ``disney.brdf``,
+Written from docs/model.md, "The model" and Disney's BRDF Explorer shader ``disney.brdf``,
 not from ``reference.hpp``: a slip in either shows up against the other.
 
 Materials are given as a mapping ``name -> value`` (numbers or arrays, as in
-README "The model"; ``base_color`` of shape ``(3,)`` or ``(..., 3)``) or as anything with
+docs/model.md, "The model"; ``base_color`` of shape ``(3,)`` or ``(..., 3)``) or as anything with
 an ``as_dict()`` method (e.g. :class:`principled_brdf.Material`). Everything
 broadcasts numpy-style against the directions' leading shape.
 
@@ -83,7 +83,7 @@ def _scalar(p):
 
 
 def eval_lobes(material, wi, wo, model: str = "disney2014") -> Lobes:
-    """The four lobes of README "The model" as float64 ``(..., 3)`` arrays."""
+    """The four lobes of docs/model.md, "The model" as float64 ``(..., 3)`` arrays."""
     return _evaluate(material, wi, wo, model)[0]
 
 
@@ -208,7 +208,7 @@ def smith_iso(cos_w, g):
 
 
 def eval(material, wi, wo, model: str = "disney2014", cosine: bool = False) -> np.ndarray:
-    """f(wi, wo) of README "The model" in 1/sr, float64 ``(..., 3)``; times cos θl if ``cosine``."""
+    """f(wi, wo) of docs/model.md, "The model" in 1/sr, float64 ``(..., 3)``; times cos θl if ``cosine``."""
     f = eval_lobes(material, wi, wo, model).total()
     if cosine:
         f = f * np.maximum(np.asarray(wi, dtype=np.float64)[..., 2:3], 0.0)

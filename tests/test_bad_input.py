@@ -1,4 +1,4 @@
-"""README "Bad input" at the Python boundary: every bad input raises ValueError (TypeError for
+"""docs/bad-input.md at the Python boundary: every bad input raises ValueError (TypeError for
 types) naming the argument and, where there is one, the first offending element."""
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ EVALUATORS = {"eval": pb.reference.eval, "eval_lobes": pb.reference.eval_lobes}
 DIRECTIONS = ("wi", "wo")
 
 SCALAR_DOMAINS = {name: domain for name, domain in TABLE_DOMAINS.items() if name != "base_color"}
-# (parameter, side) for every finite bound of README "The model"
+# (parameter, side) for every finite bound of docs/model.md, "The model"
 DOMAIN_CASES = [(name, "below") for name in SCALAR_DOMAINS] + [
     (name, "above") for name, (_, hi) in SCALAR_DOMAINS.items() if np.isfinite(hi)
 ]

@@ -148,7 +148,7 @@ def test_bad_out(out, error, message):
 
 
 def test_bad_direction_in_out_call_is_named_and_out_holds_only_right_values():
-    # README "Bad input": the check rides along with the evaluation, so out=
+    # docs/bad-input.md: the check rides along with the evaluation, so out=
     # may hold partial results after the error, each of them right.
     rng = seeded_rng("bad-direction")
     wi, wo = (w.astype(np.float32) for w in random_direction_pairs(rng, 50_000))

@@ -140,7 +140,7 @@ def test_cubature_vector_valued():
 @pytest.mark.parametrize("alpha_x, alpha_y", [(1.0, 1.0), (0.5, 0.05), (0.05, 0.05), (0.001, 0.001),
                                               (0.01, 0.001), (0.001, 0.0001)])
 def test_cubature_resolves_narrow_peaks_at_the_pole(alpha_x, alpha_y):
-    """∫ D cos θh over the hemisphere is 1 (README "The model") even when the whole peak sits inside one cell row."""
+    """∫ D cos θh over the hemisphere is 1 (docs/model.md, "The model") even when the whole peak sits inside one cell row."""
     cells = cs.integrate_cells(ggx_h_pdf(alpha_x, alpha_y), peaks=[[0.0, 0.0, 1.0]], peak_width=min(alpha_x, alpha_y))
     assert cells.sum() == pytest.approx(1.0, abs=1e-6)
 

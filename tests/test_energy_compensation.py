@@ -1,5 +1,5 @@
 """The multiple-scattering energy compensation of the primary specular lobe
-(Kulla & Conty 2017; README "Energy compensation", docs/model.md).
+(Kulla & Conty 2017; docs/energy-compensation.md, docs/model.md).
 
 - the tables (cpp/include/principled_brdf/energy_tables.hpp, written by
   scripts/energy_tables.py): sample entries recomputed by an independent
@@ -210,7 +210,7 @@ def test_white_furnace_by_monte_carlo(model):
 # |albedo - 1| of anisotropic white metals (quasi-Monte Carlo) at anisotropic 1,
 # the worst over the cases below: 2014 model 0.42 (roughness 1, θv 87°, ax = 3.2, ay = 0.32),
 # 2012 model 0.96 (its isotropic Gs with the anisotropic Ds: the single-scattering
-# lobe alone reaches 1.42 there); README "Energy compensation". The isotropic
+# lobe alone reaches 1.42 there); docs/energy-compensation.md. The isotropic
 # tables at r_eff = (ax ay)^(1/4) do not fit so stretched a lobe.
 ANISOTROPIC_BOUND = {"disney2014": 0.45, "disney2012": 1.0}
 
@@ -271,7 +271,7 @@ def test_tinted_by_f_avg():
 def test_vanishes_for_smooth_surfaces_in_the_2014_model():
     # 2014: Gs -> 1 as alpha -> 0.001, so E -> 1; the 2012 model's Smith term keeps
     # alpha_g >= 0.25 and so loses energy at grazing angles even for r = 0, which the
-    # lobe then restores (README "Energy compensation")
+    # lobe then restores (docs/energy-compensation.md)
     for r in (0.0, 0.01, 0.03):
         material = pb.Material(**WHITE, roughness=r)
         for theta in FURNACE_THETAS:
@@ -423,7 +423,7 @@ def test_lookups_beside_the_nodes(isa, per_element):
             material = pb.Material(**WHITE, roughness=np.full(len(wi), r, np.float32) if per_element else r)
             for name, simd, expected in compensated_lobes_against_reference(material, wi, wo, isa, model):
                 errors = relative_errors(simd, expected)
-                # the maximum bounds of README "What is checked": at cos θ >= 0.05, and below
+                # the maximum bounds of docs/validation.md: at cos θ >= 0.05, and below
                 steep = (wi_z >= 0.05) & (wo_z >= 0.05)
                 for bound, where in ((5e-5, steep), (1e-3, ~steep)):
                     worst = int(np.argmax(np.where(where, errors.max(axis=1), 0)))

@@ -1,4 +1,4 @@
-"""pb.fit: least squares with the analytic Jacobian (README "Fitting")."""
+"""pb.fit: least squares with the analytic Jacobian (docs/fitting.md)."""
 
 from __future__ import annotations
 

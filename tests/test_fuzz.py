@@ -1,4 +1,4 @@
-"""A fuzz of every public entry point with hostile arguments (README "Bad input").
+"""A fuzz of every public entry point with hostile arguments (docs/bad-input.md).
 
 Hypothesis draws shapes, dtypes, layouts, strides, misalignment, aliasing,
 NaN/inf, values at and beyond the domains' edges and option values. Every call

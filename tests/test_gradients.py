@@ -1,4 +1,4 @@
-"""The Jacobian of f in the material's parameters (README "Gradients").
+"""The Jacobian of f in the material's parameters (docs/gradients.md).
 
 float64 against central differences of the float64 reference, the clamps'
 derivatives, the linearity of f in sheen, clearcoat and the diffuse color,

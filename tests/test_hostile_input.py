@@ -1,4 +1,4 @@
-"""Hostile input (README "Bad input"): every element or an
+"""Hostile input (docs/bad-input.md): every element or an
 error, the direction check decided once, aliasing, alignment, the edges of the
 integer options, and finite float32 results over the whole parameter range.
 

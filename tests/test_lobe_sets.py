@@ -1,4 +1,4 @@
-"""README "Performance": a material whose lobes are off runs a kernel compiled
+"""docs/performance.md: a material whose lobes are off runs a kernel compiled
 without them (specular alone for metallic 1 without clearcoat; diffuse and
 specular without sheen, subsurface and clearcoat), chosen once per call for a
 uniform material and per batch, when all its lanes agree, for a per-element

@@ -1,4 +1,4 @@
-"""Material: README "The model" defaults and domains, immutability, replace, mix; gamma22_to_linear."""
+"""Material: docs/model.md, "The model" defaults and domains, immutability, replace, mix; gamma22_to_linear."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import principled_brdf as pb
 import numpy_model
 from conftest import TABLE_DOMAINS, random_directions, random_material_arrays, random_material_dict, seeded_rng
 
-# README "The model", copied from the table (not from the library)
-TABLE_DEFAULTS = numpy_model.DEFAULTS  # README "The model", restated once in the independent transcription
+# docs/model.md, "The model", copied from the table (not from the library)
+TABLE_DEFAULTS = numpy_model.DEFAULTS  # docs/model.md, "The model", restated once in the independent transcription
 
 
 # --------------------------------------------------------------------------
@@ -261,7 +261,7 @@ def test_gamma22_to_linear_is_c_to_the_2_2():
 
 
 def test_gamma22_to_linear_is_not_applied_implicitly():
-    # README "The model": base_color is linear; mon2lin is a helper, not a hidden step
+    # docs/model.md, "The model": base_color is linear; mon2lin is a helper, not a hidden step
     m = pb.Material(base_color=(0.5, 0.5, 0.5))
     np.testing.assert_array_equal(m.base_color, [0.5, 0.5, 0.5])
     n = np.array([0.0, 0.0, 1.0])

@@ -1,4 +1,4 @@
-"""The microfacet toolkit, principled_brdf.microfacet (README "The model"; README "What is checked":
+"""The microfacet toolkit, principled_brdf.microfacet (docs/model.md, "The model"; docs/validation.md:
 every D integrates to 1, the weak white furnace, samplers by chi-square, finite everywhere).
 
 Integrals over the hemisphere of half vectors use a product rule in (θ, ψ):
@@ -237,7 +237,7 @@ def test_ggx_formulas(rng):
     np.testing.assert_allclose(mf.ggx_d(h, ax, ay), d, rtol=1e-13)
     np.testing.assert_allclose(mf.ggx_pdf(h, ax, ay), d * h[:, 2], rtol=1e-13)
 
-    def lam(v):  # README "The model", literally
+    def lam(v):  # docs/model.md, "The model", literally
         return (-1.0 + np.sqrt(1.0 + ((ax * v[:, 0]) ** 2 + (ay * v[:, 1]) ** 2) / v[:, 2] ** 2)) / 2.0
 
     np.testing.assert_allclose(mf.ggx_lambda(w, ax, ay), lam(w), rtol=1e-10)
@@ -421,7 +421,7 @@ def test_smith_at_the_normal_and_grazing():
 
 
 # --------------------------------------------------------------------------
-# samplers against their pdf (chi-square; README "What is checked" "each D with its own sampler")
+# samplers against their pdf (chi-square; docs/validation.md "each D with its own sampler")
 
 GTR_SAMPLER_CASES = [(a, g, cf) for g in (0.5, 1.0, 1.5, 2.0, 3.0) for a in (0.05, 0.3, 1.0)
                      for cf in ((True, False) if g in (1.0, 1.5, 2.0) else (True,))]
@@ -500,7 +500,7 @@ def check_sampler(h, pdf, stretch_x, stretch_y, *, equal_area=False):
     assert np.all(np.isfinite(h))
     np.testing.assert_allclose(np.linalg.norm(h, axis=-1), 1.0, rtol=1e-14)
     assert np.all(h[:, 2] >= 0.0)
-    if equal_area:  # README "What is checked" grid: 50 x 50 cells equal in (cos θ, φ)
+    if equal_area:  # docs/validation.md grid: 50 x 50 cells equal in (cos θ, φ)
         stretch_x = stretch_y = 1.0
         theta_edges = np.arccos(np.linspace(1.0, 0.0, 51))
         psi_edges = np.linspace(-np.pi, np.pi, 51)
@@ -581,7 +581,7 @@ EQUAL_AREA_SAMPLERS = {
 
 @pytest.mark.parametrize("case", EQUAL_AREA_CASES)
 def test_sampler_equal_area_grid(rng, case):
-    # README "What is checked"'s grid: 10^6 samples, 50 x 50 cells of equal solid angle
+    # docs/validation.md's grid: 10^6 samples, 50 x 50 cells of equal solid angle
     sample, pdf = EQUAL_AREA_SAMPLERS[case]
     h = sample(*uniforms(rng, 1_000_000))
     check_sampler(h, pdf, 1.0, 1.0, equal_area=True)
@@ -604,7 +604,7 @@ def test_samplers_at_the_ends_of_the_unit_interval():
 
 
 # --------------------------------------------------------------------------
-# finite everywhere in the domain (README "What is checked")
+# finite everywhere in the domain (docs/validation.md)
 
 
 def test_no_nan_or_inf_anywhere():

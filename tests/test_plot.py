@@ -496,7 +496,7 @@ def test_blend_demo_bad_arguments():
 
 
 # --------------------------------------------------------------------------
-# energy compensation (Kulla & Conty 2017; README "Energy compensation")
+# energy compensation (Kulla & Conty 2017; docs/energy-compensation.md)
 
 WHITE_METAL = pb.Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=1.0)
 

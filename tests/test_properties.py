@@ -1,6 +1,6 @@
-"""README "What is checked" on the float64 reference: properties over random materials.
+"""docs/validation.md on the float64 reference: properties over random materials.
 
-Hypothesis draws one uniform material per example over the domains of README "The model"
+Hypothesis draws one uniform material per example over the domains of docs/model.md, "The model"
 (edge values included) plus an explicit direction pair; each example also
 evaluates a batch of seeded random pairs (grazing down to cos θ = 1e-4, mirror
 and wi = wo pairs), so 200 examples cover ~10^4 triples per property.
@@ -61,7 +61,7 @@ def _value(k, lo, hi, edges):
 
 
 UNIT_EDGES = (0.0, 1.0)
-# (lo, hi, edges); unbounded parameters (README "The model": >= 0) go up to 10
+# (lo, hi, edges); unbounded parameters (docs/model.md, "The model": >= 0) go up to 10
 SCALARS = {
     "metallic": (0.0, 1.0, UNIT_EDGES),
     "subsurface": (0.0, 1.0, UNIT_EDGES),
@@ -254,7 +254,7 @@ LINEAR_PARAMETERS = ("metallic", "subsurface", "specular", "specular_tint", "she
 @SETTINGS
 @given(params=MATERIALS, pairs=PAIRS, name=st.sampled_from(LINEAR_PARAMETERS), t=st.floats(0.0, 1.0))
 def test_affine_in_the_linear_parameters(params, pairs, name, t):
-    # README "The model": with the others fixed, f is affine in each of these parameters
+    # docs/model.md, "The model": with the others fixed, f is affine in each of these parameters
     # (e.g. metallic is "a linear blend of two models").
     wi, wo = pairs
     for model in MODELS:

@@ -1,5 +1,5 @@
-"""README "What is checked": the float64 reference against an independent numpy transcription of
-README "The model" (tests/numpy_model.py).
+"""docs/validation.md: the float64 reference against an independent numpy transcription of
+docs/model.md, "The model" (tests/numpy_model.py).
 
 Tolerance (stated once, used throughout): every channel of every lobe and of the
 sum must satisfy
@@ -267,7 +267,7 @@ def test_below_horizon_is_exactly_zero(model, cosine):
 
 @pytest.mark.parametrize("model", MODELS)
 def test_exactly_on_the_horizon_is_zero(model):
-    # README "The model": f = 0 when cos θ <= 0 (the shader's test is `< 0`; the README's definition is normative)
+    # docs/model.md, "The model": f = 0 when cos θ <= 0 (the shader's test is `< 0`; the README's definition is normative)
     horizon = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [np.sqrt(0.5), np.sqrt(0.5), 0.0]])
     up = np.array([[0.0, 0.0, 1.0], [0.6, 0.0, 0.8], [-0.6, 0.0, 0.8]])
     material = pb.Material(roughness=0.3, sheen=1.0, clearcoat=1.0, subsurface=1.0)

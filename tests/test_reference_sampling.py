@@ -1,20 +1,20 @@
-"""The float64 reference sampler and pdf (README "Sampling and pdf", README "What is checked").
+"""The float64 reference sampler and pdf (docs/sampling.md, docs/validation.md).
 
 - the definition itself: a numpy transcription of the README (lobe probabilities,
   lobe choice by u0, the direction maps driven by u1, u2, the per-lobe pdfs built
   from the independent toolkit ``pb.microfacet``) against the reference;
 - consistency: the returned pdf is ``pdf()`` of the returned pair, the weight is
   ``f cos θl / pdf`` (1e-12 relative);
-- README "What is checked": ``∫ pdf()`` over the upper hemisphere equals the fraction of samples
+- docs/validation.md: ``∫ pdf()`` over the upper hemisphere equals the fraction of samples
   landing above it (within 1e-3; the fraction from 2^18 scrambled Sobol points);
-- README "What is checked": chi-square of 10^6 samples against ``pdf()`` for 44 materials x
+- docs/validation.md: chi-square of 10^6 samples against ``pdf()`` for 44 materials x
   4 view angles (visible normals) plus 12 x 4 (distribution sampling), Šidák
   over all cases;
-- README "What is checked": mean weight (importance-sampled Monte Carlo albedo) against a
+- docs/validation.md: mean weight (importance-sampled Monte Carlo albedo) against a
   quadrature of f cos θl done lobe by lobe ((θl, φl) for diffuse and sheen,
   stretched polar half vectors for the two specular lobes), itself checked
   against the adaptive cubature of tests/chi_square.py;
-- README "What is checked": no NaN or infinity, the below-horizon conventions, lobe probabilities.
+- docs/validation.md: no NaN or infinity, the below-horizon conventions, lobe probabilities.
 """
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ def half_vector(wi, wo):
 
 
 # --------------------------------------------------------------------------
-# README "Sampling and pdf", transcribed in numpy (per element: p is a dict of arrays)
+# docs/sampling.md, transcribed in numpy (per element: p is a dict of arrays)
 
 
 def mix(a, b, t):
@@ -347,7 +347,7 @@ def test_lobe_probability_is_zero_only_for_a_lobe_that_is_zero():
 
 
 # --------------------------------------------------------------------------
-# README "What is checked": ∫ pdf over the upper hemisphere = fraction of samples above it
+# docs/validation.md: ∫ pdf over the upper hemisphere = fraction of samples above it
 
 HEMISPHERE_CASES = [(name, params, theta, sampler)
                     for name, params in MATERIALS[:8] + MATERIALS[-6:]
@@ -360,7 +360,7 @@ def run_hemisphere_case(case):
     material, wo = pb.Material(**params), view(theta)
     integral = cs.integrate_cells(lambda w: pb.reference.pdf(material, w, wo, specular_sampler=sampler),
                                   peaks=[mirror(wo)], peak_width=peak_width(params, wo)).sum()
-    # 2^18 scrambled Sobol points: the fraction's error (< 2e-4 here) is far below the 1e-3 of README "What is checked"
+    # 2^18 scrambled Sobol points: the fraction's error (< 2e-4 here) is far below the 1e-3 of docs/validation.md
     u = qmc.Sobol(3, scramble=True, seed=int(seeded_rng("sobol", case_id(case)).integers(2**31))).random_base2(18)
     wi = pb.reference.sample(material, wo, u, specular_sampler=sampler).wi
     return float(integral), float(np.mean(wi[:, 2] > 0))
@@ -374,7 +374,7 @@ def test_pdf_integral_equals_fraction_of_samples_above_the_horizon(case, heavy_r
 
 
 # --------------------------------------------------------------------------
-# README "What is checked": chi-square
+# docs/validation.md: chi-square
 
 
 def run_chi_square_case(case):
@@ -401,7 +401,7 @@ def test_sampling_distribution_chi_square(case, heavy_result):
 
 
 # --------------------------------------------------------------------------
-# README "What is checked": Monte Carlo albedo (mean weight) vs quadrature
+# docs/validation.md: Monte Carlo albedo (mean weight) vs quadrature
 
 
 def gauss_legendre(order: int):
@@ -553,7 +553,7 @@ def heavy_result(request, heavy_results):
 
 
 # --------------------------------------------------------------------------
-# README "What is checked" and the below-horizon conventions (e)
+# docs/validation.md and the below-horizon conventions (e)
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -646,7 +646,7 @@ def test_end_of_unit_interval_conventions():
 
 
 # --------------------------------------------------------------------------
-# Python API: shapes, broadcasting, bad input (README "Bad input")
+# Python API: shapes, broadcasting, bad input (docs/bad-input.md)
 
 
 def test_broadcasting_matches_element_by_element():

@@ -1,9 +1,9 @@
-"""README "What is checked": the float32 SIMD kernel against the float64 reference evaluated on
+"""docs/validation.md: the float32 SIMD kernel against the float64 reference evaluated on
 the same float32 inputs, on every instruction set this machine runs, for the
 total and every lobe, both models.
 
 Error per channel: |simd - ref| / max(|ref|, 1e-6), over 10^6 random
-(material, wi, wo) triples with per-element materials across README "The model".
+(material, wi, wo) triples with per-element materials across docs/model.md, "The model".
 """
 
 import numpy as np

@@ -1,7 +1,7 @@
-"""SIMD sampling against the float64 reference: README "What is checked" bounds for pdf and
+"""SIMD sampling against the float64 reference: docs/validation.md bounds for pdf and
 weights on every instruction set (reference evaluated on the same float32
 inputs), the same sample for the same uniforms, and the chi-square test of
-README "What is checked" on the SIMD sampler with its counter-based generator."""
+docs/validation.md on the SIMD sampler with its counter-based generator."""
 
 import numpy as np
 import pytest
@@ -119,7 +119,7 @@ CHI_SQUARE_THRESHOLD = cs.sidak_threshold(len(CHI_SQUARE_CASES))
 
 @pytest.mark.parametrize("case", CHI_SQUARE_CASES, ids=lambda c: f"{c[0]}-{c[2]:g}deg")
 def test_simd_sampler_chi_square(case):
-    """README "What is checked" on pb.sample (best instruction set, counter-based generator), 10^6 samples,
+    """docs/validation.md on pb.sample (best instruction set, counter-based generator), 10^6 samples,
     expected counts from the float64 reference pdf."""
     name, params, theta = case
     material = pb.Material(**params)

@@ -1,4 +1,4 @@
-"""The portable wheel (`make wheel`, README "A portable wheel"): scripts/build-wheel.sh
+"""The portable wheel (`make wheel`, docs/installing.md, "A portable wheel"): scripts/build-wheel.sh
 builds it, auditwheel gives it a manylinux tag, its baseline code uses no
 instruction beyond x86-64's SSE2 outside the AVX2/AVX-512 kernels, and a fresh
 virtual environment that installs it (and numpy from PyPI, nothing else) imports

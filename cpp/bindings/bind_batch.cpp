@@ -20,7 +20,7 @@ namespace {
 
 using Float32Array = py::array_t<float, py::array::c_style>;
 
-// The kernels read and write whole floats only (README "Bad input":
+// The kernels read and write whole floats only (docs/bad-input.md:
 // the Python side copies a misaligned input and refuses a misaligned out=).
 template <class T>
 void require_aligned(const T* data, const char* name) {

@@ -249,7 +249,7 @@ void def_family(py::module_& sub, const std::string& prefix, bool with_sampler =
 }  // namespace
 
 void bind_microfacet(py::module_& m) {
-    py::module_ sub = m.def_submodule("microfacet", "Microfacet toolkit (README \"Microfacet toolkit\") over packed float64 rows.");
+    py::module_ sub = m.def_submodule("microfacet", "Microfacet toolkit (docs/microfacet.md) over packed float64 rows.");
     const auto closed = py::arg("closed_forms");
 
     sub.def("gtr_d", &gtr_d, py::arg("cos_theta_h"), py::arg("alpha"), py::arg("gamma"), closed);

@@ -164,7 +164,7 @@ py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, co
     return py::make_tuple(value, jacobian);
 }
 
-// README "Sampling and pdf": wo (N,3), u (N,3) = (u0, u1, u2), params (N,13); each may be one shared row.
+// docs/sampling.md: wo (N,3), u (N,3) = (u0, u1, u2), params (N,13); each may be one shared row.
 py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const Float64Array& params, int model,
                            int sampler, bool energy_compensation) {
     const py::ssize_t n = common_row_count({&wo, &u, &params});

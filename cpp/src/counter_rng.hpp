@@ -1,4 +1,4 @@
-// The counter-based random generator of README "Sampling and pdf": uniform u_k for element i
+// The counter-based random generator of docs/sampling.md: uniform u_k for element i
 // and seed s is a pure function of (s, i, k), so samples do not depend on
 // threads, chunking or SIMD width.
 //

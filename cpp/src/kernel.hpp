@@ -6,7 +6,7 @@
 // namespace name). Everything here lives in that per-arch namespace, so code
 // compiled with one instruction set's flags is never linked into another's.
 //
-// Accuracy (README "What is checked"): the half vector is kept unnormalised, H = wi + wo.
+// Accuracy (docs/validation.md): the half vector is kept unnormalised, H = wi + wo.
 // Its components are exact float sums where wi and wo nearly cancel, so
 // cos²θh = Hz²/|H|² and sin²θh = (Hx² + Hy²)/|H|² keep full relative precision
 // at the narrow GTR peaks, where 1 - cos²θh would cancel.

@@ -1,5 +1,5 @@
 // Part of kernel.hpp, included inside the per-arch namespace: the counter-based
-// uniforms of README "Sampling and pdf" (the draw itself is the model's).
+// uniforms of docs/sampling.md (the draw itself is the model's).
 #pragma once  // (per translation unit)
 
 using UInts = xsimd::batch<std::uint32_t, Arch>;

@@ -64,7 +64,7 @@ else:
 
 
 class Lobes(_LobeArrays):
-    """The lobes of f (README "The model"), in the C++ table's order: ``diffuse``
+    """The lobes of f (docs/model.md, "The model"), in the C++ table's order: ``diffuse``
     (with subsurface, times 1 - metallic), ``sheen`` (times 1 - metallic),
     ``specular``, ``clearcoat`` (grey) and ``multiple_scattering`` (the energy
     compensation's, 0 unless it is on), each shaped like :func:`eval`'s
@@ -312,7 +312,7 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     wo_flat, wo_code = wo_dirs.flat(leading)
     for output in outputs:
         _require_no_partial_overlap(output, {"wi": wi_flat, "wo": wo_flat})
-    # The check rides along with the evaluation (README "Bad input"): on a bad
+    # The check rides along with the evaluation (docs/bad-input.md): on a bad
     # direction the call raises, and an out= buffer may hold partial results.
     tolerance = DIRECTION_LENGTH_TOLERANCE if check else 0.0
     out_layout = _INTERLEAVED if layout == "aos" else _ROWS
@@ -342,7 +342,7 @@ def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mod
          cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None,
          out: Float32Array | None = None, check: bool = True, isa: str | None = None,
          energy_compensation: bool = False) -> Float32Array:
-    """f(wi, wo) in 1/sr as float32, by the SIMD kernel (README "The model").
+    """f(wi, wo) in 1/sr as float32, by the SIMD kernel (docs/model.md, "The model").
 
     ``wi``, ``wo``: unit directions, ``(..., 3)`` or with ``layout="soa"``
     ``(3, ...)``; leading shapes broadcast with each other and with the
@@ -353,7 +353,7 @@ def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mod
     a non-unit direction is then used as given and a non-finite one gives 0. ``isa``
     picks one of ``cpu_info()["available"]`` (for tests and benchmarks).
     ``energy_compensation=True`` adds the primary specular lobe's multiple
-    scattering (Kulla & Conty 2017; README "Energy compensation").
+    scattering (Kulla & Conty 2017; docs/energy-compensation.md).
     """
     (f,) = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
                      lambda leading, layout: [_output(out, _vec3_shape(leading, layout))],
@@ -403,7 +403,7 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
               out: tuple[Float32Array, Float32Array] | None = None, check: bool = True,
               isa: str | None = None, energy_compensation: bool = False) -> Gradient:
     """f and its Jacobian in the material's parameters, by the SIMD kernel in
-    float32 (README "Gradients").
+    float32 (docs/gradients.md).
 
     Returns a :class:`Gradient`: ``value`` as :func:`eval` returns it,
     ``jacobian`` ``(..., 3, P)`` (``(3, P, ...)`` for ``layout="soa"``) with
@@ -444,7 +444,7 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
         specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
         check: bool = True, isa: str | None = None, energy_compensation: bool = False) -> Float32Array:
     """The density (solid angle) with which :func:`sample` draws ``wi`` given ``wo``:
-    the lobe mixture of README "Sampling and pdf", float32 ``(...)``; 0 when
+    the lobe mixture of docs/sampling.md, float32 ``(...)``; 0 when
     either direction is at or below the horizon. It does not depend on the model
     (``model`` is checked and accepted, as every call takes it) unless
     ``energy_compensation``, whose lobe's mixture weight reads the model's tables."""
@@ -521,7 +521,7 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
            check: bool = True, isa: str | None = None, with_lobes: bool = False,
            energy_compensation: bool = False) -> Sample | tuple[Sample, Lobes]:
-    """Importance-sample ``wi`` for each ``wo`` (README "Sampling and pdf").
+    """Importance-sample ``wi`` for each ``wo`` (docs/sampling.md).
 
     ``u``: three uniforms in [0, 1] per element, ``(..., 3)`` (``(3, ...)`` for
     ``layout="soa"``), broadcast with ``wo`` and the material; without it they

@@ -169,7 +169,7 @@ def float_lanes(isa: str) -> int: ...
 # importable module): float64 rows, each argument N rows or one shared row.
 @type_check_only
 class _MicrofacetModule(ModuleType):
-    """Microfacet toolkit (README "Microfacet toolkit") over packed float64 rows."""
+    """Microfacet toolkit (docs/microfacet.md) over packed float64 rows."""
 
     @staticmethod
     def gtr_d(cos_theta_h: _Float64In, alpha: _Float64In, gamma: _Float64In, closed_forms: bool) -> NDArray[np.float64]: ...

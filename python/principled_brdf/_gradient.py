@@ -2,7 +2,7 @@
 
 The Jacobian's columns are the 13 parameter slots of the C++ table
 (``params.hpp``), in its order, with ``base_color`` expanded to
-``base_color_r``, ``base_color_g`` and ``base_color_b`` (README "Gradients").
+``base_color_r``, ``base_color_g`` and ``base_color_b`` (docs/gradients.md).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Type aliases of the package's annotations (for type checkers and editors;
 the modules import them under ``TYPE_CHECKING`` only, so nothing here runs in a call).
 
-``RealArrayLike`` is what the checks of README "Bad input" accept as numbers
+``RealArrayLike`` is what the checks of docs/bad-input.md accept as numbers
 or arrays of real numbers: Python and numpy numbers, arrays (and objects with
 ``__array__``) of bool, integer or floating dtype, and nested sequences of
 them. Unlike ``numpy.typing.ArrayLike`` it leaves out ``str``, ``bytes`` and

@@ -1,4 +1,4 @@
-"""Checks at the Python boundary (README "Bad input").
+"""Checks at the Python boundary (docs/bad-input.md).
 
 Every check names the argument and the first offending element, e.g.
 ``wi[2, 7]: length 1.2 is not 1 (within 1e-3)``.

@@ -1,5 +1,5 @@
 """principled_brdf.eval against a straightforward numpy float32 implementation
-of the model (README "The model") on the same pairs, both timed in this process (the CLI's ``bench``;
+of the model (docs/model.md, "The model") on the same pairs, both timed in this process (the CLI's ``bench``;
 ``bench/python_vs_numpy.py`` runs it too)."""
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ DEMO_MATERIAL: dict[str, Any] = dict(base_color=(0.9, 0.55, 0.25), metallic=0.3,
 PICTURE_PRESETS = ("gold", "chrome", "brushed_metal", "car_paint", "blue_rubber", "satin_cloth")
 PICTURE_RESOLUTION = 128  # pixels per sphere
 #: The metals of the picture's roughness sweep: a white one (F_avg ~ 1, the white furnace of
-#: README "Energy compensation") and gold (the lost energy is colored: Kulla & Conty 2017's F_avg term).
+#: docs/energy-compensation.md) and gold (the lost energy is colored: Kulla & Conty 2017's F_avg term).
 SWEEP_METALS = {"white metal": (0.95, 0.95, 0.95), "gold": (1.0, 0.71, 0.29)}
 SWEEP_ROUGHNESS = np.linspace(0.05, 1.0, len(PICTURE_PRESETS))
 LABEL_STRIP, ROW_GAP = 22, 4  # pixels above a row of spheres with labels, and above one without
@@ -94,7 +94,7 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
 def picture_spheres(resolution: int = PICTURE_RESOLUTION) -> tuple[list[Float32Array], list[str], list[str]]:
     """The demo picture's spheres (row by row), their labels and the row titles: the presets,
     then each of :data:`SWEEP_METALS` along :data:`SWEEP_ROUGHNESS` without and, in the row
-    below, with ``energy_compensation`` (README "Energy compensation")."""
+    below, with ``energy_compensation`` (docs/energy-compensation.md)."""
     images = [lit_sphere(presets.get(name), resolution) for name in PICTURE_PRESETS]
     labels, titles = list(PICTURE_PRESETS), ["presets"]
     for name, color in SWEEP_METALS.items():

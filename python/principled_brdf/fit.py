@@ -1,4 +1,4 @@
-"""Fitting the model to measured values of f (README "Fitting").
+"""Fitting the model to measured values of f (docs/fitting.md).
 
 Least squares (``scipy.optimize.least_squares``, trust-region reflective) on
 residuals between the model and the measurements at given direction pairs,

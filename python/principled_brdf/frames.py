@@ -1,4 +1,4 @@
-"""Directions and shading frames (README "Directions"), float64, vectorised.
+"""Directions and shading frames (docs/materials-and-directions.md), float64, vectorised.
 
 The library's directions live in a local shading frame: normal z, tangent x
 (the alpha_x axis), bitangent y. These helpers build such frames from
@@ -46,7 +46,7 @@ def frame_from_normal(normal: RealArrayLike, tangent: RealArrayLike | None = Non
     al. 2017 ("Building an Orthonormal Basis, Revisited"), continuous except
     across n.z = 0's sign change; with one, the tangent is its part
     orthogonal to the normal (Gram-Schmidt), so anisotropic materials follow it.
-    The normal passes the direction check (README "Bad input") and is then
+    The normal passes the direction check (docs/bad-input.md) and is then
     normalised, so the frames are orthonormal to float64's rounding."""
     n = _validate.directions("normal", normal)
     n = n / np.sqrt(np.sum(n * n, axis=-1, keepdims=True))

@@ -1,4 +1,4 @@
-"""The material: the 11 parameters of README "The model", each uniform or per element."""
+"""The material: the 11 parameters of docs/model.md, "The model", each uniform or per element."""
 
 from __future__ import annotations
 
@@ -39,7 +39,7 @@ PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
 
 
 class Material:
-    """Disney principled BRDF parameters (README "The model").
+    """Disney principled BRDF parameters (docs/model.md, "The model").
 
     Each parameter is a number or an array broadcastable to the directions'
     leading shape; ``base_color`` is linear RGB, shape ``(3,)`` or ``(..., 3)``.

@@ -1,4 +1,4 @@
-"""Measured BRDFs in the MERL format (Matusik et al. 2003), README "Measured data".
+"""Measured BRDFs in the MERL format (Matusik et al. 2003), docs/fitting.md.
 
 A MERL file holds three int32 dimensions (90, 90, 180) for (θh, θd, φd) and
 then three blocks (red, green, blue) of 90 · 90 · 180 float64 values, cell

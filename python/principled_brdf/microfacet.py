@@ -1,4 +1,4 @@
-"""Microfacet toolkit (README "Microfacet toolkit"), float64: GTR, anisotropic GGX with Smith masking, Beckmann,
+"""Microfacet toolkit (docs/microfacet.md), float64: GTR, anisotropic GGX with Smith masking, Beckmann,
 and the rest of the family (docs/model.md "The microfacet family"): Blinn-Phong, Student-t, exponential power.
 
 Every function takes numbers or arrays, broadcasts them numpy-style (a
@@ -9,7 +9,7 @@ tangent (``alpha_x``), ``y`` bitangent (``alpha_y``); they are checked to be of
 length 1 within 1e-3 and normalised before use. ``alpha_y`` defaults to
 ``alpha_x`` (isotropic).
 
-Domains (README "Bad input": anything else raises ``ValueError``/``TypeError`` naming the
+Domains (docs/bad-input.md: anything else raises ``ValueError``/``TypeError`` naming the
 argument and its first offending element): ``cos_theta_h`` in [-1, 1];
 uniforms ``u1``, ``u2`` in [0, 1]; GTR ``alpha`` in (0, 1] and ``gamma`` in
 (0, 1e6]; GGX, Beckmann, Student-t and exponential-power ``alpha_x``, ``alpha_y`` > 0,

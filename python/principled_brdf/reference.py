@@ -1,4 +1,4 @@
-"""The float64 reference (README "The model"): slow, plain, and the yardstick for everything else."""
+"""The float64 reference (docs/model.md, "The model"): slow, plain, and the yardstick for everything else."""
 
 from __future__ import annotations
 
@@ -85,7 +85,7 @@ def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mod
 def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
               wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014",
               cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False) -> Gradient:
-    """f in float64 and its Jacobian in the material's parameters (README "Gradients"):
+    """f in float64 and its Jacobian in the material's parameters (docs/gradients.md):
     ``value`` ``(..., 3)`` as :func:`eval`, ``jacobian`` ``(..., 3, P)`` with
     ``jacobian[..., c, k] = ∂f_c/∂names[k]``, ``names`` the P parameters ``wrt``
     selects (default all 13, ``base_color`` as three channels). A uniform
@@ -122,11 +122,11 @@ def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, mode
 
 
 # --------------------------------------------------------------------------
-# sampling (README "Sampling and pdf")
+# sampling (docs/sampling.md)
 
 
 def _uniforms(name: str, value: RealArrayLike) -> Float64Array:
-    """A float64 ``(..., 3)`` array of numbers in [0, 1], checked (README "Bad input")."""
+    """A float64 ``(..., 3)`` array of numbers in [0, 1], checked (docs/bad-input.md)."""
     array = _validate.as_real_array(name, value)
     if array.ndim == 0 or array.shape[-1] != 3:
         raise ValueError(f"{name}: expected shape (..., 3) with (u0, u1, u2) on the last axis, got {array.shape}")
@@ -162,7 +162,7 @@ def _check_material(material: object) -> None:
 def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos",
            energy_compensation: bool = False) -> Sample:
-    """Draws ``wi`` for each ``wo`` from the three-lobe mixture of README "Sampling and pdf".
+    """Draws ``wi`` for each ``wo`` from the three-lobe mixture of docs/sampling.md.
 
     ``u`` holds three uniforms in [0, 1] per element, ``(u0, u1, u2)`` on the last
     axis: ``u0`` chooses the lobe, ``u1, u2`` the direction. ``material``, ``wo``
@@ -216,7 +216,7 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
 def lobe_probabilities(material: Material, wo: RealArrayLike, *, model: Model = "disney2014",
                        energy_compensation: bool = False) -> Float64Array:
     """``(P0, P1, P2)`` on the last axis, ``(..., 3)``: the chances of the cosine, primary
-    specular and clearcoat lobes at ``wo`` (README "Lobe probabilities"); with
+    specular and clearcoat lobes at ``wo`` (docs/sampling.md); with
     ``energy_compensation`` the cosine lobe's includes the multiple-scattering lobe's."""
     _check_material(material)
     model_id = _validate.model_index(model)

@@ -61,7 +61,7 @@ inline bool uniform_material(const ParamSlot* params) {
     return true;
 }
 
-// The direction check of README "Bad input": a direction w passes when
+// The direction check of docs/bad-input.md: a direction w passes when
 //     (1 - tolerance)² <= wx² + wy² + wz² <= (1 + tolerance)²,
 // the squares and sums taken in float64 in this order. The squares of floats
 // are exact in float64, so the result does not depend on contraction into

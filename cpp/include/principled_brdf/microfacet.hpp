@@ -1,4 +1,4 @@
-// Microfacet toolkit in float64 (README "Microfacet toolkit"): the GTR family of
+// Microfacet toolkit in float64 (docs/microfacet.md): the GTR family of
 // Burley 2012 (appendix B), anisotropic GGX with Smith masking, and anisotropic
 // Beckmann (Walter et al. 2007; its Smith Λ as in Heitz 2014). The
 // distributions are the model's types (model/distributions.hpp: Ggx, Gtr1,
@@ -221,7 +221,7 @@ inline double ggx_lambda(const Vec3& w, double alpha_x, double alpha_y) {
 // G1 = 1 / (1 + Λ) = 2 |wz| / (|wz| + sqrt(wz² + p²)); 0 at grazing.
 inline double ggx_g1(const Vec3& w, double alpha_x, double alpha_y) { return ggx_of(alpha_x, alpha_y).g1(upper(w)); }
 
-// G1(w) / |wz| = 2 / (|wz| + sqrt(wz² + p²)): finite at grazing (it is 2 S(w) of README "The model").
+// G1(w) / |wz| = 2 / (|wz| + sqrt(wz² + p²)): finite at grazing (it is 2 S(w) of docs/model.md, "The model").
 inline double ggx_g1_over_cos(const Vec3& w, double alpha_x, double alpha_y) {
     return 2.0 / ggx_of(alpha_x, alpha_y).smith_denominator(upper(w));
 }

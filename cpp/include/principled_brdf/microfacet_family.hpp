@@ -1,4 +1,4 @@
-// The float64 toolkit of the microfacet family (README "Microfacet toolkit",
+// The float64 toolkit of the microfacet family (docs/microfacet.md,
 // docs/model.md "The microfacet family"): Student-t, exponential power,
 // Blinn-Phong and Beckmann with Walter's rational Λ, each the model's type
 // (model/distribution_family.hpp) instantiated for double, with the

@@ -1,4 +1,4 @@
-// The 11 parameters of README "The model": names, defaults, domains.
+// The 11 parameters of docs/model.md, "The model": names, defaults, domains.
 // Shared by the reference, the batch layer and (through the bindings) Python,
 // so the table exists exactly once.
 #pragma once
@@ -61,7 +61,7 @@ constexpr double default_of(Param slot) {
     return 0.0;
 }
 
-// Which specular masking term the model uses (README "The model"); the names
+// Which specular masking term the model uses (docs/model.md, "The model"); the names
 // are the Python ones, in the enum's order.
 enum class Model : int {
     kDisney2014 = 0,  // anisotropic Smith GGX with the material's alpha_x, alpha_y
@@ -77,7 +77,7 @@ inline constexpr int kLobeCount = static_cast<int>(kLobeNames.size());
 // The lobes sampling draws from, by the index a sample reports.
 inline constexpr std::array<const char*, 3> kSampledLobeNames{"cosine", "specular", "clearcoat"};
 
-// How the primary specular lobe draws its half vector (README "Sampling and pdf").
+// How the primary specular lobe draws its half vector (docs/sampling.md).
 enum class SpecularSampler : int {
     kVisibleNormals = 0,  // Dupuy & Benyoub 2023 spherical caps; pdf G1(wo) Ds / (4 cos θv)
     kDistribution = 1,    // Burley 2012 eq. 14-15; pdf Ds cos θh / (4 cos θd)

@@ -20,7 +20,7 @@ namespace principled_brdf::reference {
 using namespace principled_brdf::f64;  // the model's parts for double
 using Eigen::Vector3d;
 
-// The parameters of README "The model", with their defaults.
+// The parameters of docs/model.md, "The model", with their defaults.
 struct Material {
     Vector3d base_color{default_of(kBaseColorR), default_of(kBaseColorG), default_of(kBaseColorB)};
     double metallic = default_of(kMetallic);
@@ -161,7 +161,7 @@ inline Vector3d eval(const Material& m, const Vector3d& wi, const Vector3d& wo, 
     return eval(m.shading(), wi, wo, model);
 }
 
-// f and its Jacobian ∂f_c/∂p over the 13 parameter slots (README "Gradients"); both zero
+// f and its Jacobian ∂f_c/∂p over the 13 parameter slots (docs/gradients.md); both zero
 // unless wi and wo lie strictly above the surface.
 struct Gradient {
     Vector3d value = Vector3d::Zero();
@@ -191,7 +191,7 @@ inline Gradient eval_grad(const Material& m, const Vector3d& wi, const Vector3d&
     return eval_grad(gradient_shading_of(m.slots().data()), wi, wo, model);
 }
 
-// ---------------------------------------------------------------- sampling (README "Sampling and pdf")
+// ---------------------------------------------------------------- sampling (docs/sampling.md)
 
 // P_k = w_k / (w0 + w1 + w2) at wo: the chances of the cosine, specular and clearcoat lobes.
 inline std::array<double, 3> lobe_probabilities(const Shading<double>& s, const Vector3d& wo) {

@@ -2,7 +2,7 @@
 // to the 13 parameter slots (params.hpp order, base color expanded), over a
 // number type F, written by hand beside the parts they differentiate.
 //
-// f is linear in most parameters (README "The model"): per channel c,
+// f is linear in most parameters (docs/model.md, "The model"): per channel c,
 //   f_c = D dc_c + FH sc_c + T f0_c + (S FH + C),   T = S (1 - FH),
 // with the material's colors dc (diffuse), sc (sheen), f0 (Cspec0) and the
 // scalars of the pair: D (diffuse, from roughness and subsurface), FH,

@@ -6,7 +6,7 @@
 #pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // What the lobes read of a pair (wi, wo): the half vector H = wi + wo kept
-// unnormalised (README "The model", numerics).
+// unnormalised (docs/model.md, "The model", numerics).
 template <class F>
 struct Geometry : HalfVector<F> {
     Vec3<F> wi, wo;
@@ -19,7 +19,7 @@ struct Geometry : HalfVector<F> {
 // |wi|² + |wo|² <= 8 (a unit vector beside one of length up to √7), and gives
 // f = 0 beyond: within it every term of the model stays finite in float32 for
 // parameters within the kernels' range (Fd90 grows with |H|², the distributions
-// with |H|⁴ / |H|² ratios), beyond it they need not (README "Bad input").
+// with |H|⁴ / |H|² ratios), beyond it they need not (docs/bad-input.md).
 inline constexpr double kLargestDirectionsLength2 = 8.0;
 
 template <class F>

@@ -1,7 +1,7 @@
 // Part of the model (docs/model.md): the principled BRDF as the composition of
 // its lobes, over a number type F: the material's constants, f and its lobes,
 // the sampling mixture's weights and density, the lobe choice, the draw of wi
-// and the weight of a drawn sample (README "The model", "Sampling and pdf").
+// and the weight of a drawn sample (docs/model.md, "The model"; docs/sampling.md).
 #pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // Everything the lobes need of a material, independent of the directions.
@@ -218,7 +218,7 @@ struct Direction {
 };
 
 // wi for the chosen lobes. Each lobe draws a point at azimuth φ = 2π u1 about
-// a centre and stretches it (README "Sampling and pdf"):
+// a centre and stretches it (docs/sampling.md):
 //   m = (sinθ cos φ + c.x, sinθ sin φ + c.y, cosθ + c.z),  d = (sx m.x, sy m.y, m.z)
 // cosine lobe:  sin²θ = u2, c = 0, s = 1, wi = d
 // clearcoat:    sin²θ of the GTR1 draw, c = 0, s = 1, h ∝ d

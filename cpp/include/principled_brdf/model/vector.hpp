@@ -66,7 +66,7 @@ PB_MODEL_INLINE F luminance_of(const Rgb<F>& c) { return mul_add(F(0.3), c.r, mu
 // luminance; 1 where Cdlum is below float32's smallest normal number 2^-126
 // (1/Cdlum would overflow float32 there, and a subnormal color is black to
 // any renderer). The float64 instantiation applies the same threshold, so
-// the two agree (README "The model").
+// the two agree (docs/model.md, "The model").
 inline constexpr double kSmallestTintedLuminance = 0x1p-126;
 
 template <class F>
