@@ -1,0 +1,145 @@
+"""Bad input at the entry points beyond the kernels: pb.fit, MERL files, the explorer and the
+command line. Each call returns a finite, fully written result or raises a ValueError/TypeError
+naming the argument (README "Bad input"); each test here failed before its fix."""
+
+from __future__ import annotations
+
+import os
+import threading
+
+import numpy as np
+import pytest
+
+import principled_brdf as pb
+from conftest import random_direction_pairs, seeded_rng
+
+
+def pairs(n, key="bad-entry"):
+    return random_direction_pairs(seeded_rng(key), n, min_cos=0.05)
+
+
+# ---------------------------------------------------------------------------------------------
+# pb.fit
+
+
+def test_fit_a_batch_with_a_problem_without_data_fits_the_others():
+    wi, wo = pairs(400)
+    truth = pb.Material(base_color=(0.6, 0.3, 0.2), roughness=0.4)
+    measured = pb.reference.eval(truth, wi, wo)
+    batch = np.stack([measured, np.full_like(measured, np.nan), measured])
+    start = dict(roughness=0.7)
+    result = pb.fit(wi, wo, batch, init=start, fit=["base_color", "roughness"])
+    assert list(result.success) == [True, False, True]
+    assert result.message[1].startswith("no data")
+    assert result.cost[1] == 0.0 and result.iterations[1] == 0 and np.isnan(result.residuals[1]).all()
+    np.testing.assert_array_equal(result.slots[1], np.asarray(pb.Material(**start).packed(()), float).reshape(-1))
+    np.testing.assert_allclose(result.material.roughness[[0, 2]], 0.4, atol=1e-4)
+    assert np.isfinite(result.slots).all() and np.isfinite(result.cost).all()
+    single = pb.fit(wi, wo, np.full_like(measured, np.nan), fit=["roughness"])  # one problem, no data
+    assert not single.success and single.message.startswith("no data") and single.cost == 0.0
+
+
+@pytest.mark.parametrize("loss", ["relative", "log", "linear"])
+def test_fit_a_black_texel_is_as_dark_as_the_model_allows(loss):
+    wi, wo = pairs(400, "bad-entry-black")
+    measured = pb.reference.eval(pb.Material(roughness=0.3), wi, wo)
+    batch = np.stack([np.zeros_like(measured), measured])
+    result = pb.fit(wi, wo, batch, loss=loss, fit=["base_color", "roughness", "specular", "metallic"])
+    assert result.success.all() and np.isfinite(result.cost).all() and np.isfinite(result.residuals).all()
+    black = pb.reference.eval(result.material.replace(**{k: np.asarray(getattr(result.material, k))[0]
+                                                        for k in pb.PARAMETERS}), wi, wo)
+    facing = (wi[:, 2] > 0.5) & (wo[:, 2] > 0.5)  # away from grazing, where Schlick's Fresnel keeps some specular
+    assert black[facing].max() < 0.02 * measured[facing].mean()
+    assert np.all(result.material.base_color[0] < 1e-3)
+    np.testing.assert_allclose(result.material.roughness[1], 0.3, atol=1e-3)
+
+
+@pytest.mark.parametrize("bounds, error, match", [
+    ({"roughness": 0.3}, TypeError, r"bounds\['roughness'\]: expected a \(lower, upper\) pair"),
+    ({"roughness": (0.1, 0.2, 0.3)}, ValueError, r"bounds\['roughness'\]: expected a \(lower, upper\) pair"),
+    ({"roughness": ("a", "b")}, TypeError, r"bounds\['roughness'\]"),
+    ({"roughness": (None, 1.0)}, TypeError, r"bounds\['roughness'\]"),
+    ({"roughness": (float("nan"), 0.5)}, ValueError, r"bounds\['roughness'\].*NaN"),
+    ({"roughness": (0.6, 0.5)}, ValueError, r"bounds\['roughness'\]"),
+    ([("roughness", (0.0, 1.0))], TypeError, "bounds: expected a mapping"),
+])
+def test_fit_malformed_bounds_name_bounds(bounds, error, match):
+    wi, wo = pairs(50)
+    with pytest.raises(error, match=match):
+        pb.fit(wi, wo, pb.reference.eval(pb.Material(), wi, wo), bounds=bounds)
+
+
+def test_fit_equal_bounds_hold_the_parameter():
+    wi, wo = pairs(400)
+    truth = pb.Material(base_color=(0.6, 0.3, 0.2), roughness=0.4, metallic=0.3)
+    measured = pb.reference.eval(truth, wi, wo)
+    result = pb.fit(wi, wo, measured, init=dict(base_color=(0.6, 0.3, 0.2), metallic=0.6), fit=["roughness", "metallic"],
+                    bounds={"roughness": (0.4, 0.4)})
+    assert result.success and result.names == ("metallic",)
+    assert result.material.roughness == 0.4 and result.material.metallic == pytest.approx(0.3, abs=1e-4)
+    held = pb.fit(wi, wo, measured, fit=["roughness"], bounds={"roughness": (0.25, 0.25)})  # nothing left to fit
+    assert held.success and held.names == () and held.material.roughness == 0.25 and held.iterations == 0
+    assert held.message.startswith("nothing to fit") and np.isfinite(held.cost) and held.cost > 0
+
+
+@pytest.mark.parametrize("value, error", [(0, ValueError), (-3, ValueError), (1.5, TypeError), (True, TypeError)])
+def test_fit_max_iterations_is_a_positive_integer(value, error):
+    wi, wo = pairs(50)
+    with pytest.raises(error, match="max_iterations"):
+        pb.fit(wi, wo, pb.reference.eval(pb.Material(), wi, wo), max_iterations=value)
+
+
+@pytest.mark.parametrize("shape", [(7,), (50, 3), (2, 50), (1, 50, 1)])
+def test_fit_wrongly_shaped_weights_name_weights(shape):
+    wi, wo = pairs(50)
+    with pytest.raises(ValueError, match=r"weights: expected shape \(50,\)"):
+        pb.fit(wi, wo, pb.reference.eval(pb.Material(), wi, wo), weights=np.ones(shape))
+
+
+def test_concurrent_fits_restore_the_blas_threads(monkeypatch):
+    """Two fits that overlap, the first one in leaving first: the BLAS limit afterwards is the one before."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    import scipy.optimize
+
+    def blas_threads():
+        return [info["num_threads"] for info in threadpoolctl.threadpool_info() if info["user_api"] == "blas"]
+
+    if not blas_threads():
+        pytest.skip("no BLAS that threadpoolctl controls")
+    wi, wo = pairs(200)
+    measured = pb.reference.eval(pb.Material(roughness=0.3), wi, wo)
+    original = scipy.optimize.least_squares
+    first_inside, second_inside, first_done = threading.Event(), threading.Event(), threading.Event()
+    errors = []
+
+    def least_squares(*args, **kwargs):  # runs inside the fit's BLAS limit
+        if threading.current_thread().name == "first":
+            first_inside.set()
+            assert second_inside.wait(60)
+        else:
+            second_inside.set()
+            assert first_done.wait(60)
+        return original(*args, **kwargs)
+
+    def run(name):
+        try:
+            pb.fit(wi, wo, measured, fit=["roughness"], max_iterations=5)
+        except BaseException as error:  # reported below
+            errors.append(error)
+        finally:
+            if name == "first":
+                first_done.set()
+
+    monkeypatch.setattr(scipy.optimize, "least_squares", least_squares)
+    before = blas_threads()
+    if max(before) < 2:
+        pytest.skip("BLAS runs on one thread already")
+    first = threading.Thread(target=run, args=("first",), name="first")
+    first.start()
+    assert first_inside.wait(60)
+    second = threading.Thread(target=run, args=("second",), name="second")
+    second.start()
+    first.join(60)
+    second.join(60)
+    assert not errors, errors
+    assert blas_threads() == before
