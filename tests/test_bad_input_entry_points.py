@@ -143,3 +143,48 @@ def test_concurrent_fits_restore_the_blas_threads(monkeypatch):
     second.join(60)
     assert not errors, errors
     assert blas_threads() == before
+
+
+# ---------------------------------------------------------------------------------------------
+# MERL files
+
+MERL_CELLS = 90 * 90 * 180
+
+
+def write_merl(path, stored):
+    with open(path, "wb") as f:
+        np.asarray((90, 90, 180), dtype="<i4").tofile(f)
+        np.asarray(stored, dtype="<f8").tofile(f)
+
+
+def test_load_merl_from_a_file_descriptor_leaves_it_open(tmp_path):
+    stored = np.full((3, 90, 90, 180), 1500.0)
+    stored[1, 2, 3, 4] = -1.0  # no data
+    path = tmp_path / "grey.binary"
+    write_merl(path, stored)
+    descriptor = os.open(path, os.O_RDONLY)
+    try:
+        table = pb.measured.load_merl(descriptor)
+        os.fstat(descriptor)  # still open: an OSError (EBADF) otherwise
+        assert os.lseek(descriptor, 0, os.SEEK_CUR) == path.stat().st_size
+    finally:
+        os.close(descriptor)
+    assert np.isnan(table.table[1, 2, 3, 4]) and table.table[0, 0, 0, 0] == 1.0
+    np.testing.assert_array_equal(pb.measured.load_merl(str(path)).table, table.table, strict=True)
+
+
+@pytest.mark.parametrize("value", [np.inf, -np.inf, np.nan])
+def test_load_merl_refuses_stored_values_that_are_not_finite(tmp_path, value):
+    stored = np.full((3, 90, 90, 180), 1500.0)
+    stored[2, 10, 20, 30] = value
+    stored[0, 0, 0, 0] = -1.0  # no data, which is fine
+    path = tmp_path / "bad.binary"
+    write_merl(path, stored)
+    with pytest.raises(ValueError, match=r"bad\.binary: channel 2 \(blue\), cell \(θh 10, θd 20, φd 30\).*not finite"):
+        pb.measured.load_merl(path)
+
+
+@pytest.mark.parametrize("path", [1.5, True, None, ["x.binary"]])
+def test_load_merl_path_of_the_wrong_type(path):
+    with pytest.raises(TypeError, match="path: expected a path or an open file descriptor"):
+        pb.measured.load_merl(path)
