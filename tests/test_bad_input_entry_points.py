@@ -188,3 +188,64 @@ def test_load_merl_refuses_stored_values_that_are_not_finite(tmp_path, value):
 def test_load_merl_path_of_the_wrong_type(path):
     with pytest.raises(TypeError, match="path: expected a path or an open file descriptor"):
         pb.measured.load_merl(path)
+
+
+# ---------------------------------------------------------------------------------------------
+# The explorer
+
+
+@pytest.fixture(scope="module")
+def explorer():
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    pytest.importorskip("ipywidgets")
+    ex = pb.explorer(resolution=32)
+    yield ex
+    ex.close()
+
+
+@pytest.mark.parametrize("control", ["roughness", "light_theta", "view_phi", "exposure"])
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), -float("inf")])
+def test_explorer_refuses_values_that_are_not_finite_and_keeps_working(explorer, control, value):
+    import traitlets
+
+    explorer.reset()
+    slider = explorer.sliders[control] if control in explorer.sliders else getattr(explorer, control)
+    kept = slider.value
+    with pytest.raises(ValueError, match=f"{control}: {value!r} is not a finite number") as error:
+        slider.value = value
+    assert isinstance(error.value, traitlets.TraitError)  # as the widgets' own refusals
+    assert slider.value == kept
+    before = explorer.images["sphere"].value
+    explorer.sliders["metallic"].value = 0.9  # later changes draw as before
+    assert explorer.images["sphere"].value != before
+    assert explorer.material.metallic == 0.9
+
+
+def test_explorer_refuses_values_beyond_what_the_pictures_take(explorer):
+    explorer.reset()
+    explorer.exposure.max = 1e6  # a wider range than the explorer's
+    with pytest.raises(ValueError, match="exposure: 1000.0 is beyond 64"):
+        explorer.exposure.value = 1e3
+    explorer.sliders["specular"].max = 1e30
+    with pytest.raises(ValueError, match="specular: 1e\\+30 is beyond 1e\\+20"):
+        explorer.sliders["specular"].value = 1e30
+    with pytest.raises(ValueError, match="material: specular"):
+        explorer.set_material(pb.Material(specular=1e21))
+    explorer.reset()
+    assert explorer.refresh() == {} and explorer.material == pb.Material()
+
+
+def test_explorer_after_close_ignores_changes():
+    pytest.importorskip("matplotlib").use("Agg")
+    pytest.importorskip("ipywidgets")
+    ex = pb.explorer(resolution=16)
+    ex.close()
+    ex.sliders["roughness"].value = 0.9  # was a KeyError from the dropped figures
+    ex.base_color.value = "#ff0000"
+    ex.preset.value = "gold"
+    ex.light_theta.value = 10.0
+    assert ex.refresh() == {}
+    ex.set_material("chrome")
+    ex.reset()
+    ex.close()  # twice: nothing more
