@@ -249,3 +249,99 @@ def test_explorer_after_close_ignores_changes():
     ex.set_material("chrome")
     ex.reset()
     ex.close()  # twice: nothing more
+
+
+# ---------------------------------------------------------------------------------------------
+# The command line and pb.render
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """The jobs themselves fail the test: a refused option never starts one (nor hangs the test)."""
+    import principled_brdf.benchmark
+    import principled_brdf.demo
+
+    def job(*args, **kwargs):
+        raise AssertionError("the job started")
+
+    monkeypatch.setattr(pb.render, "render_sphere", job)
+    monkeypatch.setattr(pb.render, "_sample", job)
+    monkeypatch.setattr(principled_brdf.demo, "run", job)
+    monkeypatch.setattr(principled_brdf.benchmark, "compare_with_numpy", job)
+
+
+def exit_status(capsys, args):
+    from principled_brdf.cli import main
+
+    try:
+        status = main(args)
+    except SystemExit as stop:  # argparse's errors
+        status = stop.code
+    return status, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, option, message", [
+    (["render", "--samples", "65536", "--resolution", "1024"], "--samples", "at most 16384 per pixel"),
+    (["render", "--samples", "65537"], "--samples", "at most 65536 samples per pixel"),
+    (["render", "--samples", "0"], "--samples", "positive integer"),
+    (["render", "--resolution", "1"], "--resolution", "at least 2 pixels"),
+    (["render", "--exposure", "1e300"], "--exposure", "at most 1e+20"),
+    (["render", "--param", "roughness=1e5"], "--param", "roughness: 100000.0 is beyond 10000"),
+    (["render", "--param", "specular=1e30"], "--param", "specular: 1e+30 is beyond 1e+20"),
+    (["demo", "--repeats", "100000000"], "--repeats", "at most 100 repeats"),
+    (["bench", "--repeats", "101"], "--repeats", "at most 100 repeats"),
+    (["bench", "--repeats", "1e8"], "--repeats", "positive integer"),
+    (["demo", "--pairs", str(1 << 27), "--repeats", "17"], "--repeats", "at most 16 repeats"),
+])
+def test_cli_numeric_options_are_bounded(capsys, tmp_path, no_work, args, option, message):
+    output = tmp_path / "x.png"
+    status, err = exit_status(capsys, args + (["--output", str(output)] if args[0] == "render" else []))
+    assert status == 2
+    lines = [line for line in err.splitlines() if line.strip() and not line.startswith(("usage:", " "))]
+    assert len(lines) == 1 and "error" in lines[0] and option in lines[0] and message in lines[0], err
+    assert not output.exists()
+
+
+def test_cli_light_of_extreme_magnitude_is_a_direction(capsys, tmp_path):
+    for light in ("1e308,1e308,1e308", "5e-324,5e-324,5e-324"):
+        output = tmp_path / "x.npy"
+        status, err = exit_status(capsys, ["render", "--light", light, "--resolution", "8", "--samples", "2",
+                                           "--output", str(output)])
+        assert status == 0, err
+        expected = pb.render.render_sphere(pb.Material(), 8, light=(1.0, 1.0, 1.0), samples=2)
+        np.testing.assert_array_equal(np.load(output), expected)
+
+
+@pytest.mark.parametrize("kwargs, error, match", [
+    (dict(resolution=1024, samples=65536), ValueError, "samples: 65536 per pixel over 1048576 pixels"),
+    (dict(resolution=64, samples=1 << 17), ValueError, "samples: expected 1 to 65536"),
+    (dict(resolution=64, samples=0), ValueError, "samples: expected 1 to 65536"),
+    (dict(resolution=64, samples=-5, environment=None), ValueError, "samples: expected 1 to 65536"),
+    (dict(resolution=64, samples=8.0), TypeError, "samples: expected an integer"),
+])
+def test_render_refuses_unbounded_samples(monkeypatch, kwargs, error, match):
+    def sample(*args, **kwargs):  # the refused job would start here: fail now rather than run for hours
+        raise AssertionError("the job started")
+
+    monkeypatch.setattr(pb.render, "_sample", sample)
+    with pytest.raises(error, match=match):
+        pb.render.render_sphere(pb.Material(), **kwargs)
+    if "environment" not in kwargs:
+        with pytest.raises(error, match=match):
+            pb.render.render_environment(pb.Material(), kwargs["resolution"], samples=kwargs["samples"])
+
+
+def test_render_counts_every_sphere_of_a_batch(monkeypatch):
+    def job(*args, **kwargs):
+        raise AssertionError("the job started")
+
+    monkeypatch.setattr(pb.render, "sphere_frames", job)
+    batch = pb.Material(roughness=np.full((1 << 12, 1, 1), 0.5))  # 4096 spheres of 2048² pixels: 2^34 pixels
+    with pytest.raises(ValueError, match="samples: 2 per pixel over 17179869184 pixels"):
+        pb.render.render_sphere(batch, 2048, samples=2)
+
+
+def test_render_light_of_extreme_magnitude():
+    expected = pb.render.render_sphere(pb.Material(), 8, light=(1.0, 1.0, 1.0), samples=2)
+    for light in ((1e308, 1e308, 1e308), (5e-324, 5e-324, 5e-324)):
+        np.testing.assert_array_equal(pb.render.render_sphere(pb.Material(), 8, light=light, samples=2), expected)
