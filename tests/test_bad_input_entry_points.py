@@ -73,8 +73,8 @@ def test_fit_equal_bounds_hold_the_parameter():
     wi, wo = pairs(400)
     truth = pb.Material(base_color=(0.6, 0.3, 0.2), roughness=0.4, metallic=0.3)
     measured = pb.reference.eval(truth, wi, wo)
-    result = pb.fit(wi, wo, measured, init=dict(base_color=(0.6, 0.3, 0.2), metallic=0.6), fit=["roughness", "metallic"],
-                    bounds={"roughness": (0.4, 0.4)})
+    result = pb.fit(wi, wo, measured, init=dict(base_color=(0.6, 0.3, 0.2), metallic=0.6),
+                    fit=["roughness", "metallic"], bounds={"roughness": (0.4, 0.4)})
     assert result.success and result.names == ("metallic",)
     assert result.material.roughness == 0.4 and result.material.metallic == pytest.approx(0.3, abs=1e-4)
     held = pb.fit(wi, wo, measured, fit=["roughness"], bounds={"roughness": (0.25, 0.25)})  # nothing left to fit
@@ -180,7 +180,8 @@ def test_load_merl_refuses_stored_values_that_are_not_finite(tmp_path, value):
     stored[0, 0, 0, 0] = -1.0  # no data, which is fine
     path = tmp_path / "bad.binary"
     write_merl(path, stored)
-    with pytest.raises(ValueError, match=r"bad\.binary: channel 2 \(blue\), cell \(θh 10, θd 20, φd 30\).*not finite"):
+    cell = r"bad\.binary: channel 2 \(blue\), cell \(θh 10, θd 20, φd 30\)"
+    with pytest.raises(ValueError, match=cell + ".*not finite"):
         pb.measured.load_merl(path)
 
 

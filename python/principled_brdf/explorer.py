@@ -135,7 +135,9 @@ def _slider_class(widgets: ModuleType) -> type[Any]:
     class RefusedValue(traitlets.TraitError, ValueError):
         """A value a slider of the explorer does not take."""
 
-    class Slider(widgets.FloatSlider):  # type: ignore[misc]  # ipywidgets is untyped
+    float_slider: Any = widgets.FloatSlider  # (ipywidgets is untyped)
+
+    class Slider(float_slider):  # type: ignore[misc]  # a subclass of Any
         name = ""  # what errors call it (not a trait)
         limit = math.inf
 

@@ -180,7 +180,7 @@ def load_merl(path: str | bytes | os.PathLike[str] | int) -> MerlBRDF:
         raise TypeError(f"path: expected a path or an open file descriptor (int), got {type(path).__name__}")
     where = f"file descriptor {path}" if isinstance(path, int) else os.fsdecode(path)
     descriptor = isinstance(path, int)
-    size = os.fstat(path).st_size if descriptor else os.path.getsize(path)
+    size = os.fstat(path).st_size if isinstance(path, int) else os.path.getsize(path)
     with open(path, "rb", closefd=not descriptor) as f:
         start = f.tell() if descriptor and f.seekable() else 0
         header = np.frombuffer(f.read(_HEADER_BYTES), dtype="<i4")
@@ -198,7 +198,8 @@ def load_merl(path: str | bytes | os.PathLike[str] | int) -> MerlBRDF:
     bad = ~np.isfinite(stored)
     if bad.any():
         channel, i_h, i_d, i_p = (int(i) for i in np.unravel_index(int(np.argmax(bad)), stored.shape))
-        raise ValueError(f"{where}: channel {channel} ({('red', 'green', 'blue')[channel]}), cell (θh {i_h}, θd {i_d}, "
+        colour = ("red", "green", "blue")[channel]
+        raise ValueError(f"{where}: channel {channel} ({colour}), cell (θh {i_h}, θd {i_d}, "
                          f"φd {i_p}): stored value {float(stored[channel, i_h, i_d, i_p])!r} is not finite "
                          "(a negative value marks a cell without data)")
     table = stored * MERL_SCALE[:, None, None, None]
