@@ -346,3 +346,17 @@ def test_render_light_of_extreme_magnitude():
     expected = pb.render.render_sphere(pb.Material(), 8, light=(1.0, 1.0, 1.0), samples=2)
     for light in ((1e308, 1e308, 1e308), (5e-324, 5e-324, 5e-324)):
         np.testing.assert_array_equal(pb.render.render_sphere(pb.Material(), 8, light=light, samples=2), expected)
+
+
+@pytest.mark.parametrize("change, match", [
+    (dict(weights=np.r_[np.ones(10), 1e300, np.ones(39)]), r"weights\[10\]: 1e\+300 is not a weight"),
+    (dict(weights=np.r_[np.ones(3), np.nan, np.ones(46)]), r"weights\[3\]: nan is not a weight"),
+    (dict(weights=np.r_[np.ones(3), -1.0, np.ones(46)]), r"weights\[3\]: -1.0 is not a weight"),
+    (dict(scale=1e300), r"measured\[0, 0\]: .* is beyond 3.402823e\+38"),
+])
+def test_fit_values_whose_squares_overflow_are_refused(change, match):
+    """The cost (half the sum of weighted squared residuals) of these was inf."""
+    wi, wo = pairs(50)
+    measured = pb.reference.eval(pb.Material(), wi, wo) * change.pop("scale", 1.0)
+    with pytest.raises(ValueError, match=match):
+        pb.fit(wi, wo, measured, loss="linear", **change)

@@ -43,6 +43,7 @@ LOSSES = ("log", "relative", "linear")
 # the absolute floor keeps a black problem (every m = 0) finite; it then fits f towards 0.
 _RELATIVE_FLOOR_FRACTION = 1e-3
 _RELATIVE_FLOOR = 1e-9
+_MAX_WEIGHT = 1e30  # weights times squared residuals (at most ~1e95) stay finite
 _NO_DATA = "no data: every sample of this problem is missing (NaN); the result is the start"
 _NOTHING_FITTED = "nothing to fit: every parameter in fit is held by equal bounds; the result is the start"
 
@@ -202,7 +203,8 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     ``wi``, ``wo``: unit directions ``(N, 3)``; ``measured``: ``(N, 3)``, or
     ``(B, N, 3)`` for B independent problems (one material per row, e.g. the
     texels of a texture; ``wi``, ``wo`` may then be ``(B, N, 3)`` too). NaN
-    marks a missing sample. ``init``: the start (a uniform Material or a dict;
+    marks a missing sample; values beyond float32's range are refused (no
+    material reaches them). ``init``: the start (a uniform Material or a dict;
     default ``Material()``), which also holds the parameters not in ``fit``
     (names; default all, ``base_color`` as three channels).
     ``loss``: ``"log"`` (``log(1 + f c) - log(1 + m c)``, c = cos θl if
@@ -210,7 +212,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     ``"relative"`` (``(f - m) / max(m, 1e-3 max m, 1e-9)``, max m over the
     problem's samples: the floors keep zero measurements finite, and a black
     problem, every m = 0, fits f towards 0) or ``"linear"`` (``(f - m) c``).
-    ``weights`` ``(N,)`` or ``(B, N)`` (finite, >= 0) scale each pair's squared
+    ``weights`` ``(N,)`` or ``(B, N)`` (0 to 1e30) scale each pair's squared
     residuals. ``bounds``: ``{name: (lower, upper)}`` over :data:`FIT_BOUNDS`
     (the domains, with the unbounded parameters held to [0, 1]); a parameter
     whose bounds are equal is held at that value (it is not fitted, nor listed
@@ -243,6 +245,11 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     finite_or_missing = np.isfinite(measured) | np.isnan(measured)
     if not finite_or_missing.all() or np.any(measured < 0):
         raise ValueError("measured: values must be finite and >= 0 (NaN marks a missing sample)")
+    huge = measured > _validate.FLOAT32_MAX  # (NaN is not)
+    if huge.any():
+        i = _validate.first_true(huge)
+        raise ValueError(f"{_validate.element_name('measured', i, measured.shape)}: {float(measured.ravel()[i])!r} "
+                         f"is beyond {_validate.FLOAT32_MAX:.7g}, the most the model reaches")
     batched = measured.ndim == 3
     problems = measured if batched else measured[None]
     wi = np.asarray(_validate.directions("wi", wi), dtype=np.float64)
@@ -259,9 +266,12 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
         if weights.shape not in allowed:
             raise ValueError(f"weights: expected shape {' or '.join(str(a) for a in allowed)} (one per pair), "
                              f"got {weights.shape}")
+        bad = ~((weights >= 0.0) & (weights <= _MAX_WEIGHT))
+        if bad.any():
+            i = _validate.first_true(bad)
+            raise ValueError(f"{_validate.element_name('weights', i, weights.shape)}: {float(weights.ravel()[i])!r} "
+                             f"is not a weight (expected finite values from 0 to {_MAX_WEIGHT:g})")
         weights = np.broadcast_to(weights, (count, n))
-        if np.any(~np.isfinite(weights)) or np.any(weights < 0):
-            raise ValueError("weights: expected finite values >= 0")
     requested = _gradient.columns(fit, "fit")
     lower, upper = _slot_bounds(bounds)
     start = _initial_slots(init)
