@@ -58,8 +58,8 @@ class FitResult:
     cost: np.float64 | Float64Array  # 0.5 * sum of squared (weighted) residuals, per problem
     residuals: Float64Array  # (..., N, 3) unweighted, at the fitted material; NaN where measured is NaN
     iterations: np.int64 | NDArray[np.int64]  # Jacobian evaluations, per problem
-    success: np.bool_ | NDArray[np.bool_]  # scipy's convergence flag, per problem
-    message: str | tuple[str, ...]  # scipy's message, per problem
+    success: np.bool_ | NDArray[np.bool_]  # scipy's convergence flag, per problem (False: no data)
+    message: str | tuple[str, ...]  # scipy's message, per problem, or why it was not fitted
     names: tuple[str, ...]  # the fitted parameters (slot names, base_color as three)
 
     def summary(self) -> str:
