@@ -1,7 +1,13 @@
 """``python -m principled_brdf``: demo, render, bench, info.
 
 Every subcommand has ``--help``; bad arguments print a one-line error and
-exit with status 2.
+exit with status 2. The numeric options are bounded so that a job fits in
+memory and ends: ``--pairs`` at most 2^27, ``--repeats`` 1 to 100 with
+pairs x repeats at most 2^31, ``--resolution`` 2 to 16384, ``--samples`` 1 to
+65536 per pixel with resolution² x samples at most 2^34 (with the sky),
+``--exposure`` finite, > 0 and at most 1e20, ``--light`` three finite numbers
+not all 0, ``--param`` values inside their domains and what the kernels take
+(``roughness`` up to 1e4, the others up to 1e20).
 """
 
 from __future__ import annotations
@@ -14,14 +20,19 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ._batch import FLOAT32_LIMITS
 from .material import PARAMETERS, Material
-from .render import MAX_RESOLUTION
+from .render import MAX_RESOLUTION, MAX_SAMPLE_WORK, MAX_SAMPLES
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
 
 # Each pair holds about 100 bytes across the benchmarks' arrays: 2**27 pairs is 13 GB.
 MAX_PAIRS = 1 << 27
+# Timed runs: each one evaluates every pair (the benchmark's numpy model at ~10 M pairs/s on two cores).
+MAX_REPEATS = 100
+MAX_PAIR_WORK = 1 << 31  # pairs x repeats
+MAX_EXPOSURE = 1e20  # a linear picture times this stays inside float32 (its values are far below 1e18)
 
 
 class _Progress:
@@ -47,10 +58,12 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def _at_most(upper: int, what: str) -> Callable[[str], int]:
-    """A positive integer option of at most ``upper`` (beyond it the job cannot fit in memory)."""
+def _at_most(upper: int, what: str, lower: int = 1) -> Callable[[str], int]:
+    """A positive integer option from ``lower`` to ``upper`` (beyond it the job cannot fit in memory or end)."""
     def parse(text: str) -> int:
         value = _positive_int(text)
+        if value < lower:
+            raise argparse.ArgumentTypeError(f"expected at least {lower} {what}, got {value}")
         if value > upper:
             raise argparse.ArgumentTypeError(f"expected at most {upper} {what}, got {value}")
         return value
@@ -62,8 +75,8 @@ def _exposure(text: str) -> float:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not (np.isfinite(value) and value > 0.0):
-        raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
+    if not (np.isfinite(value) and 0.0 < value <= MAX_EXPOSURE):
+        raise argparse.ArgumentTypeError(f"expected a finite number > 0 and at most {MAX_EXPOSURE:g}, got {text!r}")
     return value
 
 
@@ -72,7 +85,7 @@ def _vector(text: str) -> tuple[float, ...]:
         values = tuple(float(v) for v in text.split(","))
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected three comma-separated numbers, got {text!r}") from None
-    if len(values) != 3 or not np.all(np.isfinite(values)) or np.linalg.norm(values) == 0:
+    if len(values) != 3 or not np.all(np.isfinite(values)) or not any(values):
         raise argparse.ArgumentTypeError(f"expected three finite comma-separated numbers, not all 0, got {text!r}")
     return values
 
@@ -92,6 +105,9 @@ def _parameter(text: str) -> tuple[str, float | tuple[float, ...]]:
     for number in parsed:
         if not info.lower <= number <= info.upper:  # NaN fails both
             raise argparse.ArgumentTypeError(f"{name}: {number!r} is outside its domain [{info.lower:g}, {info.upper:g}]")
+        if number > FLOAT32_LIMITS.get(name, np.inf):
+            raise argparse.ArgumentTypeError(f"{name}: {number!r} is beyond {FLOAT32_LIMITS[name]:g}, the most the "
+                                             "kernels take")
     return name, parsed if info.slots == 3 else parsed[0]
 
 
@@ -106,6 +122,24 @@ def _image_path(formats: Sequence[str]) -> Callable[[str], str]:
                                              f"supported: {', '.join(formats)}")
         return text
     return parse
+
+
+def _timing_limits(args: argparse.Namespace) -> str | None:
+    """What is wrong with demo's or bench's options together, or None."""
+    if args.pairs * args.repeats > MAX_PAIR_WORK:
+        return (f"argument --repeats: {args.repeats} runs of {args.pairs} pairs is beyond {MAX_PAIR_WORK} (2^31) pairs "
+                f"in all; at most {max(MAX_PAIR_WORK // args.pairs, 1)} repeats of this many pairs")
+    return None
+
+
+def _render_limits(args: argparse.Namespace) -> str | None:
+    """What is wrong with render's options together, or None."""
+    pixels = args.resolution * args.resolution
+    if args.environment and pixels * args.samples > MAX_SAMPLE_WORK:
+        return (f"argument --samples: {args.samples} per pixel at {args.resolution}x{args.resolution} is "
+                f"{pixels * args.samples} samples, beyond {MAX_SAMPLE_WORK} (2^34); at most "
+                f"{max(MAX_SAMPLE_WORK // pixels, 1)} per pixel at this resolution")
+    return None
 
 
 def _demo(args: argparse.Namespace, report: Callable[[str], object]) -> None:
@@ -157,10 +191,11 @@ def build_parser() -> argparse.ArgumentParser:
                                            "print throughput beside the memory roofline, write a picture.")
     demo.add_argument("--pairs", type=_at_most(MAX_PAIRS, "pairs"), default=1 << 22,
                       help="pairs to evaluate (default 4194304)")
-    demo.add_argument("--repeats", type=_positive_int, default=5, help="timed runs, best kept (default 5)")
+    demo.add_argument("--repeats", type=_at_most(MAX_REPEATS, "repeats"), default=5,
+                      help=f"timed runs, best kept (default 5, at most {MAX_REPEATS})")
     demo.add_argument("--output", type=_image_path((".png",)), default="principled_brdf_demo.png",
                       help="picture to write (PNG)")
-    demo.set_defaults(run=_demo)
+    demo.set_defaults(run=_demo, limits=_timing_limits)
 
     render = commands.add_parser("render", help="render a preset or parameters on a lit sphere (PNG, EXR, NPY)",
                                  description="Render a material on a sphere lit by a directional light and a sky.")
@@ -170,27 +205,29 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--preset", choices=presets.names(), help="start from a named preset")
     render.add_argument("--param", action="append", type=_parameter, metavar="NAME=VALUE",
                         help="set a parameter (repeatable), e.g. roughness=0.3 or base_color=0.9,0.6,0.2")
-    render.add_argument("--resolution", type=_at_most(MAX_RESOLUTION, "pixels"), default=512,
+    render.add_argument("--resolution", type=_at_most(MAX_RESOLUTION, "pixels", lower=2), default=512,
                         help="image size in pixels (default 512)")
     render.add_argument("--light", type=_vector, default=(-0.5, 0.6, 0.75),
                         help="direction towards the light, camera space x,y,z (default -0.5,0.6,0.75)")
     render.add_argument("--environment", action=argparse.BooleanOptionalAction, default=True,
                         help="light by the sky too (default; --no-environment: the key light alone)")
-    render.add_argument("--samples", type=_at_most(1 << 16, "samples"), default=DEFAULT_SAMPLES,
-                        help=f"sky samples per pixel (default {DEFAULT_SAMPLES})")
+    render.add_argument("--samples", type=_at_most(MAX_SAMPLES, "samples per pixel"), default=DEFAULT_SAMPLES,
+                        help=f"sky samples per pixel (default {DEFAULT_SAMPLES}, at most {MAX_SAMPLES}, and "
+                             "resolution² x samples at most 2^34)")
     render.add_argument("--exposure", type=_exposure, default=1.0,
                         help="scale before tone mapping, or of the linear values in EXR/NPY (default 1)")
     render.add_argument("--model", choices=("disney2014", "disney2012"), default="disney2014")
     render.add_argument("--output", required=True, type=_image_path(tuple(IMAGE_FORMATS)),
                         help="file to write: .png (tone mapped, sRGB), .exr or .npy (linear float32)")
-    render.set_defaults(run=_render)
+    render.set_defaults(run=_render, limits=_render_limits)
 
     bench = commands.add_parser("bench", help="compare pb.eval with a numpy float32 implementation",
                                 description="Time pb.eval against a straightforward numpy float32 implementation "
                                             "of the model on the same pairs.")
     bench.add_argument("--pairs", type=_at_most(MAX_PAIRS, "pairs"), default=1 << 22, help="pairs (default 4194304)")
-    bench.add_argument("--repeats", type=_positive_int, default=5, help="timed runs, best kept (default 5)")
-    bench.set_defaults(run=_bench)
+    bench.add_argument("--repeats", type=_at_most(MAX_REPEATS, "repeats"), default=5,
+                       help=f"timed runs, best kept (default 5, at most {MAX_REPEATS})")
+    bench.set_defaults(run=_bench, limits=_timing_limits)
 
     info = commands.add_parser("info", help="instruction set, threads and versions",
                                description="Show the instruction set in use, threads and versions.")
@@ -201,6 +238,11 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    limits = getattr(args, "limits", None)
+    problem = limits(args) if limits is not None else None
+    if problem is not None:
+        print(f"{parser.prog} {args.command}: error: {problem}", file=sys.stderr)
+        return 2
     report = _Progress()
     try:
         args.run(args, report)

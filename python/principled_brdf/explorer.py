@@ -39,6 +39,7 @@ no kernel): tests set ``explorer.sliders["roughness"].value`` and read
 from __future__ import annotations
 
 import contextlib
+import functools
 import importlib
 import inspect
 import math
@@ -50,6 +51,7 @@ import numpy as np
 from . import _validate
 from . import presets as _presets
 from . import render as _render
+from ._batch import FLOAT32_LIMITS as _KERNEL_LIMITS
 from ._batch import eval_lobes as _eval_lobes
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material, srgb_to_linear
@@ -94,6 +96,7 @@ _KEY_STYLES: dict[str, dict[str, Any]] = {  # the legend entries of the plots, b
     "θv": dict(color="0.45", ls="--", lw=1.0, label="θv"),
 }
 _UI_MAX = 1.0  # the BRDF Explorer's slider range for the unbounded parameters (their domains go on)
+_MAX_EXPOSURE_STOPS = 64.0  # |exposure| a slider takes (2^64: far beyond any picture, and finite)
 _POLAR_STEPS = 360
 _POLAR_DECADES = 4
 _SLICE_RESOLUTION = 128
@@ -119,6 +122,39 @@ def _imports() -> tuple[ModuleType, ModuleType, type[Figure]]:
         raise ImportError("pb.explorer() needs matplotlib: pip install matplotlib "
                           "(or pip install 'principled-brdf[plot]')") from error
     return ipywidgets, matplotlib, Figure
+
+
+@functools.lru_cache(maxsize=None)
+def _slider_class(widgets: ModuleType) -> type[Any]:
+    """A FloatSlider that refuses NaN, infinities and values beyond ``limit`` in magnitude:
+    setting one raises a ``traitlets.TraitError`` that is also a ``ValueError`` naming the
+    slider, and the slider keeps its value (finite values outside its range are clamped to
+    it, as a FloatSlider does)."""
+    import traitlets
+
+    class RefusedValue(traitlets.TraitError, ValueError):
+        """A value a slider of the explorer does not take."""
+
+    float_slider: Any = widgets.FloatSlider  # (ipywidgets is untyped)
+
+    class Slider(float_slider):  # type: ignore[misc]  # a subclass of Any
+        name = ""  # what errors call it (not a trait)
+        limit = math.inf
+
+        @traitlets.validate("value")
+        def _validate_value(self, proposal: Mapping[str, Any]) -> float:
+            value = float(proposal["value"])
+            if not math.isfinite(value):
+                raise RefusedValue(f"{self.name}: {value!r} is not a finite number (the slider keeps {self.value!r})")
+            if abs(value) > self.limit:
+                raise RefusedValue(f"{self.name}: {value!r} is beyond {self.limit:g}, the most it takes "
+                                   f"(the slider keeps {self.value!r})")
+            return cast(float, super()._validate_value(proposal))
+
+    Slider.__qualname__ = Slider.__name__ = "FiniteFloatSlider"
+    RefusedValue.__qualname__ = RefusedValue.__name__ = "RefusedSliderValue"
+    RefusedValue.__module__ = Slider.__module__ = __name__
+    return Slider
 
 
 def _accepts(function: Callable[..., object], keyword: str) -> bool:
@@ -204,6 +240,13 @@ class Explorer:
     ``last_update_seconds``: the last update's total. Methods:
     :meth:`set_material`, :meth:`reset`, :meth:`hold` (several changes, one
     update), :meth:`refresh`, :meth:`write_pngs`, :meth:`close`.
+
+    The sliders clamp a finite value to their range (as a FloatSlider does)
+    and refuse NaN, infinities, material values beyond what the kernels take
+    (``roughness`` 1e4, the others 1e20) and exposures beyond ±64 stops: the
+    assignment raises a ``traitlets.TraitError`` that is also a ``ValueError``
+    naming the slider, which keeps its last value. After :meth:`close` the
+    explorer is inert: changes to its controls are ignored.
     """
 
     # (the widgets are ipywidgets', untyped: Any)
@@ -230,6 +273,7 @@ class Explorer:
         self.resolution = resolution
         self._holding = 0
         self._quiet = False  # while the preset menu sets the sliders
+        self._closed = False
         self._rendered = {}
         self.timings = {}
         self.last_update_seconds = 0.0
@@ -240,10 +284,14 @@ class Explorer:
         style = {"description_width": "104px"}
         layout = widgets.Layout(width="330px")
 
+        Slider = _slider_class(widgets)
+
         def slider(description: str, value: float, lower: float, upper: float, step: float,
-                   fmt: str = ".2f") -> Any:
-            return widgets.FloatSlider(value=value, min=lower, max=upper, step=step, description=description,
-                                       continuous_update=True, readout_format=fmt, style=style, layout=layout)
+                   fmt: str = ".2f", name: str = "", limit: float = math.inf) -> Any:
+            control = Slider(value=value, min=lower, max=upper, step=step, description=description,
+                             continuous_update=True, readout_format=fmt, style=style, layout=layout)
+            control.name, control.limit = name or description, limit
+            return control
 
         self.sliders = {}
         for name, info in PARAMETERS.items():
@@ -251,7 +299,7 @@ class Explorer:
                 continue
             value = float(getattr(material, name))
             upper = info.upper if math.isfinite(info.upper) else max(_UI_MAX, math.ceil(value))
-            self.sliders[name] = slider(name, value, info.lower, upper, 0.01)
+            self.sliders[name] = slider(name, value, info.lower, upper, 0.01, limit=_KERNEL_LIMITS.get(name, math.inf))
         self.base_color = widgets.ColorPicker(value=_hex(self._base_color), description="base_color", concise=False,
                                               style=style, layout=layout)
         self.model = widgets.Dropdown(options=list(_validate.MODELS), value=model, description="model", style=style,
@@ -259,11 +307,11 @@ class Explorer:
         self.preset = widgets.Dropdown(options=[CUSTOM] + _presets.names(), value=preset or CUSTOM,
                                        description="preset", style=style, layout=layout)
         theta_l, phi_l = self._default_light()
-        self.light_theta = slider("light θ (°)", theta_l, 0.0, 90.0, 0.5, ".1f")
-        self.light_phi = slider("light φ (°)", phi_l, 0.0, 360.0, 1.0, ".0f")
-        self.view_theta = slider("view θ (°)", 45.0, 0.0, 90.0, 0.5, ".1f")
-        self.view_phi = slider("view φ (°)", 0.0, 0.0, 360.0, 1.0, ".0f")
-        self.exposure = slider("exposure (stops)", 0.0, -4.0, 4.0, 0.25, "+.2f")
+        self.light_theta = slider("light θ (°)", theta_l, 0.0, 90.0, 0.5, ".1f", "light_theta")
+        self.light_phi = slider("light φ (°)", phi_l, 0.0, 360.0, 1.0, ".0f", "light_phi")
+        self.view_theta = slider("view θ (°)", 45.0, 0.0, 90.0, 0.5, ".1f", "view_theta")
+        self.view_phi = slider("view φ (°)", 0.0, 0.0, 360.0, 1.0, ".0f", "view_phi")
+        self.exposure = slider("exposure (stops)", 0.0, -4.0, 4.0, 0.25, "+.2f", "exposure", _MAX_EXPOSURE_STOPS)
         self.sky = widgets.Checkbox(value=True, description="sky light on the sphere", indent=False)
         self.log_radius = widgets.Checkbox(value=False, description="log radius (polar)", indent=False)
         self.energy_compensation = (widgets.Checkbox(value=False, description="energy compensation", indent=False)
@@ -359,7 +407,10 @@ class Explorer:
                 self.refresh()
 
     def refresh(self) -> dict[str, float]:
-        """Redraw the pictures whose inputs changed; returns ``{name: seconds}`` of those drawn."""
+        """Redraw the pictures whose inputs changed; returns ``{name: seconds}`` of those drawn
+        (nothing after :meth:`close`)."""
+        if self._closed:
+            return {}
         state = self._state()
         material = self.material
         start = time.perf_counter()
@@ -381,6 +432,8 @@ class Explorer:
         return drawn
 
     def _changed(self, change: Mapping[str, Any]) -> None:
+        if self._closed:
+            return
         material_control = change["owner"] is self.base_color or change["owner"] in self.sliders.values()
         if material_control and not self._quiet and self.preset.value != CUSTOM:
             self._quietly(lambda: setattr(self.preset, "value", CUSTOM))
@@ -395,7 +448,7 @@ class Explorer:
             self._quiet = quiet
 
     def _color_picked(self, change: Mapping[str, Any]) -> None:
-        if self._quiet:
+        if self._quiet or self._closed:
             return
         try:
             self._base_color = _picked(change["new"])
@@ -404,7 +457,7 @@ class Explorer:
         self._changed(change)
 
     def _preset_chosen(self, change: Mapping[str, Any]) -> None:
-        if self._quiet or change["new"] == CUSTOM:
+        if self._quiet or self._closed or change["new"] == CUSTOM:
             return
         self.set_material(_presets.get(change["new"]), preset=change["new"])
 
@@ -427,6 +480,11 @@ class Explorer:
         """Set every material control to ``material`` (a uniform Material or a preset name), one update."""
         material, named = _uniform(material)
         preset = preset or named
+        for name, limit in _KERNEL_LIMITS.items():  # what the kernels take: the pictures could not be drawn
+            value = np.asarray(getattr(material, name), dtype=np.float64)
+            if np.any(value > limit):
+                raise ValueError(f"material: {name} = {value.tolist()!r} is beyond {limit:g}, the most the "
+                                 "explorer's kernels take")
 
         def apply() -> None:
             for name, s in self.sliders.items():
@@ -691,7 +749,16 @@ class Explorer:
         return paths
 
     def close(self) -> None:
-        """Close the widgets (and drop the figures)."""
+        """Close the widgets (and drop the figures). The explorer is inert afterwards: changes to
+        its controls are ignored and :meth:`refresh` draws nothing. Closing twice does nothing more."""
+        if self._closed:
+            return
+        self._closed = True
+        for control in self._controls():
+            handler = (self._preset_chosen if control is self.preset else
+                       self._color_picked if control is self.base_color else self._changed)
+            control.unobserve(handler, names="value")
+
         def close(widget: Any) -> None:
             for child in getattr(widget, "children", ()):
                 close(child)

@@ -10,9 +10,12 @@ rounding, and stop at the start point.
 from __future__ import annotations
 
 import contextlib
+import math
+import threading
 
+from collections.abc import Mapping as _Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,8 +26,8 @@ from .material import PARAMETERS, Material
 from . import reference
 
 if TYPE_CHECKING:
-    from collections.abc import Callable, Mapping
-    from typing import Any, Literal, SupportsFloat, SupportsIndex
+    from collections.abc import Callable, Iterator, Mapping
+    from typing import Literal, SupportsFloat, SupportsIndex
 
     from numpy.typing import NDArray
 
@@ -36,6 +39,13 @@ __all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES"]
 # to [0, 1] as the BRDF Explorer's sliders are (pass bounds= to widen them).
 FIT_BOUNDS = {name: (max(info.lower, 0.0), min(info.upper, 1.0)) for name, info in PARAMETERS.items()}
 LOSSES = ("log", "relative", "linear")
+# The "relative" loss divides by max(m, _RELATIVE_FLOOR_FRACTION * max m, _RELATIVE_FLOOR) (1/sr):
+# the absolute floor keeps a black problem (every m = 0) finite; it then fits f towards 0.
+_RELATIVE_FLOOR_FRACTION = 1e-3
+_RELATIVE_FLOOR = 1e-9
+_MAX_WEIGHT = 1e30  # weights times squared residuals (at most ~1e95) stay finite
+_NO_DATA = "no data: every sample of this problem is missing (NaN); the result is the start"
+_NOTHING_FITTED = "nothing to fit: every parameter in fit is held by equal bounds; the result is the start"
 
 
 @dataclass(frozen=True)
@@ -48,8 +58,8 @@ class FitResult:
     cost: np.float64 | Float64Array  # 0.5 * sum of squared (weighted) residuals, per problem
     residuals: Float64Array  # (..., N, 3) unweighted, at the fitted material; NaN where measured is NaN
     iterations: np.int64 | NDArray[np.int64]  # Jacobian evaluations, per problem
-    success: np.bool_ | NDArray[np.bool_]  # scipy's convergence flag, per problem
-    message: str | tuple[str, ...]  # scipy's message, per problem
+    success: np.bool_ | NDArray[np.bool_]  # scipy's convergence flag, per problem (False: no data)
+    message: str | tuple[str, ...]  # scipy's message, per problem, or why it was not fitted
     names: tuple[str, ...]  # the fitted parameters (slot names, base_color as three)
 
     def summary(self) -> str:
@@ -73,14 +83,33 @@ class FitResult:
         return self.summary()
 
 
+def _bound_pair(name: str, pair: object) -> tuple[float, float]:
+    """``(lower, upper)`` of ``bounds[name]``: two real numbers, not NaN."""
+    where = f"bounds[{name!r}]"
+    if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or not hasattr(pair, "__getitem__"):
+        raise TypeError(f"{where}: expected a (lower, upper) pair of numbers, got {pair!r}")
+    if len(pair) != 2:
+        raise ValueError(f"{where}: expected a (lower, upper) pair of numbers, got {len(pair)} values")
+    values = []
+    for value in (pair[0], pair[1]):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise TypeError(f"{where}: expected a (lower, upper) pair of numbers, got {pair!r}")
+        values.append(float(value))
+    if any(math.isnan(v) for v in values):
+        raise ValueError(f"{where}: ({values[0]}, {values[1]}) is not an interval (NaN)")
+    return values[0], values[1]
+
+
 def _slot_bounds(
     bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None,
 ) -> tuple[Float64Array, Float64Array]:
     merged = dict(FIT_BOUNDS)
+    if bounds is not None and not isinstance(bounds, _Mapping):
+        raise TypeError(f"bounds: expected a mapping {{name: (lower, upper)}}, got {type(bounds).__name__}")
     for name, pair in (bounds or {}).items():
         if name not in PARAMETERS:
             raise ValueError(f"bounds: unknown parameter {name!r}")
-        low, high = (float(v) for v in pair)
+        low, high = _bound_pair(name, pair)
         info = PARAMETERS[name]
         if not (info.lower <= low <= high <= info.upper):
             raise ValueError(f"bounds[{name!r}]: ({low}, {high}) is not an interval inside its domain "
@@ -130,15 +159,37 @@ def _residual_and_jacobian(value: Float64Array, jacobian: Float64Array, measured
     return residual, derivative
 
 
-def _one_blas_thread() -> contextlib.AbstractContextManager[object]:
+# Concurrent fits share one BLAS limit: the first to enter sets it, the last to leave restores
+# what was there before the first (a limit per call would restore the other call's 1 at the end).
+_blas_lock = threading.Lock()
+_blas_users = 0
+_blas_limiter: Any = None
+
+
+@contextlib.contextmanager
+def _one_blas_thread() -> Iterator[None]:
     """BLAS on one thread (threadpoolctl, when installed): each trust-region step takes
     the SVD of the tall (N, P) Jacobian, which threads slow down (a 20,000-pair fit on
-    two cores: 12.6 s with OpenBLAS's threads, 4.1 s with one)."""
+    two cores: 12.6 s with OpenBLAS's threads, 4.1 s with one). Calls that overlap (from
+    several threads) share the limit, and the last one out restores the previous limits."""
+    global _blas_users, _blas_limiter
     try:
         from threadpoolctl import threadpool_limits  # type: ignore[import-untyped]  # it ships no type hints
     except ImportError:  # pragma: no cover - in the fit and test extras
-        return contextlib.nullcontext()
-    return threadpool_limits(1, user_api="blas")
+        yield
+        return
+    with _blas_lock:
+        if _blas_users == 0:
+            _blas_limiter = threadpool_limits(1, user_api="blas")
+        _blas_users += 1
+    try:
+        yield
+    finally:
+        with _blas_lock:
+            _blas_users -= 1
+            if _blas_users == 0:
+                limiter, _blas_limiter = _blas_limiter, None
+                limiter.restore_original_limits()
 
 
 def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
@@ -152,33 +203,53 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     ``wi``, ``wo``: unit directions ``(N, 3)``; ``measured``: ``(N, 3)``, or
     ``(B, N, 3)`` for B independent problems (one material per row, e.g. the
     texels of a texture; ``wi``, ``wo`` may then be ``(B, N, 3)`` too). NaN
-    marks a missing sample. ``init``: the start (a uniform Material or a dict;
+    marks a missing sample; values beyond float32's range are refused (no
+    material reaches them). ``init``: the start (a uniform Material or a dict;
     default ``Material()``), which also holds the parameters not in ``fit``
     (names; default all, ``base_color`` as three channels).
     ``loss``: ``"log"`` (``log(1 + f c) - log(1 + m c)``, c = cos θl if
     ``cosine`` else 1: robust over the dynamic range of specular peaks),
-    ``"relative"`` (``(f - m) / max(m, 1e-3 max m)``) or ``"linear"`` (``(f -
-    m) c``). ``weights`` ``(N,)`` or ``(B, N)`` scale each pair's squared
+    ``"relative"`` (``(f - m) / max(m, 1e-3 max m, 1e-9)``, max m over the
+    problem's samples: the floors keep zero measurements finite, and a black
+    problem, every m = 0, fits f towards 0) or ``"linear"`` (``(f - m) c``).
+    ``weights`` ``(N,)`` or ``(B, N)`` (0 to 1e30) scale each pair's squared
     residuals. ``bounds``: ``{name: (lower, upper)}`` over :data:`FIT_BOUNDS`
-    (the domains, with the unbounded parameters held to [0, 1]).
-    ``precision``: ``"float32"`` (the SIMD kernels) or ``"float64"`` (the reference).
+    (the domains, with the unbounded parameters held to [0, 1]); a parameter
+    whose bounds are equal is held at that value (it is not fitted, nor listed
+    in ``names``). ``precision``: ``"float32"`` (the SIMD kernels) or
+    ``"float64"`` (the reference). ``max_iterations``: an integer >= 1, the
+    most evaluations of the model per problem.
+
+    A problem without data (every sample NaN) is not fitted and does not stop
+    the others: its result is the start (``init`` clipped to ``bounds``), cost
+    0.0 (the sum over no samples), iterations 0, success False and a message
+    starting ``"no data"``; its residuals are NaN. When equal bounds hold
+    every parameter of ``fit``, each problem's result is the start, evaluated
+    (cost and residuals), with iterations 0 and success True.
     """
     try:
         from scipy.optimize import least_squares
     except ImportError as error:  # pragma: no cover - scipy is in the test and fit extras
         raise ImportError("pb.fit needs scipy: pip install 'principled-brdf[fit]'") from error
-    if loss not in LOSSES:
+    if not isinstance(loss, str) or loss not in LOSSES:
         raise ValueError(f"loss: expected one of {', '.join(LOSSES)}, got {loss!r}")
-    if precision not in ("float32", "float64"):
+    if not isinstance(precision, str) or precision not in ("float32", "float64"):
         raise ValueError(f"precision: expected 'float32' or 'float64', got {precision!r}")
     cosine = _validate.flag("cosine", cosine)
     max_iterations = _validate.integer("max_iterations", max_iterations)
+    if max_iterations < 1:
+        raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations}")
     measured = np.asarray(_validate.as_real_array("measured", measured), dtype=np.float64)
     if measured.ndim not in (2, 3) or measured.shape[-1] != 3:
         raise ValueError(f"measured: expected (N, 3) or (B, N, 3) values of f, got shape {measured.shape}")
     finite_or_missing = np.isfinite(measured) | np.isnan(measured)
     if not finite_or_missing.all() or np.any(measured < 0):
         raise ValueError("measured: values must be finite and >= 0 (NaN marks a missing sample)")
+    huge = measured > _validate.FLOAT32_MAX  # (NaN is not)
+    if huge.any():
+        i = _validate.first_true(huge)
+        raise ValueError(f"{_validate.element_name('measured', i, measured.shape)}: {float(measured.ravel()[i])!r} "
+                         f"is beyond {_validate.FLOAT32_MAX:.7g}, the most the model reaches")
     batched = measured.ndim == 3
     problems = measured if batched else measured[None]
     wi = np.asarray(_validate.directions("wi", wi), dtype=np.float64)
@@ -190,57 +261,78 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     wi_rows = np.broadcast_to(wi, (count, n, 3))
     wo_rows = np.broadcast_to(wo, (count, n, 3))
     if weights is not None:
-        weights = np.broadcast_to(np.asarray(_validate.as_real_array("weights", weights), dtype=np.float64), (count, n))
-        if np.any(~np.isfinite(weights)) or np.any(weights < 0):
-            raise ValueError("weights: expected finite values >= 0")
-    slots = _gradient.columns(fit, "fit")
+        weights = np.asarray(_validate.as_real_array("weights", weights), dtype=np.float64)
+        allowed = ((n,), (count, n)) if batched else ((n,),)
+        if weights.shape not in allowed:
+            raise ValueError(f"weights: expected shape {' or '.join(str(a) for a in allowed)} (one per pair), "
+                             f"got {weights.shape}")
+        bad = ~((weights >= 0.0) & (weights <= _MAX_WEIGHT))
+        if bad.any():
+            i = _validate.first_true(bad)
+            raise ValueError(f"{_validate.element_name('weights', i, weights.shape)}: {float(weights.ravel()[i])!r} "
+                             f"is not a weight (expected finite values from 0 to {_MAX_WEIGHT:g})")
+        weights = np.broadcast_to(weights, (count, n))
+    requested = _gradient.columns(fit, "fit")
     lower, upper = _slot_bounds(bounds)
     start = _initial_slots(init)
-    start[slots] = np.clip(start[slots], lower[slots], upper[slots])
+    start[requested] = np.clip(start[requested], lower[requested], upper[requested])
+    slots = [k for k in requested if lower[k] < upper[k]]  # equal bounds hold a parameter (clipped to it above)
     _validate.model_index(model)  # checked before any work; eval_grad takes the name
 
     fitted = np.empty((count, len(GRADIENT_NAMES)))
     costs, iterations, success, messages = np.empty(count), np.empty(count, np.int64), np.empty(count, bool), []
     residuals_out = np.full(problems.shape, np.nan)
     dtype = np.float32 if precision == "float32" else np.float64
-    for row in range(count):
-        target = problems[row]
-        present = ~np.isnan(target).any(axis=-1)
-        wi_p = np.ascontiguousarray(wi_rows[row][present], dtype=dtype)
-        wo_p = np.ascontiguousarray(wo_rows[row][present], dtype=dtype)
-        m = target[present]
-        cos_theta = np.maximum(wi_rows[row][present][:, 2], 0.0) if cosine else np.ones(len(m))
-        scale = np.maximum(m, 1e-3 * max(float(m.max(initial=0.0)), 1e-300))
-        root_weight = np.sqrt(weights[row][present])[:, None] if weights is not None else np.ones((len(m), 1))
-        values = start.copy()
-        last: dict[str, Float64Array] = {}
+    with _one_blas_thread():
+        for row in range(count):
+            target = problems[row]
+            present = ~np.isnan(target).any(axis=-1)
+            if not present.any():
+                fitted[row], costs[row], iterations[row], success[row] = start, 0.0, 0, False
+                messages.append(_NO_DATA)
+                continue
+            wi_p = np.ascontiguousarray(wi_rows[row][present], dtype=dtype)
+            wo_p = np.ascontiguousarray(wo_rows[row][present], dtype=dtype)
+            m = target[present]
+            cos_theta = np.maximum(wi_rows[row][present][:, 2], 0.0) if cosine else np.ones(len(m))
+            scale = np.maximum(m, max(_RELATIVE_FLOOR_FRACTION * float(m.max()), _RELATIVE_FLOOR))
+            root_weight = np.sqrt(weights[row][present])[:, None] if weights is not None else np.ones((len(m), 1))
+            values = start.copy()
+            last: dict[str, Float64Array] = {}
 
-        def evaluate(x: Float64Array) -> tuple[Float64Array, Float64Array]:
-            """Unweighted residuals (n, 3) and their Jacobian (n, 3, len(slots)) at x, kept for the next call."""
-            if last.get("x") is None or not np.array_equal(last["x"], x):
-                values[slots] = x
-                material = _material_of(values)
-                if precision == "float32":
-                    g = eval_grad(material, wi_p, wo_p, model=model, check=False)
-                else:
-                    g = reference.eval_grad(material, wi_p, wo_p, model=model)
-                r, d = _residual_and_jacobian(g.value.astype(np.float64), g.jacobian.astype(np.float64), m, cos_theta,
-                                              loss, scale)
-                last.update(x=x.copy(), r=r, d=d[..., slots])
-            return last["r"], last["d"]
+            def evaluate(x: Float64Array) -> tuple[Float64Array, Float64Array]:
+                """Unweighted residuals (n, 3) and their Jacobian (n, 3, len(slots)) at x, kept for the next call."""
+                if last.get("x") is None or not np.array_equal(last["x"], x):
+                    values[slots] = x
+                    material = _material_of(values)
+                    if precision == "float32":
+                        g = eval_grad(material, wi_p, wo_p, model=model, check=False)
+                    else:
+                        g = reference.eval_grad(material, wi_p, wo_p, model=model)
+                    r, d = _residual_and_jacobian(g.value.astype(np.float64), g.jacobian.astype(np.float64), m,
+                                                  cos_theta, loss, scale)
+                    last.update(x=x.copy(), r=r, d=d[..., slots])
+                return last["r"], last["d"]
 
-        with _one_blas_thread():
+            if not slots:
+                x = start[slots]
+                residual = evaluate(x)[0]
+                fitted[row], iterations[row], success[row] = start, 0, True
+                costs[row] = 0.5 * float(np.sum((residual * root_weight) ** 2))
+                messages.append(_NOTHING_FITTED)
+                residuals_out[row][present] = residual
+                continue
             solution = least_squares(lambda x: (evaluate(x)[0] * root_weight).reshape(-1), start[slots],
                                      jac=lambda x: (evaluate(x)[1] * root_weight[..., None]).reshape(-1, len(slots)),
                                      bounds=(lower[slots], upper[slots]), method="trf", x_scale="jac",
                                      max_nfev=max_iterations)
-        values[slots] = solution.x
-        fitted[row] = values
-        costs[row] = solution.cost
-        iterations[row] = solution.njev if solution.njev is not None else solution.nfev
-        success[row] = solution.success
-        messages.append(solution.message)
-        residuals_out[row][present] = evaluate(solution.x)[0]
+            values[slots] = solution.x
+            fitted[row] = values
+            costs[row] = solution.cost
+            iterations[row] = solution.njev if solution.njev is not None else solution.nfev
+            success[row] = solution.success
+            messages.append(solution.message)
+            residuals_out[row][present] = evaluate(solution.x)[0]
 
     take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
     return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),

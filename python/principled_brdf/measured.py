@@ -195,18 +195,37 @@ def _require_brdf_values(name: str, values: Float64Array) -> None:
                          "BRDF value (finite and >= 0, or NaN for no data)")
 
 
-def load_merl(path: str | os.PathLike[str]) -> MerlBRDF:
-    """Reads a MERL ``.binary`` file. A file of the wrong size or header is a ValueError saying what was expected."""
-    size = os.path.getsize(path)
-    with open(path, "rb") as f:
-        header = np.fromfile(f, dtype="<i4", count=3)
+def load_merl(path: str | bytes | os.PathLike[str] | int) -> MerlBRDF:
+    """Reads a MERL ``.binary`` file: ``path`` a path, or an open file descriptor (an int),
+    read from its current position and left open. A file of the wrong size or header is a
+    ValueError saying what was expected; a stored value that is NaN or infinite is a ValueError
+    naming its channel and cell (a negative value marks a cell without data: NaN in the table)."""
+    if isinstance(path, (bool, np.bool_)) or not isinstance(path, (str, bytes, os.PathLike, int)):
+        raise TypeError(f"path: expected a path or an open file descriptor (int), got {type(path).__name__}")
+    where = f"file descriptor {path}" if isinstance(path, int) else os.fsdecode(path)
+    descriptor = isinstance(path, int)
+    size = os.fstat(path).st_size if isinstance(path, int) else os.path.getsize(path)
+    with open(path, "rb", closefd=not descriptor) as f:
+        start = f.tell() if descriptor and f.seekable() else 0
+        header = np.frombuffer(f.read(_HEADER_BYTES), dtype="<i4")
         if header.size != 3 or tuple(int(v) for v in header) != MERL_SHAPE:
-            raise ValueError(f"{path}: expected a MERL header of three int32 dimensions {MERL_SHAPE}, "
+            raise ValueError(f"{where}: expected a MERL header of three int32 dimensions {MERL_SHAPE}, "
                              f"got {tuple(int(v) for v in header)}")
-        if size != _FILE_BYTES:
-            raise ValueError(f"{path}: expected {_FILE_BYTES} bytes (a 12-byte header and 3 x {_CELLS} float64), "
-                             f"got {size}")
-        stored = np.fromfile(f, dtype="<f8", count=3 * _CELLS).reshape((3,) + MERL_SHAPE)
+        if f.seekable() and size - start != _FILE_BYTES:
+            raise ValueError(f"{where}: expected {_FILE_BYTES} bytes (a 12-byte header and 3 x {_CELLS} float64), "
+                             f"got {size - start}")
+        data = f.read(3 * _CELLS * 8)
+        if len(data) != 3 * _CELLS * 8:
+            raise ValueError(f"{where}: expected {_FILE_BYTES} bytes (a 12-byte header and 3 x {_CELLS} float64), "
+                             f"got {_HEADER_BYTES + len(data)}")
+    stored = np.frombuffer(data, dtype="<f8").reshape((3,) + MERL_SHAPE)
+    bad = ~np.isfinite(stored)
+    if bad.any():
+        channel, i_h, i_d, i_p = (int(i) for i in np.unravel_index(int(np.argmax(bad)), stored.shape))
+        color = ("red", "green", "blue")[channel]
+        raise ValueError(f"{where}: channel {channel} ({color}), cell (θh {i_h}, θd {i_d}, "
+                         f"φd {i_p}): stored value {float(stored[channel, i_h, i_d, i_p])!r} is not finite "
+                         "(a negative value marks a cell without data)")
     table = stored * MERL_SCALE[:, None, None, None]
     table[stored < 0.0] = np.nan
     return MerlBRDF(table)

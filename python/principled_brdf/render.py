@@ -42,6 +42,7 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
 
 __all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_frames", "lattice_uniforms", "tone_map",
            "to_srgb8", "png_bytes", "write_png", "save_image", "IMAGE_FORMATS", "DEFAULT_LIGHT", "DEFAULT_SAMPLES", "MAX_RESOLUTION",
+           "MAX_SAMPLES", "MAX_SAMPLE_WORK",
            "TONE_CURVES", "REINHARD_WHITE", "FILMIC_WHITE"]
 
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
@@ -49,6 +50,10 @@ DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y
 
 MAX_RESOLUTION = 16384
 DEFAULT_SAMPLES = 64  # sky samples per pixel: with the lattice below, no visible noise on any preset
+MAX_SAMPLES = 1 << 16  # sky samples per pixel
+# Sky samples in all (pixels x samples, every sphere of a batch counted): 16384² pixels at the default
+# 64 samples; about half an hour at the 9 M samples/s of two cores.
+MAX_SAMPLE_WORK = 1 << 34
 
 
 def _resolution(value: object) -> int:
@@ -58,11 +63,34 @@ def _resolution(value: object) -> int:
     return value
 
 
+def _samples(value: object, pixels: int) -> int:
+    """Sky samples per pixel: an integer from 1 to MAX_SAMPLES, and pixels x samples at most MAX_SAMPLE_WORK."""
+    samples = _validate.integer("samples", value)
+    if not 1 <= samples <= MAX_SAMPLES:
+        raise ValueError(f"samples: expected 1 to {MAX_SAMPLES} per pixel, got {samples}")
+    if pixels * samples > MAX_SAMPLE_WORK:
+        raise ValueError(f"samples: {samples} per pixel over {pixels} pixels is {pixels * samples} samples, beyond "
+                         f"the {MAX_SAMPLE_WORK} (2^34) a picture takes; at most {max(MAX_SAMPLE_WORK // pixels, 0)} "
+                         "per pixel at this size")
+    return samples
+
+
+def _pixels(material: object, resolution: int) -> int:
+    """The pixels a picture of ``material`` shades (every sphere of a batch), where the shapes broadcast."""
+    try:
+        shape = np.broadcast_shapes(tuple(getattr(material, "shape", ())), (resolution, resolution))
+    except (TypeError, ValueError):  # refused where the material is used, naming it
+        shape = (resolution, resolution)
+    return int(np.prod(shape, dtype=np.int64))
+
+
 def _light_direction(value: object) -> Float64Array:
     light = _validate.as_real_array("light", value)
     if light.shape != (3,):
         raise ValueError(f"light: expected a 3-vector towards the light, got shape {light.shape}")
     _validate.require_finite("light", light)
+    largest = float(np.max(np.abs(light)))
+    light = light / largest if largest > 0.0 else light  # no overflow nor underflow in the length
     length = float(np.linalg.norm(light))
     if not 0.0 < length < np.inf:
         raise ValueError(f"light: expected a non-zero direction, got {light.tolist()}")
@@ -133,7 +161,8 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     irradiance, 0 turns it off) and by ``environment``: ``"sky"`` (default,
     :func:`sky_environment`), a callable ``L(direction)`` from camera-space
     directions ``(..., 3)`` to RGB radiance, or None. The environment's
-    integral is :func:`render_environment`'s (``samples`` per pixel, ``seed``).
+    integral is :func:`render_environment`'s (``samples`` per pixel, ``seed``;
+    1 to :data:`MAX_SAMPLES`, and pixels x samples at most :data:`MAX_SAMPLE_WORK`).
     ``ambient``: an optional constant ``ambient * base_color`` term (an
     approximation that ignores metallic; 0 by default).
 
@@ -146,6 +175,8 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     light_intensity = _non_negative("light_intensity", light_intensity)
     ambient = _non_negative("ambient", ambient)
     environment = _environment(environment)
+    resolution = _resolution(resolution)
+    _samples(samples, _pixels(material, resolution) if environment is not None else 0)  # (unused without one)
     inside, to_local = sphere_frames(resolution)
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
     radiance = np.float32(light_intensity) * _eval(material, wi, wo, cosine=True, model=model,
@@ -207,12 +238,13 @@ def render_environment(material: Material, resolution: int = 256, environment: _
     ``(..., 3)`` to RGB radiance; default :func:`sky_environment`), per pixel
     ``∫ f L(wi) cos θl dωi`` estimated from ``samples`` importance samples (``pb.sample``) at
     :func:`lattice_uniforms` points shifted per pixel from ``seed``: deterministic, and far
-    less noisy than independent samples. ``energy_compensation`` as in ``pb.sample``."""
+    less noisy than independent samples. ``samples``: 1 to :data:`MAX_SAMPLES`, and pixels
+    (every sphere of a batch) x samples at most :data:`MAX_SAMPLE_WORK`. ``energy_compensation``
+    as in ``pb.sample``."""
     # (False, which _environment maps to None, is not checked here: calling it fails as before)
     environment = typing.cast("_Environment", sky_environment if environment is None else _environment(environment))
-    samples = _validate.integer("samples", samples)
-    if samples < 1:
-        raise ValueError(f"samples: expected at least 1, got {samples}")
+    resolution = _resolution(resolution)
+    samples = _samples(samples, _pixels(material, resolution))
     inside, to_local = sphere_frames(resolution)
     wo = to_local((0.0, 0.0, 1.0))
     # to_local(e_k)[..., j] = frame_j[k]: the tangent, bitangent and normal (j = 0, 1, 2) in camera space
