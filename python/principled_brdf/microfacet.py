@@ -13,19 +13,19 @@ quantity (pbrt-v4's ``TrowbridgeReitzDistribution`` and Mitsuba 3's
 
 The methods, named as the math:
 
-================================  ===  ========  ==========  =======  ================  ===
-method                            GGX  Beckmann  BlinnPhong  StudentT ExponentialPower  GTR
-================================  ===  ========  ==========  =======  ================  ===
-``d(h)``                          yes  yes       yes         yes      yes               yes
-``pdf(h)``                        yes  yes       yes         yes      yes               yes
-``sample(u1, u2)``                yes  yes       yes         yes      yes               yes
-``lambda_(w)``                    yes  yes       yes         yes      yes               --
-``g1(w)``                         yes  yes       yes         yes      yes               --
-``g2(wi, wo, correlated=True)``   yes  yes       yes         yes      yes               --
-``pdf_visible(h, wo)``            yes  yes       yes         yes      yes               --
-``sample_visible(wo, u1, u2)``    yes  yes       --          --       --                --
-``g2_over_4cos(wi, wo)``          yes  --        --          --       --                --
-================================  ===  ========  ==========  =======  ================  ===
+===============================  ===  ========  ==========  ========  ================  ===
+method                           GGX  Beckmann  BlinnPhong  StudentT  ExponentialPower  GTR
+===============================  ===  ========  ==========  ========  ================  ===
+``d(h)``                         yes  yes       yes         yes       yes               yes
+``pdf(h)``                       yes  yes       yes         yes       yes               yes
+``sample(u1, u2)``               yes  yes       yes         yes       yes               yes
+``lambda_(w)``                   yes  yes       yes         yes       yes               --
+``g1(w)``                        yes  yes       yes         yes       yes               --
+``g2(wi, wo, correlated=True)``  yes  yes       yes         yes       yes               --
+``pdf_visible(h, wo)``           yes  yes       yes         yes       yes               --
+``sample_visible(wo, u1, u2)``   yes  yes       --          --        --                --
+``g2_over_4cos(wi, wo)``         yes  --        --          --        --                --
+===============================  ===  ========  ==========  ========  ================  ===
 
 A method a family lacks ("--") is absent: reading it raises ``AttributeError`` with the
 reason (GTR is not shape-invariant, so it has no Smith Λ; no visible-normal sampler is
