@@ -158,6 +158,14 @@ def test_immutable_equal_by_value_and_picklable(dist):
     assert dist != mf.GGX(0.25) and dist != "GGX(alpha_x=0.3)"
 
 
+def test_equality_is_of_the_parameters_in_effect():
+    assert mf.GGX(0.3) == mf.GGX(0.3, 0.3) and hash(mf.GGX(0.3)) == hash(mf.GGX(0.3, 0.3))
+    assert mf.Beckmann(0.3) == mf.Beckmann(0.3, approximation=None) != mf.Beckmann(0.3, approximation="walter")
+    assert mf.GTR(0.2, 1.5) == mf.GTR(0.2, 1.5, closed_forms=True) != mf.GTR(0.2, 1.5, closed_forms=False)
+    assert mf.StudentT(0.3, gamma=2) == mf.StudentT(0.3, 0.3, gamma=2.0) != mf.StudentT(0.3, gamma=3.0)
+    assert mf.GGX(0.3) != mf.Beckmann(0.3) and mf.GGX([0.3]) != mf.GGX(0.3)  # the shapes differ
+
+
 def test_parameters_are_copied_and_read_only():
     alpha = np.array([0.1, 0.2])
     ggx = mf.GGX(alpha)

@@ -11,6 +11,11 @@ quantity (pbrt-v4's ``TrowbridgeReitzDistribution`` and Mitsuba 3's
 - :class:`GTR`, Burley 2012's generalized Trowbridge-Reitz (isotropic, ``alpha`` and
   ``gamma``).
 
+The parameters are read-only properties (float64 arrays); setting one raises
+``AttributeError``. Two distributions are equal when their type and the parameters in
+effect are (``GGX(0.3) == GGX(0.3, 0.3)``); they hash, copy and pickle, and their
+``repr`` rebuilds them.
+
 The methods, named as the math:
 
 ===============================  ===  ========  ==========  ========  ================  ===
@@ -239,9 +244,13 @@ class _Distribution:
                           for name, value in self._parameters().items())
         return f"{type(self).__name__}({shown})"
 
+    def _values(self) -> dict[str, object]:
+        """What equality compares: the parameters in effect."""
+        return self._parameters()
+
     def _key(self) -> tuple[object, ...]:
         return tuple((name, value.shape, value.tobytes()) if isinstance(value, np.ndarray) else (name, value)
-                     for name, value in self._parameters().items())
+                     for name, value in self._values().items())
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
@@ -287,6 +296,10 @@ class _Anisotropic(_Distribution):
         if not self._isotropic:
             parameters["alpha_y"] = self._alpha_y
         return parameters
+
+    def _values(self) -> dict[str, object]:
+        # GGX(0.3) is GGX(0.3, 0.3)
+        return {"alpha_x": self._alpha_x, "alpha_y": self._alpha_y, **self._parameters()}
 
     def _shape_argument(self) -> dict[str, Float64Array]:
         """The shape argument of the family's bindings (none for GGX and Beckmann)."""
