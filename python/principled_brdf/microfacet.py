@@ -14,7 +14,7 @@ quantity (pbrt-v4's ``TrowbridgeReitzDistribution`` and Mitsuba 3's
 The parameters are read-only properties (float64 arrays); setting one raises
 ``AttributeError``. Two distributions are equal when their type and the parameters in
 effect are (``GGX(0.3) == GGX(0.3, 0.3)``); they hash, copy and pickle, and their
-``repr`` rebuilds them.
+``repr`` shows the parameters as the constructor takes them.
 
 The methods, named as the math:
 
