@@ -56,16 +56,16 @@ def cosine_power_pdf(exponent):
 
 
 def ggx_h_sample(rng, n, alpha_x, alpha_y):
-    return mf.ggx_sample(rng.random(n), rng.random(n), alpha_x, alpha_y)
+    return mf.GGX(alpha_x, alpha_y).sample(rng.random(n), rng.random(n))
 
 
 def ggx_h_pdf(alpha_x, alpha_y):
-    return lambda h: mf.ggx_pdf(h, alpha_x, alpha_y)
+    return lambda h: mf.GGX(alpha_x, alpha_y).pdf(h)
 
 
 def visible_wi_sample(rng, n, wo, alpha_x, alpha_y):
     """wi reflected about Heitz's visible normals: some land below the horizon."""
-    h = mf.ggx_sample_visible(wo, rng.random(n), rng.random(n), alpha_x, alpha_y)
+    h = mf.GGX(alpha_x, alpha_y).sample_visible(wo, rng.random(n), rng.random(n))
     return reflect(wo, h)
 
 
@@ -76,7 +76,7 @@ def visible_wi_pdf(wo, alpha_x, alpha_y, lower=False):
     def pdf(w):
         w = w * np.array([1.0, 1.0, -1.0]) if lower else w
         h = half_vector(w, wo)
-        return mf.ggx_pdf_visible(h, wo, alpha_x, alpha_y) / (4.0 * np.sum(wo * h, axis=-1))
+        return mf.GGX(alpha_x, alpha_y).pdf_visible(h, wo) / (4.0 * np.sum(wo * h, axis=-1))
 
     return pdf
 

@@ -32,7 +32,8 @@ ISAS = pb.cpu_info()["available"]
 ARGUMENT_NAMES = ("wi", "wo", "u", "out", "material", "model", "layout", "threads", "check", "cosine", "isa",
                   "seed", "specular_sampler", "n", "first", "samples", "cos_theta_o", "resolution", "light",
                   "light_intensity", "ambient", "leading shapes", "h", "w", "u1", "u2", "alpha", "alpha_x",
-                  "alpha_y", "gamma", "cos_theta_h", "closed_forms", "params", "energy_compensation", "wrt",
+                  "alpha_y", "gamma", "p", "approximation", "correlated", "closed_forms", "params",
+                  "energy_compensation", "wrt",
                   "out[0]", "out[1]", "measured", "weights", "bounds", "fit", "init", "loss", "max_iterations",
                   "precision", "normal", "tangent", "frame", "theta", "phi", "theta_h", "phi_h", "theta_d", "phi_d",
                   "color", "linear", "exposure", "curve", "table", "brdf", "interpolation", "theta_o", "phi_d",
@@ -368,44 +369,67 @@ def test_fuzz_reference(data, leading, seed, entry):
             assert np.isfinite(array).all()
 
 
-TOOLKIT = {
-    "gtr_d": ("cos_theta_h", "alpha", "gamma"),
-    "gtr_pdf": ("h", "alpha", "gamma"),
-    "gtr_sample": ("u1", "u2", "alpha", "gamma"),
-    "ggx_d": ("h", "alpha_x", "alpha_y"),
-    "ggx_pdf": ("h", "alpha_x", "alpha_y"),
-    "ggx_sample": ("u1", "u2", "alpha_x", "alpha_y"),
-    "ggx_sample_visible": ("wo", "u1", "u2", "alpha_x", "alpha_y"),
-    "ggx_pdf_visible": ("h", "wo", "alpha_x", "alpha_y"),
-    "ggx_lambda": ("w", "alpha_x", "alpha_y"),
-    "ggx_g1": ("w", "alpha_x", "alpha_y"),
-    "ggx_g2_separable": ("wi", "wo", "alpha_x", "alpha_y"),
-    "ggx_g2_height_correlated": ("wi", "wo", "alpha_x", "alpha_y"),
-    "beckmann_d": ("h", "alpha_x", "alpha_y"),
-    "beckmann_pdf": ("h", "alpha_x", "alpha_y"),
-    "beckmann_sample": ("u1", "u2", "alpha_x", "alpha_y"),
-    "beckmann_lambda": ("w", "alpha_x", "alpha_y"),
-    "beckmann_g1": ("w", "alpha_x", "alpha_y"),
-}
+# the toolkit's types: each constructor's parameters and each method's arguments
+TOOLKIT_TYPES = {"GGX": ("alpha_x", "alpha_y"), "Beckmann": ("alpha_x", "alpha_y"), "BlinnPhong": ("alpha_x", "alpha_y"),
+                 "StudentT": ("alpha_x", "alpha_y", "gamma"), "ExponentialPower": ("alpha_x", "alpha_y", "p"),
+                 "GTR": ("alpha", "gamma")}
+TOOLKIT_METHODS = {"d": ("h",), "pdf": ("h",), "sample": ("u1", "u2"), "lambda_": ("w",), "g1": ("w",),
+                   "g2": ("wi", "wo"), "pdf_visible": ("h", "wo"), "sample_visible": ("wo", "u1", "u2"),
+                   "g2_over_4cos": ("wi", "wo")}
+TOOLKIT = {f"{type_name}.{method}": (parameters, TOOLKIT_METHODS[method])
+           for type_name, parameters in TOOLKIT_TYPES.items() for method in TOOLKIT_METHODS
+           if hasattr(getattr(pb.microfacet, type_name), method)}
+KEYWORD_ONLY = {("StudentT", "gamma"), ("ExponentialPower", "p")}
+# the options, good and bad: of the constructors, then of the methods
+TOOLKIT_OPTIONS = {"Beckmann": ("approximation", (None, "walter", "karis", 1)),
+                   "GTR": ("closed_forms", (True, False, 1, None)),
+                   "g2": ("correlated", (True, False, "yes", None)),
+                   "g2_over_4cos": ("approximation", (None, "karis", "hammon", "walter", 3))}
 SCALAR_VALUES = (0.5, 1.0, 1e-6, 0.0, -0.5, 1.5, np.nan, np.inf, "a", None, 1e300)
+
+
+def toolkit_value(data, rng, leading, type_name, argument):
+    if argument in ("h", "w", "wi", "wo"):
+        return data.draw(direction_argument(leading, rng))
+    if data.draw(st.booleans()):
+        values = rng.random(leading) * 0.98 + 0.01
+        if (type_name, argument) == ("StudentT", "gamma"):
+            values = 1.6 + 4.0 * values  # in its domain (3/2, 1e12]
+        elif argument == "p":
+            values = 0.1 + 4.0 * values  # in its domain [0.1, 10]
+        return convert(values, data.draw(st.sampled_from(DTYPES[:4])), data.draw(st.sampled_from(LAYOUT_FAULTS)))
+    value = data.draw(st.sampled_from(SCALAR_VALUES))
+    if argument == "gamma" and isinstance(value, float) and value == 0.5:
+        value = 2.0
+    return value
+
+
+def toolkit_option(data, key):
+    if key not in TOOLKIT_OPTIONS or not data.draw(st.booleans()):
+        return {}
+    name, values = TOOLKIT_OPTIONS[key]
+    return {name: data.draw(st.sampled_from(values))}
 
 
 @FUZZ
 @given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1), name=st.sampled_from(sorted(TOOLKIT)))
 def test_fuzz_toolkit(data, leading, seed, name):
     rng = rng_from(seed)
-    arguments = []
-    for argument in TOOLKIT[name]:
-        if argument in ("h", "w", "wi", "wo"):
-            arguments.append(data.draw(direction_argument(leading, rng)))
-        elif data.draw(st.booleans()):
-            arguments.append(convert(rng.random(leading) * 0.98 + 0.01, data.draw(st.sampled_from(DTYPES[:4])),
-                                     data.draw(st.sampled_from(LAYOUT_FAULTS))))
+    type_name, method = name.split(".")
+    parameters, arguments = TOOLKIT[name]
+    positional, keywords = [], toolkit_option(data, type_name)
+    for parameter in parameters:
+        value = toolkit_value(data, rng, leading, type_name, parameter)
+        if (type_name, parameter) in KEYWORD_ONLY:
+            keywords[parameter] = value
         else:
-            arguments.append(data.draw(st.sampled_from(SCALAR_VALUES)))
-    if TOOLKIT[name][-1] == "gamma" and isinstance(arguments[-1], float) and arguments[-1] == 0.5:
-        arguments[-1] = 2.0
-    result = outcome(lambda: getattr(pb.microfacet, name)(*arguments))
+            positional.append(value)
+    values = [toolkit_value(data, rng, leading, type_name, argument) for argument in arguments]
+    options = toolkit_option(data, method)
+    distribution = outcome(lambda: getattr(pb.microfacet, type_name)(*positional, **keywords))
+    if distribution is None:
+        return
+    result = outcome(lambda: getattr(distribution, method)(*values, **options))
     if result is not None:
         assert np.isfinite(result).all()
 

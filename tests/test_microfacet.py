@@ -90,6 +90,12 @@ def direction(theta_deg, phi=0.0):
     return np.array([np.sin(t) * np.cos(phi), np.sin(t) * np.sin(phi), np.cos(t)])
 
 
+def half_vector(cos_theta_h):
+    """Half vectors ``(..., 3)`` in the xz plane at the polar cosines given (GTR's D reads cos θh only)."""
+    c = np.asarray(cos_theta_h, dtype=np.float64)
+    return np.stack([np.sqrt(np.maximum(0.0, 1.0 - c * c)), np.zeros_like(c), c], axis=-1)
+
+
 # --------------------------------------------------------------------------
 # normalization: ∫ D(h) cos θh dω_h = 1 (stated bound 1e-4; the quadrature reaches ~1e-15)
 
@@ -104,34 +110,34 @@ ANISO_ALPHAS = [(0.05, 0.05), (0.5, 0.05), (0.05, 0.5), (1.0, 0.1), (0.3, 0.03),
 @pytest.mark.parametrize("gamma", GTR_GAMMAS)
 def test_gtr_normalised(gamma, closed_forms):
     for alpha in GTR_ALPHAS:
-        via_h = hemisphere_integral(lambda h: mf.gtr_pdf(h, alpha, gamma, closed_forms=closed_forms), alpha, alpha,
+        via_h = hemisphere_integral(lambda h: mf.GTR(alpha, gamma, closed_forms=closed_forms).pdf(h), alpha, alpha,
                                     n_psi=4)
         assert abs(via_h - 1.0) < NORMALISATION_TOLERANCE, (alpha, via_h)
-        # the cosine interface: 2π ∫ D(cos θ) cos θ sin θ dθ
+        # D itself, which reads cos θh only: 2π ∫ D(cos θ) cos θ sin θ dθ
         h, weight = hemisphere_nodes(alpha, alpha, n_psi=1)
-        via_cos = np.sum(mf.gtr_d(h[..., 2], alpha, gamma, closed_forms=closed_forms) * h[..., 2] * weight)
+        via_cos = np.sum(mf.GTR(alpha, gamma, closed_forms=closed_forms).d(h) * h[..., 2] * weight)
         assert abs(via_cos - 1.0) < 1e-7, (alpha, via_cos)  # cos θ near 1 carries less of θ
 
 
 @pytest.mark.parametrize("alpha_x, alpha_y", ANISO_ALPHAS)
 def test_ggx_normalised(alpha_x, alpha_y):
-    total = hemisphere_integral(lambda h: mf.ggx_pdf(h, alpha_x, alpha_y), alpha_x, alpha_y)
+    total = hemisphere_integral(lambda h: mf.GGX(alpha_x, alpha_y).pdf(h), alpha_x, alpha_y)
     assert abs(total - 1.0) < NORMALISATION_TOLERANCE
-    total_d = hemisphere_integral(lambda h: mf.ggx_d(h, alpha_x, alpha_y) * h[..., 2], alpha_x, alpha_y)
+    total_d = hemisphere_integral(lambda h: mf.GGX(alpha_x, alpha_y).d(h) * h[..., 2], alpha_x, alpha_y)
     assert abs(total_d - 1.0) < NORMALISATION_TOLERANCE
 
 
 @pytest.mark.parametrize("alpha_x, alpha_y", ANISO_ALPHAS)
 def test_beckmann_normalised(alpha_x, alpha_y):
-    total = hemisphere_integral(lambda h: mf.beckmann_pdf(h, alpha_x, alpha_y), alpha_x, alpha_y)
+    total = hemisphere_integral(lambda h: mf.Beckmann(alpha_x, alpha_y).pdf(h), alpha_x, alpha_y)
     assert abs(total - 1.0) < NORMALISATION_TOLERANCE
-    total_d = hemisphere_integral(lambda h: mf.beckmann_d(h, alpha_x, alpha_y) * h[..., 2], alpha_x, alpha_y)
+    total_d = hemisphere_integral(lambda h: mf.Beckmann(alpha_x, alpha_y).d(h) * h[..., 2], alpha_x, alpha_y)
     assert abs(total_d - 1.0) < NORMALISATION_TOLERANCE
 
 
 def test_quadrature_is_not_blind():
     # a 1e-6 slip in a normaliser must show: the rule integrates a mis-scaled D to its scale
-    total = hemisphere_integral(lambda h: 1.000001 * mf.ggx_pdf(h, 0.5, 0.05), 0.5, 0.05)
+    total = hemisphere_integral(lambda h: 1.000001 * mf.GGX(0.5, 0.05).pdf(h), 0.5, 0.05)
     assert abs(total - 1.000001) < 1e-12
 
 
@@ -154,10 +160,10 @@ def furnace_tolerance(theta_deg):
 def test_ggx_weak_white_furnace(alpha_x, alpha_y):
     for theta_deg, phi in FURNACE_VIEWS:
         wo = direction(theta_deg, phi)
-        g1 = float(mf.ggx_g1(wo, alpha_x, alpha_y))
+        g1 = float(mf.GGX(alpha_x, alpha_y).g1(wo))
 
         def integrand(h):
-            return g1 * mf.ggx_d(h, alpha_x, alpha_y) * np.maximum(0.0, h @ wo) / abs(wo[2])
+            return g1 * mf.GGX(alpha_x, alpha_y).d(h) * np.maximum(0.0, h @ wo) / abs(wo[2])
 
         total = hemisphere_integral(integrand, alpha_x, alpha_y, n_psi=384, kink=horizon_of(wo))
         assert abs(total - 1.0) < furnace_tolerance(theta_deg), (theta_deg, phi, total)
@@ -168,10 +174,10 @@ def test_beckmann_weak_white_furnace(alpha_x, alpha_y):
     # holds only with the exact Λ of eq. (3-30): the rational fit (3-31) misses by ~1e-3
     for theta_deg, phi in FURNACE_VIEWS[:-2]:
         wo = direction(theta_deg, phi)
-        g1 = float(mf.beckmann_g1(wo, alpha_x, alpha_y))
+        g1 = float(mf.Beckmann(alpha_x, alpha_y).g1(wo))
 
         def integrand(h):
-            return g1 * mf.beckmann_d(h, alpha_x, alpha_y) * np.maximum(0.0, h @ wo) / abs(wo[2])
+            return g1 * mf.Beckmann(alpha_x, alpha_y).d(h) * np.maximum(0.0, h @ wo) / abs(wo[2])
 
         total = hemisphere_integral(integrand, alpha_x, alpha_y, n_psi=384, kink=horizon_of(wo))
         assert abs(total - 1.0) < furnace_tolerance(theta_deg), (theta_deg, phi, total)
@@ -199,7 +205,7 @@ def test_ggx_weak_white_furnace_over_wi(alpha_x, alpha_y, theta_deg):
     wi, weight = sphere_nodes(wo)
     half = wi + wo
     half /= np.linalg.norm(half, axis=-1, keepdims=True)
-    value = mf.ggx_g1(wo, alpha_x, alpha_y) * mf.ggx_d(half, alpha_x, alpha_y) / (4.0 * abs(wo[2]))
+    value = mf.GGX(alpha_x, alpha_y).g1(wo) * mf.GGX(alpha_x, alpha_y).d(half) / (4.0 * abs(wo[2]))
     assert abs(np.sum(value * weight) - 1.0) < 1e-4
 
 
@@ -209,7 +215,7 @@ def test_visible_normal_pdf_normalised(alpha_x, alpha_y):
     for wo in views:
         theta_deg = np.degrees(np.arccos(abs(wo[2])))
         mirrored = wo if wo[2] >= 0 else -wo  # the pdf serves a wo below the horizon as -wo
-        total = hemisphere_integral(lambda h: mf.ggx_pdf_visible(h, wo, alpha_x, alpha_y), alpha_x, alpha_y,
+        total = hemisphere_integral(lambda h: mf.GGX(alpha_x, alpha_y).pdf_visible(h, wo), alpha_x, alpha_y,
                                     n_psi=384, kink=horizon_of(mirrored))
         assert abs(total - 1.0) < furnace_tolerance(theta_deg), (wo, total)
 
@@ -234,22 +240,22 @@ def test_ggx_formulas(rng):
     ay = rng.uniform(0.01, 1.5, n)
 
     d = 1.0 / (np.pi * ax * ay * ((h[:, 0] / ax) ** 2 + (h[:, 1] / ay) ** 2 + h[:, 2] ** 2) ** 2)  # eq. (13)
-    np.testing.assert_allclose(mf.ggx_d(h, ax, ay), d, rtol=1e-13)
-    np.testing.assert_allclose(mf.ggx_pdf(h, ax, ay), d * h[:, 2], rtol=1e-13)
+    np.testing.assert_allclose(mf.GGX(ax, ay).d(h), d, rtol=1e-13)
+    np.testing.assert_allclose(mf.GGX(ax, ay).pdf(h), d * h[:, 2], rtol=1e-13)
 
     def lam(v):  # docs/model.md, "The model", literally
         return (-1.0 + np.sqrt(1.0 + ((ax * v[:, 0]) ** 2 + (ay * v[:, 1]) ** 2) / v[:, 2] ** 2)) / 2.0
 
-    np.testing.assert_allclose(mf.ggx_lambda(w, ax, ay), lam(w), rtol=1e-10)
-    np.testing.assert_allclose(mf.ggx_g1(w, ax, ay), 1.0 / (1.0 + lam(w)), rtol=1e-13)
-    np.testing.assert_allclose(mf.ggx_g2_separable(wi, w, ax, ay), 1.0 / ((1 + lam(wi)) * (1 + lam(w))), rtol=1e-13)
-    np.testing.assert_allclose(mf.ggx_g2_height_correlated(wi, w, ax, ay), 1.0 / (1 + lam(wi) + lam(w)), rtol=1e-13)
+    np.testing.assert_allclose(mf.GGX(ax, ay).lambda_(w), lam(w), rtol=1e-10)
+    np.testing.assert_allclose(mf.GGX(ax, ay).g1(w), 1.0 / (1.0 + lam(w)), rtol=1e-13)
+    np.testing.assert_allclose(mf.GGX(ax, ay).g2(wi, w, correlated=False), 1.0 / ((1 + lam(wi)) * (1 + lam(w))), rtol=1e-13)
+    np.testing.assert_allclose(mf.GGX(ax, ay).g2(wi, w), 1.0 / (1 + lam(wi) + lam(w)), rtol=1e-13)
     visible = (1.0 / (1.0 + lam(w))) * np.maximum(0.0, np.sum(w * h, axis=-1)) * d / w[:, 2]
-    np.testing.assert_allclose(mf.ggx_pdf_visible(h, w, ax, ay), visible, rtol=1e-12, atol=1e-300)
+    np.testing.assert_allclose(mf.GGX(ax, ay).pdf_visible(h, w), visible, rtol=1e-12, atol=1e-300)
 
     # isotropic GGX is GTR with γ = 2
     iso = ax <= 1.0
-    np.testing.assert_allclose(mf.ggx_d(h[iso], ax[iso], ax[iso]) * h[iso, 2], mf.gtr_pdf(h[iso], ax[iso], 2.0),
+    np.testing.assert_allclose(mf.GGX(ax[iso], ax[iso]).d(h[iso]) * h[iso, 2], mf.GTR(ax[iso], 2.0).pdf(h[iso]),
                                rtol=1e-13)
 
 
@@ -261,12 +267,12 @@ def test_beckmann_formulas(rng):
     cos2 = h[:, 2] ** 2
     slope2 = (h[:, 0] / ax) ** 2 + (h[:, 1] / ay) ** 2
     d = np.exp(-slope2 / cos2) / (np.pi * ax * ay * cos2 * cos2)  # eq. (3-29), stretched
-    np.testing.assert_allclose(mf.beckmann_d(h, ax, ay), d, rtol=1e-12, atol=1e-290)
-    np.testing.assert_allclose(mf.beckmann_pdf(h, ax, ay), d * h[:, 2], rtol=1e-12, atol=1e-290)
+    np.testing.assert_allclose(mf.Beckmann(ax, ay).d(h), d, rtol=1e-12, atol=1e-290)
+    np.testing.assert_allclose(mf.Beckmann(ax, ay).pdf(h), d * h[:, 2], rtol=1e-12, atol=1e-290)
     # isotropic: the seed's form with cos θ only
     alpha = ax
     d_iso = np.exp((cos2 - 1.0) / (alpha ** 2 * cos2)) / (np.pi * alpha ** 2 * cos2 ** 2)
-    np.testing.assert_allclose(mf.beckmann_d(h, alpha, alpha), d_iso, rtol=1e-9, atol=1e-290)
+    np.testing.assert_allclose(mf.Beckmann(alpha, alpha).d(h), d_iso, rtol=1e-9, atol=1e-290)
 
 
 def test_beckmann_lambda_exact():
@@ -279,13 +285,13 @@ def test_beckmann_lambda_exact():
         w = np.array([np.sin(np.arctan(tan_theta)), 0.0, np.cos(np.arctan(tan_theta))])
         a_exact = mpmath.mpf(w[2]) / (alpha * mpmath.mpf(w[0]))
         lam = (mpmath.erf(a_exact) - 1) / 2 + mpmath.exp(-a_exact ** 2) / (2 * a_exact * mpmath.sqrt(mpmath.pi))
-        got = float(mf.beckmann_lambda(w, alpha))
+        got = float(mf.Beckmann(alpha).lambda_(w))
         tolerance = 1e-13 * (1.0 + 2.0 * a * a)  # (erf - 1) and exp(-a²)/… cancel by ~2a²
         assert abs(got - float(lam)) <= tolerance * float(lam), (a, got, float(lam))
-        assert float(mf.beckmann_g1(w, alpha)) == pytest.approx(float(1 / (1 + lam)), rel=1e-14)
-    assert float(mf.beckmann_lambda([0.0, 0.0, 1.0], 0.3)) == 0.0
-    assert float(mf.beckmann_lambda([1.0, 0.0, 0.0], 0.3)) == np.inf
-    assert float(mf.beckmann_g1([1.0, 0.0, 0.0], 0.3)) == 0.0
+        assert float(mf.Beckmann(alpha).g1(w)) == pytest.approx(float(1 / (1 + lam)), rel=1e-14)
+    assert float(mf.Beckmann(0.3).lambda_([0.0, 0.0, 1.0])) == 0.0
+    assert float(mf.Beckmann(0.3).lambda_([1.0, 0.0, 0.0])) == np.inf
+    assert float(mf.Beckmann(0.3).g1([1.0, 0.0, 0.0])) == 0.0
 
 
 def gtr_d_exact(mpmath, cos_theta, alpha, gamma):
@@ -311,7 +317,7 @@ def test_gtr_d_accurate_near_singular_points(closed_forms):
     cosines = (0.0, 0.3, 0.9, 0.999, 1.0)
     for gamma in NEAR_SINGULAR_GAMMAS:
         for alpha in NEAR_SINGULAR_ALPHAS:
-            got = mf.gtr_d(np.array(cosines), alpha, gamma, closed_forms=closed_forms)
+            got = mf.GTR(alpha, gamma, closed_forms=closed_forms).d(half_vector(cosines))
             for c, value in zip(cosines, got):
                 if c == 0.0:
                     assert value == 0.0  # D is 0 for h·n <= 0, the horizon included
@@ -326,8 +332,8 @@ def test_gtr_closed_forms_match_general_formula():
     c = np.linspace(0.0, 1.0, 101)
     for gamma in (1.0, 1.5, 2.0):
         for alpha in NEAR_SINGULAR_ALPHAS:
-            closed = mf.gtr_d(c, alpha, gamma)
-            general = mf.gtr_d(c, alpha, gamma, closed_forms=False)
+            closed = mf.GTR(alpha, gamma).d(half_vector(c))
+            general = mf.GTR(alpha, gamma, closed_forms=False).d(half_vector(c))
             np.testing.assert_allclose(general, closed, rtol=1e-13)
             # the seed's closed forms written out literally (away from α = 1, where (4) is 0/0, and
             # from tiny α, where 1 + (α²-1) cos²θh cancels)
@@ -345,16 +351,16 @@ def test_gtr_continuous_in_gamma_and_alpha():
     c = np.linspace(0.0, 1.0, 41)
     for gamma in (1.0, 1.5, 2.0):
         for alpha in (0.01, 0.1, 0.5, 0.9):
-            at = mf.gtr_d(c, alpha, gamma)
+            at = mf.GTR(alpha, gamma).d(half_vector(c))
             for delta in (1e-7, 1e-12):
                 # |d ln D / dγ| <= |ln t| + |ln α²| + 1
                 bound = delta * (2.0 + 4.0 * abs(np.log(alpha)))
                 for side in (-1.0, 1.0):
-                    np.testing.assert_allclose(mf.gtr_d(c, alpha, gamma + side * delta), at, rtol=bound)
+                    np.testing.assert_allclose(mf.GTR(alpha, gamma + side * delta).d(half_vector(c)), at, rtol=bound)
     for gamma in (0.3, 1.0, 1.0 + 1e-9, 1.5, 2.0, 3.0):
         for eps in (1e-6, 1e-12, 0.0):
-            np.testing.assert_allclose(mf.gtr_d(c[1:], 1.0 - eps, gamma), 1.0 / np.pi, rtol=10 * eps * gamma + 1e-15)
-        np.testing.assert_allclose(mf.gtr_d(c[1:], 1.0, gamma, closed_forms=False), 1.0 / np.pi, rtol=1e-15)
+            np.testing.assert_allclose(mf.GTR(1.0 - eps, gamma).d(half_vector(c[1:])), 1.0 / np.pi, rtol=10 * eps * gamma + 1e-15)
+        np.testing.assert_allclose(mf.GTR(1.0, gamma, closed_forms=False).d(half_vector(c[1:])), 1.0 / np.pi, rtol=1e-15)
 
 
 def gtr_cos2_exact(mpmath, u2, alpha, gamma):
@@ -374,7 +380,7 @@ def test_gtr_sample_accurate_near_singular_points(closed_forms):
     u2 = np.array([0.0, 1e-9, 0.01, 0.3, 0.5, 0.9, 0.999999, 1.0])
     for gamma in NEAR_SINGULAR_GAMMAS:
         for alpha in NEAR_SINGULAR_ALPHAS:
-            h = mf.gtr_sample(0.1, u2, alpha, gamma, closed_forms=closed_forms)
+            h = mf.GTR(alpha, gamma, closed_forms=closed_forms).sample(0.1, u2)
             np.testing.assert_allclose(np.linalg.norm(h, axis=-1), 1.0, rtol=1e-15)
             for u, hv in zip(u2, h):
                 if u == 0.0:
@@ -398,9 +404,9 @@ def test_height_correlated_g2_at_least_separable(rng):
     wi[:200, :2] /= np.linalg.norm(wi[:200, :2], axis=-1, keepdims=True)
     ax = np.exp(rng.uniform(np.log(1e-4), np.log(3.0), n))
     ay = np.exp(rng.uniform(np.log(1e-4), np.log(3.0), n))
-    separable = mf.ggx_g2_separable(wi, wo, ax, ay)
-    correlated = mf.ggx_g2_height_correlated(wi, wo, ax, ay)
-    g1i, g1o = mf.ggx_g1(wi, ax, ay), mf.ggx_g1(wo, ax, ay)
+    separable = mf.GGX(ax, ay).g2(wi, wo, correlated=False)
+    correlated = mf.GGX(ax, ay).g2(wi, wo)
+    g1i, g1o = mf.GGX(ax, ay).g1(wi), mf.GGX(ax, ay).g1(wo)
     assert np.all(correlated >= separable * (1.0 - 1e-15))
     assert np.all(correlated <= np.minimum(g1i, g1o) * (1.0 + 1e-15))
     assert np.all((separable >= 0.0) & (correlated >= 0.0) & (correlated <= 1.0))
@@ -409,15 +415,15 @@ def test_height_correlated_g2_at_least_separable(rng):
 
 def test_smith_at_the_normal_and_grazing():
     n, x = [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]
-    assert float(mf.ggx_lambda(n, 0.3, 0.1)) == 0.0 and float(mf.ggx_g1(n, 0.3, 0.1)) == 1.0
-    assert float(mf.ggx_lambda(x, 0.3, 0.1)) == np.inf and float(mf.ggx_g1(x, 0.3, 0.1)) == 0.0
+    assert float(mf.GGX(0.3, 0.1).lambda_(n)) == 0.0 and float(mf.GGX(0.3, 0.1).g1(n)) == 1.0
+    assert float(mf.GGX(0.3, 0.1).lambda_(x)) == np.inf and float(mf.GGX(0.3, 0.1).g1(x)) == 0.0
     # Λ ≈ α sinθ / (2 cosθ) close to grazing: finite, no overflow, no cancellation
     tiny = 1e-200
     w = [np.sqrt(1.0 - tiny * tiny), 0.0, tiny]
-    assert float(mf.ggx_lambda(w, 0.3, 0.1)) == pytest.approx(0.3 / (2.0 * tiny), rel=1e-14)
+    assert float(mf.GGX(0.3, 0.1).lambda_(w)) == pytest.approx(0.3 / (2.0 * tiny), rel=1e-14)
     # visible-normal density stays finite for a grazing wo
-    h = mf.ggx_sample_visible(x, 0.3, 0.4, 0.3, 0.1)
-    assert np.isfinite(mf.ggx_pdf_visible(h, x, 0.3, 0.1)) and float(mf.ggx_pdf_visible(h, x, 0.3, 0.1)) > 0.0
+    h = mf.GGX(0.3, 0.1).sample_visible(x, 0.3, 0.4)
+    assert np.isfinite(mf.GGX(0.3, 0.1).pdf_visible(h, x)) and float(mf.GGX(0.3, 0.1).pdf_visible(h, x)) > 0.0
 
 
 # --------------------------------------------------------------------------
@@ -521,8 +527,8 @@ def test_chi_square_is_not_blind(rng):
     # samples of α = 0.3 must fail against the pdf of α = 0.31 (and γ = 1 against γ = 1.05)
     u1, u2 = uniforms(rng, 200_000)
     for h, pdf, stretch in [
-        (mf.ggx_sample(u1, u2, 0.3, 0.3), lambda v: mf.ggx_pdf(v, 0.31, 0.31), 0.31),
-        (mf.gtr_sample(u1, u2, 0.2, 1.0), lambda v: mf.gtr_pdf(v, 0.2, 1.05), 0.2),
+        (mf.GGX(0.3, 0.3).sample(u1, u2), lambda v: mf.GGX(0.31, 0.31).pdf(v), 0.31),
+        (mf.GTR(0.2, 1.0).sample(u1, u2), lambda v: mf.GTR(0.2, 1.05).pdf(v), 0.2),
     ]:
         with pytest.raises(AssertionError):
             check_sampler(h, pdf, stretch, stretch)
@@ -535,47 +541,47 @@ def uniforms(rng, n):
 @pytest.mark.parametrize("alpha, gamma, closed_forms", GTR_SAMPLER_CASES)
 def test_gtr_sampler_matches_pdf(rng, alpha, gamma, closed_forms):
     u1, u2 = uniforms(rng, 200_000)
-    h = mf.gtr_sample(u1, u2, alpha, gamma, closed_forms=closed_forms)
-    check_sampler(h, lambda v: mf.gtr_pdf(v, alpha, gamma, closed_forms=closed_forms), alpha, alpha)
+    h = mf.GTR(alpha, gamma, closed_forms=closed_forms).sample(u1, u2)
+    check_sampler(h, lambda v: mf.GTR(alpha, gamma, closed_forms=closed_forms).pdf(v), alpha, alpha)
 
 
 @pytest.mark.parametrize("alpha_x, alpha_y", ANISO_SAMPLER_ALPHAS)
 def test_ggx_sampler_matches_pdf(rng, alpha_x, alpha_y):
     u1, u2 = uniforms(rng, 200_000)
-    h = mf.ggx_sample(u1, u2, alpha_x, alpha_y)
-    check_sampler(h, lambda v: mf.ggx_pdf(v, alpha_x, alpha_y), alpha_x, alpha_y)
+    h = mf.GGX(alpha_x, alpha_y).sample(u1, u2)
+    check_sampler(h, lambda v: mf.GGX(alpha_x, alpha_y).pdf(v), alpha_x, alpha_y)
 
 
 @pytest.mark.parametrize("alpha_x, alpha_y", ANISO_SAMPLER_ALPHAS)
 def test_beckmann_sampler_matches_pdf(rng, alpha_x, alpha_y):
     u1, u2 = uniforms(rng, 200_000)
-    h = mf.beckmann_sample(u1, u2, alpha_x, alpha_y)
-    check_sampler(h, lambda v: mf.beckmann_pdf(v, alpha_x, alpha_y), alpha_x, alpha_y)
+    h = mf.Beckmann(alpha_x, alpha_y).sample(u1, u2)
+    check_sampler(h, lambda v: mf.Beckmann(alpha_x, alpha_y).pdf(v), alpha_x, alpha_y)
 
 
 @pytest.mark.parametrize("alpha_x, alpha_y, theta_deg, phi", VISIBLE_SAMPLER_CASES)
 def test_visible_normal_sampler_matches_pdf(rng, alpha_x, alpha_y, theta_deg, phi):
     wo = direction(theta_deg, phi)
     u1, u2 = uniforms(rng, 200_000)
-    h = mf.ggx_sample_visible(wo, u1, u2, alpha_x, alpha_y)
+    h = mf.GGX(alpha_x, alpha_y).sample_visible(wo, u1, u2)
     mirrored = wo if wo[2] >= 0 else -wo
     assert np.all(h @ mirrored >= -1e-15)  # only visible normals
-    check_sampler(h, lambda v: mf.ggx_pdf_visible(v, wo, alpha_x, alpha_y), alpha_x, alpha_y)
+    check_sampler(h, lambda v: mf.GGX(alpha_x, alpha_y).pdf_visible(v, wo), alpha_x, alpha_y)
 
 
 EQUAL_AREA_SAMPLERS = {
-    "gtr-1": (lambda a, b: mf.gtr_sample(a, b, 0.5, 1.0), lambda v: mf.gtr_pdf(v, 0.5, 1.0)),
-    "gtr-1.5": (lambda a, b: mf.gtr_sample(a, b, 0.5, 1.5), lambda v: mf.gtr_pdf(v, 0.5, 1.5)),
-    "gtr-2": (lambda a, b: mf.gtr_sample(a, b, 0.5, 2.0), lambda v: mf.gtr_pdf(v, 0.5, 2.0)),
-    "gtr-3": (lambda a, b: mf.gtr_sample(a, b, 0.5, 3.0), lambda v: mf.gtr_pdf(v, 0.5, 3.0)),
-    "ggx": (lambda a, b: mf.ggx_sample(a, b, 0.8, 0.08), lambda v: mf.ggx_pdf(v, 0.8, 0.08)),
-    "beckmann": (lambda a, b: mf.beckmann_sample(a, b, 0.8, 0.08), lambda v: mf.beckmann_pdf(v, 0.8, 0.08)),
-    "visible-0": (lambda a, b: mf.ggx_sample_visible(direction(0.0), a, b, 0.6, 0.2),
-                  lambda v: mf.ggx_pdf_visible(v, direction(0.0), 0.6, 0.2)),
-    "visible-60": (lambda a, b: mf.ggx_sample_visible(direction(60.0, 0.5), a, b, 0.6, 0.2),
-                   lambda v: mf.ggx_pdf_visible(v, direction(60.0, 0.5), 0.6, 0.2)),
-    "visible-85": (lambda a, b: mf.ggx_sample_visible(direction(85.0, 1.0), a, b, 0.6, 0.2),
-                   lambda v: mf.ggx_pdf_visible(v, direction(85.0, 1.0), 0.6, 0.2)),
+    "gtr-1": (lambda a, b: mf.GTR(0.5, 1.0).sample(a, b), lambda v: mf.GTR(0.5, 1.0).pdf(v)),
+    "gtr-1.5": (lambda a, b: mf.GTR(0.5, 1.5).sample(a, b), lambda v: mf.GTR(0.5, 1.5).pdf(v)),
+    "gtr-2": (lambda a, b: mf.GTR(0.5, 2.0).sample(a, b), lambda v: mf.GTR(0.5, 2.0).pdf(v)),
+    "gtr-3": (lambda a, b: mf.GTR(0.5, 3.0).sample(a, b), lambda v: mf.GTR(0.5, 3.0).pdf(v)),
+    "ggx": (lambda a, b: mf.GGX(0.8, 0.08).sample(a, b), lambda v: mf.GGX(0.8, 0.08).pdf(v)),
+    "beckmann": (lambda a, b: mf.Beckmann(0.8, 0.08).sample(a, b), lambda v: mf.Beckmann(0.8, 0.08).pdf(v)),
+    "visible-0": (lambda a, b: mf.GGX(0.6, 0.2).sample_visible(direction(0.0), a, b),
+                  lambda v: mf.GGX(0.6, 0.2).pdf_visible(v, direction(0.0))),
+    "visible-60": (lambda a, b: mf.GGX(0.6, 0.2).sample_visible(direction(60.0, 0.5), a, b),
+                   lambda v: mf.GGX(0.6, 0.2).pdf_visible(v, direction(60.0, 0.5))),
+    "visible-85": (lambda a, b: mf.GGX(0.6, 0.2).sample_visible(direction(85.0, 1.0), a, b),
+                   lambda v: mf.GGX(0.6, 0.2).pdf_visible(v, direction(85.0, 1.0))),
 }
 
 
@@ -590,15 +596,15 @@ def test_sampler_equal_area_grid(rng, case):
 def test_samplers_at_the_ends_of_the_unit_interval():
     u = np.array([0.0, 1e-300, 0.5, 1.0 - 2.0 ** -53, 1.0])
     u1, u2 = np.meshgrid(u, u)
-    for h in (mf.gtr_sample(u1, u2, 0.3, 1.0), mf.gtr_sample(u1, u2, 0.3, 2.7), mf.ggx_sample(u1, u2, 0.3, 0.03),
-              mf.beckmann_sample(u1, u2, 0.3, 0.03), mf.ggx_sample_visible([0.6, 0.0, 0.8], u1, u2, 0.3, 0.03),
-              mf.ggx_sample_visible([1.0, 0.0, 0.0], u1, u2, 0.3, 0.03)):
+    for h in (mf.GTR(0.3, 1.0).sample(u1, u2), mf.GTR(0.3, 2.7).sample(u1, u2), mf.GGX(0.3, 0.03).sample(u1, u2),
+              mf.Beckmann(0.3, 0.03).sample(u1, u2), mf.GGX(0.3, 0.03).sample_visible([0.6, 0.0, 0.8], u1, u2),
+              mf.GGX(0.3, 0.03).sample_visible([1.0, 0.0, 0.0], u1, u2)):
         assert h.shape == (5, 5, 3)
         assert np.all(np.isfinite(h)) and np.all(h[..., 2] >= 0.0)
         np.testing.assert_allclose(np.linalg.norm(h, axis=-1), 1.0, rtol=1e-15)
     # u2 = 0 is the normal and u2 = 1 the horizon for the distribution samplers
-    for sample in (lambda a, b: mf.gtr_sample(a, b, 0.3, 1.7), lambda a, b: mf.ggx_sample(a, b, 0.3, 0.5),
-                   lambda a, b: mf.beckmann_sample(a, b, 0.3, 0.5)):
+    for sample in (lambda a, b: mf.GTR(0.3, 1.7).sample(a, b), lambda a, b: mf.GGX(0.3, 0.5).sample(a, b),
+                   lambda a, b: mf.Beckmann(0.3, 0.5).sample(a, b)):
         np.testing.assert_array_equal(sample(0.3, 0.0), [0.0, 0.0, 1.0])
         assert sample(0.3, 1.0)[2] == pytest.approx(0.0, abs=1e-16)
 
@@ -613,14 +619,15 @@ def test_no_nan_or_inf_anywhere():
     cosines = np.array([-1.0, -1e-300, 0.0, 5e-324, 1e-150, 1e-8, 0.5, 1.0 - 1e-16, 1.0])
     u = np.array([0.0, 5e-324, 1e-300, 0.5, 1.0 - 2.0 ** -53, 1.0])
     grid = np.meshgrid(cosines, alphas, gammas, indexing="ij")
-    d = mf.gtr_d(*grid)
+    h_grid = half_vector(grid[0])
+    d = mf.GTR(grid[1], grid[2]).d(h_grid)
     assert np.all(np.isfinite(d)) and np.all(d >= 0.0)
-    assert np.all(np.isfinite(mf.gtr_d(*grid, closed_forms=False)))
+    assert np.all(np.isfinite(mf.GTR(grid[1], grid[2], closed_forms=False).d(h_grid)))
     ua, ub, a, g = np.meshgrid(u, u, alphas, gammas, indexing="ij")
     for closed in (True, False):
-        h = mf.gtr_sample(ua, ub, a, g, closed_forms=closed)
+        h = mf.GTR(a, g, closed_forms=closed).sample(ua, ub)
         assert np.all(np.isfinite(h))
-        assert np.all(np.isfinite(mf.gtr_pdf(h, a, g, closed_forms=closed)))
+        assert np.all(np.isfinite(mf.GTR(a, g, closed_forms=closed).pdf(h)))
 
     zs = np.array([-1.0, -0.5, -1e-300, 0.0, 5e-324, 1e-200, 1e-8, 0.3, 1.0 - 1e-16, 1.0])
     phis = np.array([0.0, 0.3, np.pi / 2, 2.0])
@@ -633,27 +640,27 @@ def test_no_nan_or_inf_anywhere():
     wi, wo = w[None, :, None, :], w[None, None, :, :]
     axx, ayy = ax[..., None], ay[..., None]
     for name, values in [
-        ("ggx_d", mf.ggx_d(w, ax, ay)),
-        ("ggx_pdf", mf.ggx_pdf(w, ax, ay)),
-        ("ggx_g1", mf.ggx_g1(w, ax, ay)),
-        ("ggx_g2_separable", mf.ggx_g2_separable(wi, wo, axx, ayy)),
-        ("ggx_g2_height_correlated", mf.ggx_g2_height_correlated(wi, wo, axx, ayy)),
-        ("ggx_pdf_visible", mf.ggx_pdf_visible(wi, wo, axx, ayy)),
-        ("beckmann_d", mf.beckmann_d(w, ax, ay)),
-        ("beckmann_pdf", mf.beckmann_pdf(w, ax, ay)),
-        ("beckmann_g1", mf.beckmann_g1(w, ax, ay)),
+        ("ggx_d", mf.GGX(ax, ay).d(w)),
+        ("ggx_pdf", mf.GGX(ax, ay).pdf(w)),
+        ("ggx_g1", mf.GGX(ax, ay).g1(w)),
+        ("ggx_g2_separable", mf.GGX(axx, ayy).g2(wi, wo, correlated=False)),
+        ("ggx_g2_height_correlated", mf.GGX(axx, ayy).g2(wi, wo)),
+        ("ggx_pdf_visible", mf.GGX(axx, ayy).pdf_visible(wi, wo)),
+        ("beckmann_d", mf.Beckmann(ax, ay).d(w)),
+        ("beckmann_pdf", mf.Beckmann(ax, ay).pdf(w)),
+        ("beckmann_g1", mf.Beckmann(ax, ay).g1(w)),
     ]:
         assert np.all(np.isfinite(values)), name
         assert np.all(values >= 0.0), name
-    for lam in (mf.ggx_lambda(w, ax, ay), mf.beckmann_lambda(w, ax, ay)):
+    for lam in (mf.GGX(ax, ay).lambda_(w), mf.Beckmann(ax, ay).lambda_(w)):
         assert not np.any(np.isnan(lam)) and np.all(lam >= 0.0)
         # +inf only where the true Λ ~ α sinθ / (2|cosθ|) is beyond the double range
         assert np.all(np.isfinite(lam) | (np.abs(np.broadcast_to(w[:, 2], lam.shape)) < 1e-290))
     u1, u2 = np.meshgrid(u, u)
     for a_x in ggx_alphas:
         for a_y in ggx_alphas:
-            for h in (mf.ggx_sample(u1, u2, a_x, a_y), mf.beckmann_sample(u1, u2, a_x, a_y),
-                      mf.ggx_sample_visible(w[:, None, None, :], u1, u2, a_x, a_y)):
+            for h in (mf.GGX(a_x, a_y).sample(u1, u2), mf.Beckmann(a_x, a_y).sample(u1, u2),
+                      mf.GGX(a_x, a_y).sample_visible(w[:, None, None, :], u1, u2)):
                 assert np.all(np.isfinite(h)), (a_x, a_y)
 
 
@@ -664,70 +671,73 @@ def test_no_nan_or_inf_anywhere():
 def test_broadcasting_and_shapes():
     c = np.linspace(0.0, 1.0, 4).reshape(4, 1)
     alpha = np.array([0.1, 0.5, 1.0])
-    d = mf.gtr_d(c, alpha, 2.0)
+    d = mf.GTR(alpha, 2.0).d(half_vector(c))
     assert d.shape == (4, 3) and d.dtype == np.float64
-    np.testing.assert_array_equal(d[2], [float(mf.gtr_d(c[2, 0], a, 2.0)) for a in alpha])
-    assert isinstance(mf.gtr_d(0.5, 0.5, 1.0), np.ndarray) and mf.gtr_d(0.5, 0.5, 1.0).shape == ()
-    assert mf.gtr_sample(0.1, 0.2, 0.3, 1.0).shape == (3,)
-    assert mf.gtr_sample([0.1, 0.2], [[0.2], [0.3], [0.4]], 0.3, 1.0).shape == (3, 2, 3)
-    h = mf.ggx_sample(np.full((2, 5), 0.3), 0.5, 0.2, np.array([0.1, 0.2, 0.3, 0.4, 0.5]))
+    np.testing.assert_array_equal(d[2], [float(mf.GTR(a, 2.0).d(half_vector(c[2, 0]))) for a in alpha])
+    assert isinstance(mf.GTR(0.5, 1.0).d(half_vector(0.5)), np.ndarray)
+    assert mf.GTR(0.5, 1.0).d(half_vector(0.5)).shape == ()
+    assert mf.GTR(0.3, 1.0).sample(0.1, 0.2).shape == (3,)
+    assert mf.GTR(0.3, 1.0).sample([0.1, 0.2], [[0.2], [0.3], [0.4]]).shape == (3, 2, 3)
+    h = mf.GGX(0.2, np.array([0.1, 0.2, 0.3, 0.4, 0.5])).sample(np.full((2, 5), 0.3), 0.5)
     assert h.shape == (2, 5, 3)
-    assert mf.ggx_d(h, 0.2, 0.1).shape == (2, 5)
-    assert mf.ggx_d(h[0, 0], np.array([0.1, 0.2]), 0.1).shape == (2,)
-    assert mf.ggx_pdf_visible(h, [0.0, 0.0, 1.0], 0.2, 0.1).shape == (2, 5)
-    assert mf.ggx_g2_separable(h[:, :1], h[:1, :], 0.2).shape == (2, 5)
-    assert mf.ggx_sample_visible(h, 0.5, 0.5, 0.3).shape == (2, 5, 3)
-    assert mf.beckmann_lambda(np.zeros((0, 3)), 0.3).shape == (0,)
-    assert mf.gtr_sample(np.zeros(0), 0.5, 0.3, 1.0).shape == (0, 3)
+    assert mf.GGX(0.2, 0.1).d(h).shape == (2, 5)
+    assert mf.GGX(np.array([0.1, 0.2]), 0.1).d(h[0, 0]).shape == (2,)
+    assert mf.GGX(0.2, 0.1).pdf_visible(h, [0.0, 0.0, 1.0]).shape == (2, 5)
+    assert mf.GGX(0.2).g2(h[:, :1], h[:1, :], correlated=False).shape == (2, 5)
+    assert mf.GGX(0.3).sample_visible(h, 0.5, 0.5).shape == (2, 5, 3)
+    assert mf.Beckmann(0.3).lambda_(np.zeros((0, 3))).shape == (0,)
+    assert mf.GTR(0.3, 1.0).sample(np.zeros(0), 0.5).shape == (0, 3)
     # alpha_y defaults to alpha_x; integer and list inputs are read as float64
-    np.testing.assert_array_equal(mf.ggx_d(h, 0.2), mf.ggx_d(h, 0.2, 0.2))
-    assert float(mf.ggx_g1([0, 0, 1], 1)) == 1.0
+    np.testing.assert_array_equal(mf.GGX(0.2).d(h), mf.GGX(0.2, 0.2).d(h))
+    assert float(mf.GGX(1).g1([0, 0, 1])) == 1.0
     # directions are normalised before use (length off by < 1e-3 is accepted)
-    np.testing.assert_allclose(mf.ggx_d([0.0, 0.0, 1.0005], 0.3), mf.ggx_d([0.0, 0.0, 1.0], 0.3), rtol=1e-15)
+    np.testing.assert_allclose(mf.GGX(0.3).d([0.0, 0.0, 1.0005]), mf.GGX(0.3).d([0.0, 0.0, 1.0]), rtol=1e-15)
     # non-contiguous and float32 inputs
     hh = np.ascontiguousarray(np.broadcast_to(h[..., None], h.shape + (2,)))[..., 0]
-    np.testing.assert_array_equal(mf.beckmann_d(hh, 0.2, 0.4), mf.beckmann_d(h, 0.2, 0.4))
-    np.testing.assert_array_equal(mf.gtr_d(np.float32(0.5), 0.5, 1.5), mf.gtr_d(0.5, 0.5, 1.5))
+    np.testing.assert_array_equal(mf.Beckmann(0.2, 0.4).d(hh), mf.Beckmann(0.2, 0.4).d(h))
+    h32 = np.array([0.484375, 0.0, 0.875], dtype=np.float32)  # exact in float32, of length 1 within 1.3e-4
+    np.testing.assert_array_equal(mf.GTR(0.5, 1.5).d(h32), mf.GTR(0.5, 1.5).d(h32.astype(np.float64)))
 
 
 BAD_INPUT = [
-    (lambda: mf.gtr_d(0.5, 0.0, 1.0), ValueError, "alpha"),
-    (lambda: mf.gtr_d(0.5, [0.5, 1.2], 1.0), ValueError, r"alpha\[1\]"),
-    (lambda: mf.gtr_d(0.5, 0.5, [[1.0, 2.0], [0.0, 1.0]]), ValueError, r"gamma\[1, 0\]"),
-    (lambda: mf.gtr_d(0.5, 0.5, -1.0), ValueError, "gamma"),
-    (lambda: mf.gtr_d(0.5, 0.5, 2e6), ValueError, "gamma"),
-    (lambda: mf.gtr_d(0.5, 0.5, np.nan), ValueError, "gamma"),
-    (lambda: mf.gtr_d([0.5, 1.5], 0.5, 1.0), ValueError, r"cos_theta_h\[1\]"),
-    (lambda: mf.gtr_d([0.5, np.inf], 0.5, 1.0), ValueError, r"cos_theta_h\[1\]"),
-    (lambda: mf.gtr_d("0.5", 0.5, 1.0), TypeError, "cos_theta_h"),
-    (lambda: mf.gtr_d(0.5, 0.5 + 0.1j, 1.0), TypeError, "alpha"),
-    (lambda: mf.gtr_d(0.5, None, 1.0), TypeError, "alpha"),
-    (lambda: mf.gtr_d(np.zeros(3), np.full(2, 0.5), 1.0), ValueError, "broadcast"),
-    (lambda: mf.gtr_sample(-0.1, 0.5, 0.5, 1.0), ValueError, "u1"),
-    (lambda: mf.gtr_sample(0.1, [0.5, 1.0 + 1e-12], 0.5, 1.0), ValueError, r"u2\[1\]"),
-    (lambda: mf.gtr_pdf([0.0, 0.0, 1.1], 0.5, 1.0), ValueError, "h"),
-    (lambda: mf.gtr_pdf([[0.0, 0.0, 1.0], [0.0, 0.0, 0.5]], 0.5, 1.0), ValueError, r"h\[1\]"),
-    (lambda: mf.ggx_d([0.0, 1.0], 0.5), ValueError, "h"),
-    (lambda: mf.ggx_d([0.0, 0.0, 1.0], -0.5), ValueError, "alpha_x"),
-    (lambda: mf.ggx_d([0.0, 0.0, 1.0], 0.5, [0.1, 0.0]), ValueError, r"alpha_y\[1\]"),
-    (lambda: mf.ggx_d([0.0, 0.0, 1.0], 0.5, np.inf), ValueError, "alpha_y"),
-    (lambda: mf.ggx_d([0.0, 0.0, 1.0], "rough"), TypeError, "alpha_x"),
-    (lambda: mf.ggx_d(np.array([["a", "b", "c"]]), 0.5), TypeError, "h"),
-    (lambda: mf.ggx_sample(0.5, 2.0, 0.5), ValueError, "u2"),
-    (lambda: mf.ggx_sample_visible([np.nan, 0.0, 1.0], 0.5, 0.5, 0.5), ValueError, r"wo"),
-    (lambda: mf.ggx_sample_visible([0.0, 0.0, 1.0], 0.5, -0.5, 0.5), ValueError, "u2"),
-    (lambda: mf.ggx_pdf_visible([0.0, 0.0, 1.0], [0.0, 0.0, 2.0], 0.5), ValueError, "wo"),
-    (lambda: mf.ggx_lambda([[0.0, 0.0, 1.0]] * 2 + [[1.0, 1.0, 1.0]], 0.5), ValueError, r"w\[2\]"),
-    (lambda: mf.ggx_g1([0.0, 0.0, 1.0], 0.0), ValueError, "alpha_x"),
-    (lambda: mf.ggx_g2_separable([0.0, 0.0, 1.0], [0.0, 0.0, 0.9], 0.5), ValueError, "wo"),
-    (lambda: mf.ggx_g2_height_correlated([0.0, 0.0, 0.9], [0.0, 0.0, 1.0], 0.5), ValueError, "wi"),
-    (lambda: mf.ggx_g2_height_correlated(np.zeros((2, 3)) + [0, 0, 1], np.zeros((3, 3)) + [0, 0, 1], 0.5),
+    (lambda: mf.GTR(0.0, 1.0).d([0.0, 0.0, 1.0]), ValueError, "alpha"),
+    (lambda: mf.GTR([0.5, 1.2], 1.0).d([0.0, 0.0, 1.0]), ValueError, r"alpha\[1\]"),
+    (lambda: mf.GTR(0.5, [[1.0, 2.0], [0.0, 1.0]]).d([0.0, 0.0, 1.0]), ValueError, r"gamma\[1, 0\]"),
+    (lambda: mf.GTR(0.5, -1.0).d([0.0, 0.0, 1.0]), ValueError, "gamma"),
+    (lambda: mf.GTR(0.5, 2e6).d([0.0, 0.0, 1.0]), ValueError, "gamma"),
+    (lambda: mf.GTR(0.5, np.nan).d([0.0, 0.0, 1.0]), ValueError, "gamma"),
+    (lambda: mf.GTR(0.5, 1.0).d([[0.0, 0.0, 1.0], [0.0, 0.0, 1.5]]), ValueError, r"h\[1\]"),
+    (lambda: mf.GTR(0.5, 1.0).d([[0.0, 0.0, 1.0], [np.inf, 0.0, 1.0]]), ValueError, r"h\[1, 0\]"),
+    (lambda: mf.GTR(0.5, 1.0).d("0.5"), TypeError, "h"),
+    (lambda: mf.GTR(0.5, 1.0).d(0.5), ValueError, r"h: expected shape \(\.\.\., 3\)"),
+    (lambda: mf.GTR(0.5 + 0.1j, 1.0).d([0.0, 0.0, 1.0]), TypeError, "alpha"),
+    (lambda: mf.GTR(None, 1.0).d([0.0, 0.0, 1.0]), TypeError, "alpha"),
+    (lambda: mf.GTR(np.full(2, 0.5), 1.0).d(np.zeros((3, 3)) + [0.0, 0.0, 1.0]), ValueError, "broadcast"),
+    (lambda: mf.GTR(0.5, 1.0).sample(-0.1, 0.5), ValueError, "u1"),
+    (lambda: mf.GTR(0.5, 1.0).sample(0.1, [0.5, 1.0 + 1e-12]), ValueError, r"u2\[1\]"),
+    (lambda: mf.GTR(0.5, 1.0).pdf([0.0, 0.0, 1.1]), ValueError, "h"),
+    (lambda: mf.GTR(0.5, 1.0).pdf([[0.0, 0.0, 1.0], [0.0, 0.0, 0.5]]), ValueError, r"h\[1\]"),
+    (lambda: mf.GGX(0.5).d([0.0, 1.0]), ValueError, "h"),
+    (lambda: mf.GGX(-0.5).d([0.0, 0.0, 1.0]), ValueError, "alpha_x"),
+    (lambda: mf.GGX(0.5, [0.1, 0.0]).d([0.0, 0.0, 1.0]), ValueError, r"alpha_y\[1\]"),
+    (lambda: mf.GGX(0.5, np.inf).d([0.0, 0.0, 1.0]), ValueError, "alpha_y"),
+    (lambda: mf.GGX("rough").d([0.0, 0.0, 1.0]), TypeError, "alpha_x"),
+    (lambda: mf.GGX(0.5).d(np.array([["a", "b", "c"]])), TypeError, "h"),
+    (lambda: mf.GGX(0.5).sample(0.5, 2.0), ValueError, "u2"),
+    (lambda: mf.GGX(0.5).sample_visible([np.nan, 0.0, 1.0], 0.5, 0.5), ValueError, r"wo"),
+    (lambda: mf.GGX(0.5).sample_visible([0.0, 0.0, 1.0], 0.5, -0.5), ValueError, "u2"),
+    (lambda: mf.GGX(0.5).pdf_visible([0.0, 0.0, 1.0], [0.0, 0.0, 2.0]), ValueError, "wo"),
+    (lambda: mf.GGX(0.5).lambda_([[0.0, 0.0, 1.0]] * 2 + [[1.0, 1.0, 1.0]]), ValueError, r"w\[2\]"),
+    (lambda: mf.GGX(0.0).g1([0.0, 0.0, 1.0]), ValueError, "alpha_x"),
+    (lambda: mf.GGX(0.5).g2([0.0, 0.0, 1.0], [0.0, 0.0, 0.9], correlated=False), ValueError, "wo"),
+    (lambda: mf.GGX(0.5).g2([0.0, 0.0, 0.9], [0.0, 0.0, 1.0]), ValueError, "wi"),
+    (lambda: mf.GGX(0.5).g2(np.zeros((2, 3)) + [0, 0, 1], np.zeros((3, 3)) + [0, 0, 1]),
      ValueError, "broadcast"),
-    (lambda: mf.beckmann_d([0.0, 0.0, 1.0], 0.5, -1.0), ValueError, "alpha_y"),
-    (lambda: mf.beckmann_lambda([0.0, 0.0, 1.0], np.nan), ValueError, "alpha_x"),
-    (lambda: mf.beckmann_g1([0.0, 0.0], 0.5), ValueError, "w"),
-    (lambda: mf.beckmann_sample(0.5, np.nan, 0.5), ValueError, "u2"),
-    (lambda: mf.beckmann_pdf([0.0, 0.0, 1.0], 0.5, object()), TypeError, "alpha_y"),
+    (lambda: mf.Beckmann(0.5, -1.0).d([0.0, 0.0, 1.0]), ValueError, "alpha_y"),
+    (lambda: mf.Beckmann(np.nan).lambda_([0.0, 0.0, 1.0]), ValueError, "alpha_x"),
+    (lambda: mf.Beckmann(0.5).g1([0.0, 0.0]), ValueError, "w"),
+    (lambda: mf.Beckmann(0.5).sample(0.5, np.nan), ValueError, "u2"),
+    (lambda: mf.Beckmann(0.5, object()).pdf([0.0, 0.0, 1.0]), TypeError, "alpha_y"),
 ]
 
 

@@ -41,12 +41,12 @@ def direction(theta_deg: float, phi: float = 0.0) -> np.ndarray:
 
 def student_t(gamma):
     return dict(
-        d=lambda h, ax, ay: mf.student_t_d(h, ax, ay, gamma=gamma),
-        pdf=lambda h, ax, ay: mf.student_t_pdf(h, ax, ay, gamma=gamma),
-        lam=lambda w, ax, ay: mf.student_t_lambda(w, ax, ay, gamma=gamma),
-        g1=lambda w, ax, ay: mf.student_t_g1(w, ax, ay, gamma=gamma),
-        sample=lambda u1, u2, ax, ay: mf.student_t_sample(u1, u2, ax, ay, gamma=gamma),
-        visible=lambda h, wo, ax, ay: mf.student_t_pdf_visible(h, wo, ax, ay, gamma=gamma),
+        d=lambda h, ax, ay: mf.StudentT(ax, ay, gamma=gamma).d(h),
+        pdf=lambda h, ax, ay: mf.StudentT(ax, ay, gamma=gamma).pdf(h),
+        lam=lambda w, ax, ay: mf.StudentT(ax, ay, gamma=gamma).lambda_(w),
+        g1=lambda w, ax, ay: mf.StudentT(ax, ay, gamma=gamma).g1(w),
+        sample=lambda u1, u2, ax, ay: mf.StudentT(ax, ay, gamma=gamma).sample(u1, u2),
+        visible=lambda h, wo, ax, ay: mf.StudentT(ax, ay, gamma=gamma).pdf_visible(h, wo),
         # the slope density falls as r^-2γ: Smith's integrand as r^(3-2γ) beyond sqrt(γ-1)
         tail_span=lambda s0: max(s0, 0.5 * np.log(gamma - 1.0)) + 18.0 / (2.0 * gamma - 3.0) + 3.0,
     )
@@ -54,12 +54,12 @@ def student_t(gamma):
 
 def exponential_power(p):
     return dict(
-        d=lambda h, ax, ay: mf.exponential_power_d(h, ax, ay, p=p),
-        pdf=lambda h, ax, ay: mf.exponential_power_pdf(h, ax, ay, p=p),
-        lam=lambda w, ax, ay: mf.exponential_power_lambda(w, ax, ay, p=p),
-        g1=lambda w, ax, ay: mf.exponential_power_g1(w, ax, ay, p=p),
-        sample=lambda u1, u2, ax, ay: mf.exponential_power_sample(u1, u2, ax, ay, p=p),
-        visible=lambda h, wo, ax, ay: mf.exponential_power_pdf_visible(h, wo, ax, ay, p=p),
+        d=lambda h, ax, ay: mf.ExponentialPower(ax, ay, p=p).d(h),
+        pdf=lambda h, ax, ay: mf.ExponentialPower(ax, ay, p=p).pdf(h),
+        lam=lambda w, ax, ay: mf.ExponentialPower(ax, ay, p=p).lambda_(w),
+        g1=lambda w, ax, ay: mf.ExponentialPower(ax, ay, p=p).g1(w),
+        sample=lambda u1, u2, ax, ay: mf.ExponentialPower(ax, ay, p=p).sample(u1, u2),
+        visible=lambda h, wo, ax, ay: mf.ExponentialPower(ax, ay, p=p).pdf_visible(h, wo),
         # exp(-r^(2p)) < e^-60 beyond r = 60^(1/2p)
         tail_span=lambda s0: max(s0 + 3.0, np.log(60.0) / (2.0 * p) + 1.0),
         step=min(1.0, 0.5 / p),  # r^(2p) changes by e^(2p step) across a panel
@@ -67,8 +67,12 @@ def exponential_power(p):
 
 
 BLINN_PHONG = dict(
-    d=mf.blinn_phong_d, pdf=mf.blinn_phong_pdf, lam=mf.blinn_phong_lambda, g1=mf.blinn_phong_g1,
-    sample=mf.blinn_phong_sample, visible=mf.blinn_phong_pdf_visible,
+    d=lambda h, ax, ay: mf.BlinnPhong(ax, ay).d(h),
+    pdf=lambda h, ax, ay: mf.BlinnPhong(ax, ay).pdf(h),
+    lam=lambda w, ax, ay: mf.BlinnPhong(ax, ay).lambda_(w),
+    g1=lambda w, ax, ay: mf.BlinnPhong(ax, ay).g1(w),
+    sample=lambda u1, u2, ax, ay: mf.BlinnPhong(ax, ay).sample(u1, u2),
+    visible=lambda h, wo, ax, ay: mf.BlinnPhong(ax, ay).pdf_visible(h, wo),
     tail_span=lambda s0: max(s0 + 3.0, 4.0),
 )
 
@@ -198,7 +202,7 @@ def test_normalised_across_the_shape_range():
 
 
 def test_quadrature_is_not_blind():
-    total = hemisphere_integral(lambda h: 1.00001 * mf.student_t_pdf(h, 0.5, 0.05, gamma=1.6), 0.5, 0.05)
+    total = hemisphere_integral(lambda h: 1.00001 * mf.StudentT(0.5, 0.05, gamma=1.6).pdf(h), 0.5, 0.05)
     assert abs(total - 1.00001) < 1e-7
 
 
@@ -224,8 +228,8 @@ def test_beckmann_lambda_matches_its_definition():
     # the harness itself, on the exact Beckmann Λ (erf form)
     for theta_deg, phi in LAMBDA_VIEWS:
         w = direction(theta_deg, phi)
-        expected = lambda_by_definition(mf.beckmann_d, BLINN_PHONG["tail_span"], w, 0.6, 0.1)
-        assert abs(float(mf.beckmann_lambda(w, 0.6, 0.1)) - expected) <= 1e-8 * expected + 1e-14
+        expected = lambda_by_definition(lambda h, ax, ay: mf.Beckmann(ax, ay).d(h), BLINN_PHONG["tail_span"], w, 0.6, 0.1)
+        assert abs(float(mf.Beckmann(0.6, 0.1).lambda_(w)) - expected) <= 1e-8 * expected + 1e-14
 
 
 def test_blinn_phong_lambda_is_beckmanns_approximation():
@@ -235,10 +239,10 @@ def test_blinn_phong_lambda_is_beckmanns_approximation():
     for alpha, bound in [(0.3, 2.5e-2), (0.6, 0.14), (1.0, 0.66)]:
         for theta_deg, phi in LAMBDA_VIEWS:
             w = direction(theta_deg, phi)
-            expected = lambda_by_definition(mf.blinn_phong_d, BLINN_PHONG["tail_span"], w, alpha, alpha)
-            got = float(mf.blinn_phong_lambda(w, alpha))
-            assert got == float(mf.beckmann_lambda(w, alpha))
-            assert abs(float(mf.blinn_phong_g1(w, alpha)) * (1.0 + expected) - 1.0) < bound, (alpha, theta_deg)
+            expected = lambda_by_definition(BLINN_PHONG["d"], BLINN_PHONG["tail_span"], w, alpha, alpha)
+            got = float(mf.BlinnPhong(alpha).lambda_(w))
+            assert got == float(mf.Beckmann(alpha).lambda_(w))
+            assert abs(float(mf.BlinnPhong(alpha).g1(w)) * (1.0 + expected) - 1.0) < bound, (alpha, theta_deg)
 
 
 # --------------------------------------------------------------------------
@@ -279,8 +283,8 @@ def test_walter_weak_white_furnace():
     for alpha in (0.05, 0.3, 1.0):
         for theta_deg, phi in FURNACE_VIEWS:
             wo = direction(theta_deg, phi)
-            g1 = float(mf.beckmann_g1(wo, alpha, approximation="walter"))
-            total = hemisphere_integral(lambda h: g1 * mf.beckmann_d(h, alpha) * np.maximum(0.0, h @ wo) / wo[2],
+            g1 = float(mf.Beckmann(alpha, approximation="walter").g1(wo))
+            total = hemisphere_integral(lambda h: g1 * mf.Beckmann(alpha).d(h) * np.maximum(0.0, h @ wo) / wo[2],
                                         alpha, alpha, n_psi=192, kink=horizon_of(wo))
             assert abs(total - 1.0) < 3.5e-3, (alpha, theta_deg, total)
 
@@ -315,10 +319,10 @@ def test_beckmann_visible_sampler_matches_pdf(alpha_x, alpha_y, theta_deg, phi):
     rng = np.random.default_rng(2014 + int(theta_deg))
     u1, u2 = rng.random((2, 40_000))
     wo = direction(theta_deg, phi)
-    h = mf.beckmann_sample_visible(wo, u1, u2, alpha_x, alpha_y)
+    h = mf.Beckmann(alpha_x, alpha_y).sample_visible(wo, u1, u2)
     np.testing.assert_allclose(np.linalg.norm(h, axis=-1), 1.0, atol=1e-12)
     assert np.all(h @ wo > -1e-12)
-    result = cs.chi_square_test(h, lambda w: mf.beckmann_pdf_visible(w, wo, alpha_x, alpha_y), peaks=[[0.0, 0.0, 1.0]],
+    result = cs.chi_square_test(h, lambda w: mf.Beckmann(alpha_x, alpha_y).pdf_visible(w, wo), peaks=[[0.0, 0.0, 1.0]],
                                 peak_width=min(alpha_x, alpha_y), rtol=1e-5)
     assert abs(result.integral - 1.0) < 1e-3, result.describe()
     assert result.p_value > cs.sidak_threshold(len(BECKMANN_VISIBLE_CASES)), result.describe()
@@ -327,17 +331,17 @@ def test_beckmann_visible_sampler_matches_pdf(alpha_x, alpha_y, theta_deg, phi):
 def test_chi_square_is_not_blind():
     rng = np.random.default_rng(7)
     u1, u2 = rng.random((2, 40_000))
-    h = mf.student_t_sample(u1, u2, 0.3, 0.3, gamma=1.6)
-    wrong = cs.chi_square_test(h, lambda w: mf.student_t_pdf(w, 0.36, 0.3, gamma=1.6), peaks=[[0.0, 0.0, 1.0]],
+    h = mf.StudentT(0.3, 0.3, gamma=1.6).sample(u1, u2)
+    wrong = cs.chi_square_test(h, lambda w: mf.StudentT(0.36, 0.3, gamma=1.6).pdf(w), peaks=[[0.0, 0.0, 1.0]],
                                peak_width=0.3)
     assert wrong.p_value < 1e-6, wrong.describe()
 
 
 def test_samplers_at_the_ends_of_the_unit_interval():
-    for sample in (lambda u1, u2: mf.student_t_sample(u1, u2, 0.3, 0.1, gamma=1.7),
-                   lambda u1, u2: mf.exponential_power_sample(u1, u2, 0.3, 0.1, p=0.4),
-                   lambda u1, u2: mf.blinn_phong_sample(u1, u2, 0.3, 0.1),
-                   lambda u1, u2: mf.beckmann_sample_visible(direction(75.0, 2.0), u1, u2, 0.5, 0.1)):
+    for sample in (lambda u1, u2: mf.StudentT(0.3, 0.1, gamma=1.7).sample(u1, u2),
+                   lambda u1, u2: mf.ExponentialPower(0.3, 0.1, p=0.4).sample(u1, u2),
+                   lambda u1, u2: mf.BlinnPhong(0.3, 0.1).sample(u1, u2),
+                   lambda u1, u2: mf.Beckmann(0.5, 0.1).sample_visible(direction(75.0, 2.0), u1, u2)):
         h = sample(np.array([0.0, 0.3, 1.0, 0.7]), np.array([0.0, 1.0, 1e-300, 1.0 - 1e-16]))
         assert np.all(np.isfinite(h))
         np.testing.assert_allclose(np.linalg.norm(h, axis=-1), 1.0, atol=1e-12)
@@ -368,12 +372,12 @@ def test_student_t_at_gamma_2_is_ggx():
     rng = np.random.default_rng(11)
     h, w = random_unit(rng, 2000), random_unit(rng, 2000)
     ax, ay = rng.uniform(0.05, 1.0, (2, 2000))
-    np.testing.assert_allclose(mf.student_t_d(h, ax, ay, gamma=2.0), mf.ggx_d(h, ax, ay), rtol=1e-12)
-    np.testing.assert_allclose(mf.student_t_lambda(w, ax, ay, gamma=2.0), mf.ggx_lambda(w, ax, ay), rtol=1e-12)
-    np.testing.assert_allclose(mf.student_t_g2_height_correlated(h, w, ax, ay, gamma=2.0),
-                               mf.ggx_g2_height_correlated(h, w, ax, ay), rtol=1e-12)
+    np.testing.assert_allclose(mf.StudentT(ax, ay, gamma=2.0).d(h), mf.GGX(ax, ay).d(h), rtol=1e-12)
+    np.testing.assert_allclose(mf.StudentT(ax, ay, gamma=2.0).lambda_(w), mf.GGX(ax, ay).lambda_(w), rtol=1e-12)
+    np.testing.assert_allclose(mf.StudentT(ax, ay, gamma=2.0).g2(h, w),
+                               mf.GGX(ax, ay).g2(h, w), rtol=1e-12)
     u1, u2 = rng.random((2, 2000))
-    np.testing.assert_allclose(mf.student_t_sample(u1, u2, ax, ay, gamma=2.0), mf.ggx_sample(u1, u2, ax, ay),
+    np.testing.assert_allclose(mf.StudentT(ax, ay, gamma=2.0).sample(u1, u2), mf.GGX(ax, ay).sample(u1, u2),
                                rtol=1e-10, atol=1e-12)
 
 
@@ -383,15 +387,15 @@ def test_student_t_tends_to_beckmann():
     rng = np.random.default_rng(12)
     h, w = random_unit(rng, 2000), random_unit(rng, 2000)
     ax, ay = rng.uniform(0.05, 1.0, (2, 2000))
-    beckmann_d, beckmann_lambda = mf.beckmann_d(h, ax, ay), mf.beckmann_lambda(w, ax, ay)
+    beckmann_d, beckmann_lambda = mf.Beckmann(ax, ay).d(h), mf.Beckmann(ax, ay).lambda_(w)
     keep = beckmann_d > 1e-8 * beckmann_d.max()
-    np.testing.assert_allclose(mf.student_t_d(h, ax, ay, gamma=1e10)[keep], beckmann_d[keep], rtol=1e-6)
+    np.testing.assert_allclose(mf.StudentT(ax, ay, gamma=1e10).d(h)[keep], beckmann_d[keep], rtol=1e-6)
     visible = beckmann_lambda > 1e-8
-    np.testing.assert_allclose(mf.student_t_lambda(w, ax, ay, gamma=1e10)[visible], beckmann_lambda[visible],
+    np.testing.assert_allclose(mf.StudentT(ax, ay, gamma=1e10).lambda_(w)[visible], beckmann_lambda[visible],
                                rtol=1e-6)
-    np.testing.assert_allclose(mf.student_t_g1(w, ax, ay, gamma=1e10), mf.beckmann_g1(w, ax, ay), rtol=1e-6)
+    np.testing.assert_allclose(mf.StudentT(ax, ay, gamma=1e10).g1(w), mf.Beckmann(ax, ay).g1(w), rtol=1e-6)
     # and as 1/γ: ten times γ, a tenth of the difference
-    differences = [np.abs(mf.student_t_lambda(w, ax, ay, gamma=g) - beckmann_lambda)[visible].max()
+    differences = [np.abs(mf.StudentT(ax, ay, gamma=g).lambda_(w) - beckmann_lambda)[visible].max()
                    for g in (1e3, 1e4)]
     assert 5.0 < differences[0] / differences[1] < 20.0, differences
 
@@ -410,7 +414,7 @@ def test_student_t_lambda_against_mpmath():
             expected = float(mpmath.gamma(g - 0.5) / (mpmath.gamma(g) * mpmath.sqrt(mpmath.pi))
                              * ((g - 1) ** g / (2 * g - 3) * s1 + mpmath.sqrt(g - 1) * s2) - 0.5)
             w = np.array([1.0, 0.0, a]) / math.hypot(1.0, a)  # a = cot θ / α at α = 1
-            got = float(mf.student_t_lambda(w, 1.0, gamma=gamma))
+            got = float(mf.StudentT(1.0, gamma=gamma).lambda_(w))
             assert abs(got - expected) <= 1e-12 * expected + (1e-14 if gamma > 20 else 0.0), (gamma, a, got, expected)
 
 
@@ -418,12 +422,12 @@ def test_exponential_power_at_p_1_is_beckmann():
     rng = np.random.default_rng(13)
     h, w = random_unit(rng, 2000), random_unit(rng, 2000)
     ax, ay = rng.uniform(0.05, 1.0, (2, 2000))
-    np.testing.assert_allclose(mf.exponential_power_d(h, ax, ay, p=1.0), mf.beckmann_d(h, ax, ay), rtol=1e-12,
+    np.testing.assert_allclose(mf.ExponentialPower(ax, ay, p=1.0).d(h), mf.Beckmann(ax, ay).d(h), rtol=1e-12,
                                atol=1e-300)
-    np.testing.assert_allclose(mf.exponential_power_lambda(w, ax, ay, p=1.0), mf.beckmann_lambda(w, ax, ay),
+    np.testing.assert_allclose(mf.ExponentialPower(ax, ay, p=1.0).lambda_(w), mf.Beckmann(ax, ay).lambda_(w),
                                rtol=1e-9, atol=1e-300)  # 6e-11 at Λ ~ 1e-250
     u1, u2 = rng.random((2, 2000))
-    np.testing.assert_allclose(mf.exponential_power_sample(u1, u2, ax, ay, p=1.0), mf.beckmann_sample(u1, u2, ax, ay),
+    np.testing.assert_allclose(mf.ExponentialPower(ax, ay, p=1.0).sample(u1, u2), mf.Beckmann(ax, ay).sample(u1, u2),
                                rtol=1e-9, atol=1e-12)
 
 
@@ -459,22 +463,22 @@ def cot_grid():
 def test_walter_lambda_error():
     a = cot_grid()
     w = np.stack([np.ones_like(a), np.zeros_like(a), a], axis=-1) / np.hypot(1.0, a)[:, None]  # α = 1
-    exact_g1 = mf.beckmann_g1(w, 1.0)
-    walter_g1 = mf.beckmann_g1(w, 1.0, approximation="walter")
+    exact_g1 = mf.Beckmann(1.0).g1(w)
+    walter_g1 = mf.Beckmann(1.0, approximation="walter").g1(w)
     relative = np.abs(walter_g1 / exact_g1 - 1.0)
     # Walter et al. 2007 eq. 27: at most 3.13e-3 relative in G1 (at a = 1.33)
     assert relative.max() < 3.2e-3, relative.max()
     # in Λ: the same bound relative to 1 + Λ, and 1.8e-3 absolutely beyond the cut at a = 1.6
-    exact = mf.beckmann_lambda(w, 1.0)
-    walter = mf.beckmann_lambda(w, 1.0, approximation="walter")
+    exact = mf.Beckmann(1.0).lambda_(w)
+    walter = mf.Beckmann(1.0, approximation="walter").lambda_(w)
     assert np.all(np.abs(walter - exact) < 3.2e-3 * (1.0 + exact))
     assert np.abs(walter - exact)[a >= 1.6].max() < 1.8e-3
     # and it is the same function of a at any alpha and azimuth
     w2 = direction(70.0, 0.8)
     a2 = w2[2] / math.hypot(0.4 * w2[0], 0.1 * w2[1])
-    assert float(mf.beckmann_lambda(w2, 0.4, 0.1, approximation="walter")) == pytest.approx(
+    assert float(mf.Beckmann(0.4, 0.1, approximation="walter").lambda_(w2)) == pytest.approx(
         (1 - 1.259 * a2 + 0.396 * a2 * a2) / (3.535 * a2 + 2.181 * a2 * a2), rel=1e-14)
-    g2 = mf.beckmann_g2_height_correlated(w2, direction(20.0), 0.4, 0.1, approximation="walter")
+    g2 = mf.Beckmann(0.4, 0.1, approximation="walter").g2(w2, direction(20.0))
     assert 0.0 < float(g2) <= 1.0
 
 
@@ -485,50 +489,51 @@ def test_ggx_g2_over_4cos():
     wo = np.stack([-np.sqrt(1 - mo * mo) * 0.6, np.sqrt(1 - mo * mo) * 0.8, mo], axis=-1)
     low = {"karis": 0.0, "hammon": 0.0}
     for alpha in np.linspace(0.05, 1.0, 20):
-        exact = mf.ggx_g2_over_4cos(wi, wo, alpha)
+        exact = mf.GGX(alpha).g2_over_4cos(wi, wo)
         # the exact form is G2 / (4 μi μo) with the height-correlated G2
-        np.testing.assert_allclose(exact, mf.ggx_g2_height_correlated(wi, wo, alpha) / (4 * mi * mo), rtol=1e-13)
+        np.testing.assert_allclose(exact, mf.GGX(alpha).g2(wi, wo) / (4 * mi * mo), rtol=1e-13)
         for name in low:
-            relative = mf.ggx_g2_over_4cos(wi, wo, alpha, approximation=name) / exact - 1.0
+            relative = mf.GGX(alpha).g2_over_4cos(wi, wo, approximation=name) / exact - 1.0
             assert relative.max() < 1e-12  # neither overestimates
             low[name] = min(low[name], relative.min())
         # Karis's G1 against the exact G1 (what Karis 2013 approximates): within 18.5%
         k = alpha / 2.0
         karis_g1 = mi / (mi * (1.0 - k) + k)
-        assert np.all(np.abs(karis_g1 / mf.ggx_g1(wi, alpha) - 1.0) < 0.185)
+        assert np.all(np.abs(karis_g1 / mf.GGX(alpha).g1(wi) - 1.0) < 0.185)
     # the docstring's bounds: Karis (separable) down to -82% of the height-correlated V
     # (both directions grazing, α = 1), Hammon down to -27.6% (grazing, α = 0.05)
     assert low["karis"] > -0.82 and low["hammon"] > -0.276, low
     # anisotropic exact form equals G2 / (4 μi μo) too
-    np.testing.assert_allclose(mf.ggx_g2_over_4cos(wi, wo, 0.5, 0.1),
-                               mf.ggx_g2_height_correlated(wi, wo, 0.5, 0.1) / (4 * mi * mo), rtol=1e-13)
+    np.testing.assert_allclose(mf.GGX(0.5, 0.1).g2_over_4cos(wi, wo),
+                               mf.GGX(0.5, 0.1).g2(wi, wo) / (4 * mi * mo), rtol=1e-13)
 
 
 # --------------------------------------------------------------------------
 # masking-shadowing relations and bad input
 
 
-@pytest.mark.parametrize("prefix, shape", [("student_t", {"gamma": 2.7}), ("exponential_power", {"p": 0.6}),
-                                           ("blinn_phong", {}), ("beckmann", {})])
-def test_g2_relations(prefix, shape):
+@pytest.mark.parametrize("cls, shape", [(mf.StudentT, {"gamma": 2.7}), (mf.ExponentialPower, {"p": 0.6}),
+                                        (mf.BlinnPhong, {}), (mf.Beckmann, {})],
+                         ids=["student_t", "exponential_power", "blinn_phong", "beckmann"])
+def test_g2_relations(cls, shape):
     rng = np.random.default_rng(14)
     wi, wo = random_unit(rng, 500), random_unit(rng, 500)
-    g1 = getattr(mf, f"{prefix}_g1")
-    separable = getattr(mf, f"{prefix}_g2_separable")(wi, wo, 0.4, 0.2, **shape)
-    correlated = getattr(mf, f"{prefix}_g2_height_correlated")(wi, wo, 0.4, 0.2, **shape)
-    np.testing.assert_allclose(separable, g1(wi, 0.4, 0.2, **shape) * g1(wo, 0.4, 0.2, **shape), rtol=1e-14)
+    dist = cls(0.4, 0.2, **shape)
+    separable = dist.g2(wi, wo, correlated=False)
+    correlated = dist.g2(wi, wo)
+    np.testing.assert_allclose(separable, dist.g1(wi) * dist.g1(wo), rtol=1e-14)
     assert np.all(correlated >= separable - 1e-15) and np.all(correlated <= 1.0)
-    assert float(g1(np.array([0.0, 0.0, 1.0]), 0.4, 0.2, **shape)) == 1.0
-    assert float(g1(np.array([1.0, 0.0, 0.0]), 0.4, 0.2, **shape)) == 0.0
+    assert float(dist.g1(np.array([0.0, 0.0, 1.0]))) == 1.0
+    assert float(dist.g1(np.array([1.0, 0.0, 0.0]))) == 0.0
 
 
 @pytest.mark.parametrize("call, pattern", [
-    (lambda: mf.student_t_d([0, 0, 1], 0.3, gamma=1.5), "gamma.*outside its domain"),
-    (lambda: mf.student_t_lambda([0, 0, 1], 0.3, gamma=np.nan), "gamma"),
-    (lambda: mf.exponential_power_d([0, 0, 1], 0.3, p=0.05), "p.*outside its domain"),
-    (lambda: mf.blinn_phong_d([0, 0, 1], 1.2), "alpha_x.*outside its domain"),
-    (lambda: mf.beckmann_lambda([0, 0, 1], 0.3, approximation="karis"), "approximation"),
-    (lambda: mf.ggx_g2_over_4cos([0, 0, 1], [0, 0, 1], 0.3, approximation="walter"), "approximation"),
+    (lambda: mf.StudentT(0.3, gamma=1.5).d([0, 0, 1]), "gamma.*outside its domain"),
+    (lambda: mf.StudentT(0.3, gamma=np.nan).lambda_([0, 0, 1]), "gamma"),
+    (lambda: mf.ExponentialPower(0.3, p=0.05).d([0, 0, 1]), "p.*outside its domain"),
+    (lambda: mf.BlinnPhong(1.2).d([0, 0, 1]), "alpha_x.*outside its domain"),
+    (lambda: mf.Beckmann(0.3, approximation="karis").lambda_([0, 0, 1]), "approximation"),
+    (lambda: mf.GGX(0.3).g2_over_4cos([0, 0, 1], [0, 0, 1], approximation="walter"), "approximation"),
 ])
 def test_bad_input(call, pattern):
     with pytest.raises(ValueError, match=pattern):
@@ -540,8 +545,8 @@ def test_no_nan_anywhere():
     w = random_unit(rng, 300)
     w[:3] = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.6, 0.8, 1e-200]]
     for alpha in (1e-4, 0.05, 1.0):
-        for values in (mf.student_t_d(w, alpha, gamma=1.51), mf.student_t_lambda(w, alpha, gamma=1e9),
-                       mf.exponential_power_d(w, alpha, p=0.1), mf.exponential_power_lambda(w, alpha, p=10.0),
-                       mf.blinn_phong_d(w, alpha), mf.blinn_phong_g1(w, alpha),
-                       mf.student_t_pdf_visible(w, w[::-1], alpha, gamma=3.0)):
+        for values in (mf.StudentT(alpha, gamma=1.51).d(w), mf.StudentT(alpha, gamma=1e9).lambda_(w),
+                       mf.ExponentialPower(alpha, p=0.1).d(w), mf.ExponentialPower(alpha, p=10.0).lambda_(w),
+                       mf.BlinnPhong(alpha).d(w), mf.BlinnPhong(alpha).g1(w),
+                       mf.StudentT(alpha, gamma=3.0).pdf_visible(w, w[::-1])):
             assert not np.any(np.isnan(values))

@@ -558,10 +558,10 @@ def test_microfacet_family_draws_every_distribution(tmp_path):
     # the values are pb.microfacet's
     theta, d = line(d_ax, "GGX")
     h = np.stack([np.sin(np.radians(theta)), 0 * theta, np.cos(np.radians(theta))], -1)
-    np.testing.assert_allclose(d, pb.microfacet.ggx_d(h, 0.3), rtol=1e-12)
+    np.testing.assert_allclose(d, pb.microfacet.GGX(0.3).d(h), rtol=1e-12)
     theta, lam = line(lambda_ax, "Student-t γ = 4")
     w = np.stack([np.sin(np.radians(theta)), 0 * theta, np.cos(np.radians(theta))], -1)
-    np.testing.assert_allclose(lam, pb.microfacet.student_t_lambda(w, 0.3, gamma=4.0), rtol=1e-12)
+    np.testing.assert_allclose(lam, pb.microfacet.StudentT(0.3, gamma=4.0).lambda_(w), rtol=1e-12)
     assert d_ax.get_legend() is not None
     assert_png_not_blank(fig, tmp_path, "family")
 

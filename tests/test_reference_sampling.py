@@ -173,10 +173,10 @@ def toolkit_pdf(p, wi, wo, sampler):
     h = half_vector(wi, wo)
     cos_d = np.linalg.norm(wi + wo, axis=-1) / 2.0  # = wi·h = wo·h, symmetric in wi and wo (as reference.hpp)
     if sampler == "visible":
-        spec = mf.ggx_pdf_visible(h, wo, ax, ay) / (4.0 * dot(wo, h))
+        spec = mf.GGX(ax, ay).pdf_visible(h, wo) / (4.0 * dot(wo, h))
     else:
-        spec = mf.ggx_pdf(h, ax, ay) / (4.0 * cos_d)
-    coat = mf.gtr_pdf(h, ac, 1.0) / (4.0 * cos_d)
+        spec = mf.GGX(ax, ay).pdf(h) / (4.0 * cos_d)
+    coat = mf.GTR(ac, 1.0).pdf(h) / (4.0 * cos_d)
     density[upper] = probability[:, 0] * wi[:, 2] / np.pi + probability[:, 1] * spec + probability[:, 2] * coat
     return density
 

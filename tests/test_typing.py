@@ -233,9 +233,15 @@ theta, phi = pb.frames.direction_to_spherical(local)
 direction: NDArray[np.float64] = pb.frames.spherical_to_direction(theta, phi)
 theta_h, phi_h, theta_d, phi_d = pb.frames.wiwo_to_half_diff(wi, wo)
 
-half: NDArray[np.float64] = pb.microfacet.ggx_sample(np.full(4, 0.5), np.full(4, 0.25), alpha_x=0.3, alpha_y=0.1)
-d: NDArray[np.float64] = pb.microfacet.gtr_d(np.cos(np.radians([0, 10, 30])), alpha=0.2, gamma=1.5)
-g1: NDArray[np.float64] = pb.microfacet.ggx_g1(half, 0.3)
+ggx_distribution: pb.microfacet.GGX = pb.microfacet.GGX(alpha_x=0.3, alpha_y=0.1)
+half: NDArray[np.float64] = ggx_distribution.sample(np.full(4, 0.5), np.full(4, 0.25))
+d: NDArray[np.float64] = pb.microfacet.GTR(alpha=0.2, gamma=1.5).d(half)
+g1: NDArray[np.float64] = pb.microfacet.GGX(0.3).g1(half)
+g2: NDArray[np.float64] = ggx_distribution.g2(half, half, correlated=False)
+lam: NDArray[np.float64] = pb.microfacet.StudentT(0.3, gamma=2.5).lambda_(half)
+walter: pb.microfacet.Beckmann = pb.microfacet.Beckmann(0.3, approximation="walter")
+approximation: str | None = walter.approximation
+alpha_x: NDArray[np.float64] = ggx_distribution.alpha_x
 
 measured = pb.reference.eval(pb.Material(roughness=0.4), wi, wo)
 result: pb.FitResult = pb.fit(wi, wo, measured, fit=["roughness"], max_iterations=3, loss="linear")
@@ -271,6 +277,7 @@ assert density.dtype == np.float32 and vp.value.dtype == np.float32 and vp.pdf.d
 assert p64.dtype == np.float64 and chances.dtype == np.float64 and u.dtype == np.float32
 assert albedo_total.dtype == np.float64 and a.lobes.diffuse.dtype == np.float64
 assert direction.dtype == np.float64 and half.dtype == np.float64 and g1.dtype == np.float64
+assert d.dtype == np.float64 and g2.dtype == np.float64 and lam.dtype == np.float64 and approximation == "walter"
 assert fitted.is_uniform and isinstance(summary, str) and ggx.dtype == np.float64
 assert part.shape == (2,) and flat.shape == (6,) and from_table.dtype == np.float64
 '''
@@ -293,7 +300,9 @@ pb.sample(m, wi, seed=1).shares  # E: attr-defined
 pb.Material(roughnes=0.3)  # E: call-arg
 pb.Material(roughness="0.3")  # E: arg-type
 pb.eval_grad(m, wi, wi, wrt=3)  # E: arg-type
-pb.microfacet.ggx_d(wi, alpha_x="0.3")  # E: arg-type
+pb.microfacet.GGX(alpha_x="0.3")  # E: arg-type
+pb.microfacet.GTR(0.2, 1.5).lambda_(wi)  # E: attr-defined
+pb.microfacet.GGX(0.3).g2(wi, wi, True)  # E: call-arg
 pb.reference.sample(m, wi)  # E: call-arg
 
 _core.reference_eval(wi, wi, wi, 0)  # E: call-arg

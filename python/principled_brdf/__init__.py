@@ -19,4 +19,4 @@ __all__ = [
 ]
 from .explorer import explorer  # noqa: E402 - ipywidgets and matplotlib are imported by the call
 __all__.append("explorer")
-__version__ = "0.1.0"
+__version__ = "0.2.0"

@@ -669,19 +669,19 @@ def microfacet_family(alpha: float = 0.3, *, student_t_gammas: Iterable[float] =
     exponent = 2.0 / a**2 - 2.0
     # (label, color, line style, D(h), Λ(w) or None)
     curves: list[tuple[str, str, str | tuple[int, tuple[int, ...]], Float64Array, Float64Array | None]] = [
-        ("GGX", "tab:blue", "-", mf.ggx_d(w, a), mf.ggx_lambda(w, a)),
-        ("Beckmann", "tab:orange", "-", mf.beckmann_d(w, a), mf.beckmann_lambda(w, a)),
-        (f"Blinn-Phong (n = {exponent:.3g})", "tab:green", "--", mf.blinn_phong_d(w, a), mf.blinn_phong_lambda(w, a)),
+        ("GGX", "tab:blue", "-", mf.GGX(a).d(w), mf.GGX(a).lambda_(w)),
+        ("Beckmann", "tab:orange", "-", mf.Beckmann(a).d(w), mf.Beckmann(a).lambda_(w)),
+        (f"Blinn-Phong (n = {exponent:.3g})", "tab:green", "--", mf.BlinnPhong(a).d(w), mf.BlinnPhong(a).lambda_(w)),
     ]
     shades = ("tab:purple", "tab:pink", "tab:olive", "tab:cyan")
-    curves += [(f"Student-t γ = {g:g}", shades[k % len(shades)], "-.", mf.student_t_d(w, a, gamma=g),
-                mf.student_t_lambda(w, a, gamma=g)) for k, g in enumerate(gammas)]
+    curves += [(f"Student-t γ = {g:g}", shades[k % len(shades)], "-.", mf.StudentT(a, gamma=g).d(w),
+                mf.StudentT(a, gamma=g).lambda_(w)) for k, g in enumerate(gammas)]
     shades = ("tab:red", "tab:brown", "darkgoldenrod", "maroon")
-    curves += [(f"exponential power p = {p:g}", shades[k % len(shades)], ":", mf.exponential_power_d(w, a, p=p),
-                mf.exponential_power_lambda(w, a, p=p)) for k, p in enumerate(ps)]
+    curves += [(f"exponential power p = {p:g}", shades[k % len(shades)], ":", mf.ExponentialPower(a, p=p).d(w),
+                mf.ExponentialPower(a, p=p).lambda_(w)) for k, p in enumerate(ps)]
     shades = ("0.35", "0.6", "0.15", "0.75")
     curves += [(f"GTR γ = {g:g}" + (" (GTR1)" if g == 1.0 else ""), shades[k % len(shades)], (0, (5, 1, 1, 1)),
-                mf.gtr_d(w[:, 2], a, g), None) for k, g in enumerate(gtrs)]
+                mf.GTR(a, g).d(w), None) for k, g in enumerate(gtrs)]
 
     if drawn is None:
         fig, (d_ax, lambda_ax) = _pyplot().subplots(1, 2, figsize=figsize, layout="constrained")
