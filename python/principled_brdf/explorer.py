@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from . import _validate
+from . import _color, _validate
 from . import presets as _presets
 from . import render as _render
 from ._batch import FLOAT32_LIMITS as _KERNEL_LIMITS
@@ -170,13 +170,8 @@ def supports_energy_compensation() -> bool:
     return _accepts(importlib.import_module(__package__).eval, "energy_compensation")
 
 
-def _linear_to_srgb(c: RealArrayLike) -> Float64Array:
-    c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)
-    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-
-
 def _hex(linear: RealArrayLike) -> str:
-    return "#" + "".join(f"{int(round(v * 255.0)):02x}" for v in _linear_to_srgb(linear))
+    return "#" + "".join(f"{int(round(v * 255.0)):02x}" for v in _color.srgb_encode(linear))
 
 
 def _picked(value: str) -> tuple[float, ...]:

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _core
+from . import _color, _core
 from ._validate import as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
 
 if TYPE_CHECKING:
@@ -247,7 +247,17 @@ def srgb_to_linear(color: RealArrayLike) -> Float64Array:
         color = color / 255.0
     array = as_real_array("color", color)
     require_in_domain("color", array, 0.0, 1.0)
-    return np.where(array <= 0.04045, array / 12.92, ((array + 0.055) / 1.055) ** 2.4)
+    return _color.srgb_decode(array)
+
+
+def linear_to_srgb(color: RealArrayLike) -> Float64Array:
+    """Linear RGB to sRGB-encoded color, the inverse of :func:`srgb_to_linear`: ``12.92 c``
+    for ``c <= 0.0031308``, else ``1.055 c ** (1 / 2.4) - 0.055``. Values must lie in
+    [0, 1] (tone-map brighter ones first, e.g. with ``pb.render.tone_map``); float64 out,
+    times 255 and rounded for 8 bits."""
+    array = as_real_array("color", color)
+    require_in_domain("color", array, 0.0, 1.0)
+    return _color.srgb_encode(array)
 
 
 def gamma22_to_linear(color: RealArrayLike) -> Float64Array:

@@ -36,7 +36,7 @@ import numpy as np
 from . import presets as _presets
 from ._batch import eval as _eval
 from ._batch import eval_lobes as _eval_lobes
-from . import _validate
+from . import _color, _validate
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material
 from . import render as _render
@@ -202,15 +202,6 @@ def slice_directions(resolution: int, phi_d: float = 90.0) -> tuple[FloatArray, 
     return theta, theta.copy(), rotate(dx, dy, cd), rotate(-dx, -dy, cd)
 
 
-def _srgb_encode(c: Float64Array) -> Float64Array:
-    c = np.clip(c, 0.0, 1.0)
-    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-
-
-def _srgb_decode(c: Float64Array) -> Float64Array:
-    return np.where(c <= 0.04045, c / 12.92, np.power((c + 0.055) / 1.055, 2.4))
-
-
 def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
                log: bool = True, model: Model = "disney2014", vmin: float | None = None, vmax: float | None = None,
                percentile: float | None = None, exposure: float = 1.0, cmap: str = "inferno", colorbar: bool = True,
@@ -276,11 +267,11 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
     if rgb_mode:
         # display brightness (sRGB-encoded) = the luminance's place on the scale, as on the grey color bar
         level = np.clip(np.ma.filled(norm(np.maximum(value, norm.vmin)), 0.0), 0.0, 1.0)
-        scale = np.divide(_srgb_decode(level), value, out=np.zeros_like(value), where=value > 0.0)
+        scale = np.divide(_color.srgb_decode(level), value, out=np.zeros_like(value), where=value > 0.0)
         color = f * scale[..., None]
         color = color / np.maximum(1.0, color.max(axis=-1, keepdims=True))  # keep the hue where it clips
         image = np.empty(color.shape[:-1] + (4,))
-        image[..., :3] = np.where(valid[..., None], _srgb_encode(color), colors.to_rgb(_BACKGROUND))
+        image[..., :3] = np.where(valid[..., None], _color.srgb_encode(color), colors.to_rgb(_BACKGROUND))
         image[..., 3] = 1.0
         ax.imshow(image, origin="lower", extent=extent, interpolation="nearest")
         if colorbar:

@@ -19,7 +19,7 @@ import zlib
 
 import numpy as np
 
-from . import _validate
+from . import _color, _validate
 from ._batch import eval as _eval
 from ._batch import random_uniforms as _random_uniforms
 from ._batch import sample as _sample
@@ -322,9 +322,7 @@ def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "
 
 def to_srgb8(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "filmic") -> NDArray[np.uint8]:
     """Linear RGB to 8-bit sRGB for saving or showing: :func:`tone_map`, then the sRGB encoding."""
-    c = tone_map(linear, exposure, curve)
-    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-    return np.round(srgb * 255.0).astype(np.uint8)
+    return np.round(_color.srgb_encode(tone_map(linear, exposure, curve)) * 255.0).astype(np.uint8)
 
 
 def png_bytes(image: RealArrayLike) -> bytes:
