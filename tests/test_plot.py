@@ -593,3 +593,22 @@ def test_microfacet_family_bad_arguments():
         pbplot.microfacet_family(axes=(fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2, projection="polar")))
     plt.close(fig)
     assert plt.get_fignums() == []
+
+
+@pytest.mark.parametrize("draw", [
+    lambda r: pbplot.brdf_slice(EVERYTHING, resolution=r),
+    lambda r: pbplot.lit_sphere(EVERYTHING, resolution=r),
+    lambda r: pbplot.blend_demo("gold", "blue_rubber", resolution=r),
+    lambda r: pbplot.parameter_sweep(resolution=r),
+    lambda r: pbplot.slice_directions(r),
+    lambda r: pb.render.render_sphere(EVERYTHING, r),
+    lambda r: pb.render.sphere_frames(r),
+], ids=["brdf_slice", "lit_sphere", "blend_demo", "parameter_sweep", "slice_directions", "render_sphere",
+        "sphere_frames"])
+def test_one_resolution_rule_for_every_picture(draw):
+    for bad in (1, pb.render.MAX_RESOLUTION + 1):
+        with pytest.raises(ValueError, match=rf"^resolution: expected 2 to 16384 pixels, got {bad}$"):
+            draw(bad)
+    for bad in (True, 64.0, "64"):
+        with pytest.raises(TypeError, match="^resolution: expected an integer"):
+            draw(bad)

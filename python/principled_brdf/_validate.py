@@ -31,6 +31,7 @@ SAMPLERS = {name: index for index, name in enumerate(_core.SAMPLER_NAMES)}  # of
 LOBE_NAMES = tuple(_core.LOBE_NAMES)  # of f, as eval_lobes returns them
 SAMPLED_LOBE_NAMES = tuple(_core.SAMPLED_LOBE_NAMES)  # by the index a sample reports
 FLOAT32_MAX = float(np.finfo(np.float32).max)
+MAX_RESOLUTION = 16384  # pixels (or angles) along a picture's side: 16384² pixels is 3 GB of float32 RGB
 _REAL_KINDS = "biuf"  # bool, signed and unsigned integers, floats
 
 
@@ -179,6 +180,23 @@ def integer(name: str, value: object) -> int:
         return operator.index(value)  # type: ignore[arg-type]  # a TypeError here is the check
     except TypeError:
         raise TypeError(f"{name}: expected an integer, got {type(value).__name__}") from None
+
+
+def integer_in(name: str, value: object, minimum: int, maximum: int, unit: str = "") -> int:
+    """An integer (not a bool) from ``minimum`` to ``maximum``: TypeError otherwise, ValueError
+    outside, both naming the argument (``samples: expected 2 to 67108864, got 1``; ``unit``,
+    e.g. ``" per pixel"``, follows the bounds)."""
+    count = integer(name, value)
+    if not minimum <= count <= maximum:
+        raise ValueError(f"{name}: expected {minimum} to {maximum}{unit}, got {count}")
+    return count
+
+
+def resolution(name: str, value: object, minimum: int = 2, maximum: int = MAX_RESOLUTION, unit: str = " pixels") -> int:
+    """The pictures' one rule for a resolution (``render``, ``plot``, the explorer): an integer,
+    not a bool, from ``minimum`` (2 unless a picture needs more) to ``maximum``
+    (:data:`MAX_RESOLUTION`, 16384), e.g. ``resolution: expected 2 to 16384 pixels, got 1``."""
+    return integer_in(name, value, minimum, maximum, unit)
 
 
 def seed_value(seed: object) -> int:

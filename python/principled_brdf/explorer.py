@@ -262,9 +262,7 @@ class Explorer:
         widgets, self._matplotlib, Figure = _imports()
         material, preset = _uniform(material)
         _validate.model_index(model)
-        resolution = _validate.integer("resolution", resolution)
-        if not 2 <= resolution <= _render.MAX_RESOLUTION:
-            raise ValueError(f"resolution: expected 2 to {_render.MAX_RESOLUTION} pixels, got {resolution}")
+        resolution = _validate.resolution("resolution", resolution)
         self.resolution = resolution
         self._holding = 0
         self._quiet = False  # while the preset menu sets the sliders

@@ -21,14 +21,16 @@ argument is a :class:`~principled_brdf.Material` or the name of a preset
 
 Scalar pictures show one channel of the RGB result: ``"luminance"`` (Rec. 709
 weights of linear RGB, 0.2126 R + 0.7152 G + 0.0722 B), or ``"r"``, ``"g"``,
-``"b"``. matplotlib is imported on the first call, so ``import principled_brdf``
+``"b"``. A ``resolution`` (pixels, or angles for :func:`polar_lobes` and
+:func:`microfacet_family`) is an integer from 2 (8 for :func:`microfacet_family`)
+to 16384, ``pb.render.MAX_RESOLUTION``, as ``pb.render.render_sphere``'s; the
+errors name the argument. matplotlib is imported on the first call, so ``import principled_brdf``
 (and ``import principled_brdf.plot``) work without it.
 """
 
 from __future__ import annotations
 
 import numbers
-import operator
 import typing
 
 import numpy as np
@@ -37,6 +39,7 @@ from . import presets as _presets
 from ._batch import eval as _eval
 from ._batch import eval_lobes as _eval_lobes
 from . import _color, _validate
+from .albedo import MAX_SAMPLES as _ALBEDO_MAX_SAMPLES
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material
 from . import render as _render
@@ -44,7 +47,7 @@ from . import render as _render
 if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
     from collections.abc import Iterable, Mapping
     from types import ModuleType
-    from typing import Any, SupportsIndex
+    from typing import Any
 
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -106,18 +109,6 @@ def _uniform_material(name: str, value: object) -> Material:
         raise ValueError(f"{name}: expected a uniform material (one value per parameter), "
                          f"got per-element parameters of shape {material.shape}")
     return material
-
-
-def _resolution(value: SupportsIndex, name: str = "resolution", minimum: int = 2) -> int:
-    if isinstance(value, bool):
-        raise TypeError(f"{name}: expected an integer, got bool")
-    try:
-        count = operator.index(value)
-    except TypeError:
-        raise TypeError(f"{name}: expected an integer, got {type(value).__name__}") from None
-    if count < minimum:
-        raise ValueError(f"{name}: expected an integer >= {minimum}, got {count}")
-    return count
 
 
 def _real(name: str, value: object, lower: float = -np.inf, upper: float = np.inf, open_upper: bool = False,
@@ -188,7 +179,7 @@ def slice_directions(resolution: int, phi_d: float = 90.0) -> tuple[FloatArray, 
     with ``d = (sin θd cos φd, sin θd sin φd, cos θd)`` and ``d'`` its
     reflection about z (so ``h`` is their half vector and ``cos θd = wi·h``).
     """
-    n = _resolution(resolution)
+    n = _validate.resolution("resolution", resolution)
     phi = np.radians(_real("phi_d", phi_d))
     theta = (np.arange(n) + 0.5) * (90.0 / n)
     th, td = np.meshgrid(np.radians(theta), np.radians(theta))  # [θd, θh]
@@ -228,7 +219,7 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
     gives the plotted values, indexed ``[θd, θh]`` with row 0 at θd ≈ 0).
     """
     material = _uniform_material("material", material)
-    n = _resolution(resolution)
+    n = _validate.resolution("resolution", resolution)
     rgb_mode = channel == "rgb"
     weights = np.asarray(CHANNELS["luminance"]) if rgb_mode else _channel(channel)
     _validate.model_index(model)
@@ -317,7 +308,7 @@ def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True,
     """
     material = _uniform_material("material", material)
     theta = _real("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
-    n = _resolution(resolution)
+    n = _validate.resolution("resolution", resolution, unit=" angles")
     weights = _channel(channel)
     decades = _real("decades", decades, 0.0, open_lower=True)
     _validate.model_index(model)
@@ -393,13 +384,13 @@ def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealAr
     ``energy_compensation`` as in ``pb.eval``.
     """
     material = _material("material", material)
-    n = _resolution(resolution)
+    n = _validate.resolution("resolution", resolution)
     exposure = _real("exposure", exposure, 0.0)
     intensity = _real("light_intensity", light_intensity, 0.0)
     if material.shape not in ((), (n, n)):
         raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
                          f"got {material.shape}")
-    count = _resolution(environment_samples, "environment_samples", minimum=1)
+    count = _validate.integer_in("environment_samples", environment_samples, 1, _render.MAX_SAMPLES, " per pixel")
     _validate.model_index(model)
     environment = _render._environment(environment)
     ax = _axes(ax)
@@ -436,7 +427,7 @@ def albedo_curves(material: Material | str, *, angles: RealArrayLike = np.linspa
         raise ValueError("angles: expected a 1-d array of finite angles in degrees")
     if np.any(theta < 0.0) or np.any(theta >= 90.0):
         raise ValueError(f"angles: expected degrees in [0, 90), got values from {theta.min():g} to {theta.max():g}")
-    _resolution(samples, "samples")
+    _validate.integer_in("samples", samples, 2, _ALBEDO_MAX_SAMPLES)
     _validate.model_index(model)
     ax = _axes(ax)
 
@@ -496,8 +487,8 @@ def parameter_sweep(base: Material | str | None = None, *, parameters: str | Ite
         if name not in SCALAR_PARAMETERS:
             raise ValueError(f"parameters: unknown scalar parameter {name!r}; "
                              f"choose from {', '.join(SCALAR_PARAMETERS)}")
-    count = _resolution(steps, "steps")
-    n = _resolution(resolution)
+    count = _validate.integer_in("steps", steps, 2, _validate.MAX_RESOLUTION)
+    n = _validate.resolution("resolution", resolution)
     exposure = _real("exposure", exposure, 0.0)
     ranges = {} if ranges is None else dict(ranges)
     for name in ranges:
@@ -573,7 +564,7 @@ def blend_demo(a: Material | str, b: Material | str, *, mask: RealArrayLike | No
     """
     a = _material("a", a)
     b = _material("b", b)
-    n = _resolution(resolution)
+    n = _validate.resolution("resolution", resolution)
     exposure = _real("exposure", exposure, 0.0)
     if mask is None:
         mask = _checker(n)
@@ -649,7 +640,7 @@ def microfacet_family(alpha: float = 0.3, *, student_t_gammas: Iterable[float] =
     gammas = _shapes("student_t_gammas", student_t_gammas, 1.5, 1e12, open_lower=True)
     ps = _shapes("exponential_power_ps", exponential_power_ps, 0.1, 10.0)
     gtrs = _shapes("gtr_gammas", gtr_gammas, 0.0, 1e6, open_lower=True)
-    n = _resolution(resolution, minimum=8)
+    n = _validate.resolution("resolution", resolution, minimum=8, unit=" angles")
     decades = _real("decades", decades, 0.0, open_lower=True)
     drawn = _family_axes(axes)
     from . import microfacet as mf

@@ -48,7 +48,7 @@ __all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_fra
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
 
 
-MAX_RESOLUTION = 16384
+MAX_RESOLUTION = _validate.MAX_RESOLUTION  # pixels along a side (16384)
 DEFAULT_SAMPLES = 64  # sky samples per pixel: with the lattice below, no visible noise on any preset
 MAX_SAMPLES = 1 << 16  # sky samples per pixel
 # Sky samples in all (pixels x samples, every sphere of a batch counted): 16384² pixels at the default
@@ -56,18 +56,9 @@ MAX_SAMPLES = 1 << 16  # sky samples per pixel
 MAX_SAMPLE_WORK = 1 << 34
 
 
-def _resolution(value: object) -> int:
-    value = _validate.integer("resolution", value)
-    if not 2 <= value <= MAX_RESOLUTION:
-        raise ValueError(f"resolution: expected 2 to {MAX_RESOLUTION} pixels, got {value}")
-    return value
-
-
 def _samples(value: object, pixels: int) -> int:
     """Sky samples per pixel: an integer from 1 to MAX_SAMPLES, and pixels x samples at most MAX_SAMPLE_WORK."""
-    samples = _validate.integer("samples", value)
-    if not 1 <= samples <= MAX_SAMPLES:
-        raise ValueError(f"samples: expected 1 to {MAX_SAMPLES} per pixel, got {samples}")
+    samples = _validate.integer_in("samples", value, 1, MAX_SAMPLES, " per pixel")
     if pixels * samples > MAX_SAMPLE_WORK:
         raise ValueError(f"samples: {samples} per pixel over {pixels} pixels is {pixels * samples} samples, beyond "
                          f"the {MAX_SAMPLE_WORK} (2^34) a picture takes; at most {max(MAX_SAMPLE_WORK // pixels, 0)} "
@@ -113,7 +104,7 @@ def sphere_frames(resolution: int) -> tuple[NDArray[np.bool_], Callable[[RealArr
     vector ``d`` (3,) to each pixel's local shading frame, ``(H, W, 3)`` float32
     (pixels off the sphere get the normal, so every vector is valid).
     """
-    resolution = _resolution(resolution)
+    resolution = _validate.resolution("resolution", resolution)
     coords = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
     x, y = np.meshgrid(coords, -coords)  # row 0 at the top
     r2 = x * x + y * y
@@ -156,6 +147,8 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
                   seed: int = 0, energy_compensation: bool = False) -> Float32Array:
     """Linear RGB ``(resolution, resolution, 3)`` image of ``material`` on a sphere.
 
+    ``resolution``: pixels along a side, an integer from 2 to :data:`MAX_RESOLUTION`
+    (16384), the rule of every picture of ``render``, ``plot`` and the explorer.
     Lit by a directional light (``light``: direction towards it in camera
     space, x right, y up, z to the viewer; ``light_intensity``: its
     irradiance, 0 turns it off) and by ``environment``: ``"sky"`` (default,
@@ -175,7 +168,7 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     light_intensity = _non_negative("light_intensity", light_intensity)
     ambient = _non_negative("ambient", ambient)
     environment = _environment(environment)
-    resolution = _resolution(resolution)
+    resolution = _validate.resolution("resolution", resolution)
     _samples(samples, _pixels(material, resolution) if environment is not None else 0)  # (unused without one)
     inside, to_local = sphere_frames(resolution)
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
@@ -243,7 +236,7 @@ def render_environment(material: Material, resolution: int = 256, environment: _
     as in ``pb.sample``."""
     # (False, which _environment maps to None, is not checked here: calling it fails as before)
     environment = typing.cast("_Environment", sky_environment if environment is None else _environment(environment))
-    resolution = _resolution(resolution)
+    resolution = _validate.resolution("resolution", resolution)
     samples = _samples(samples, _pixels(material, resolution))
     inside, to_local = sphere_frames(resolution)
     wo = to_local((0.0, 0.0, 1.0))
