@@ -40,8 +40,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import importlib
-import inspect
 import math
 import time
 from typing import TYPE_CHECKING, cast
@@ -157,19 +155,6 @@ def _slider_class(widgets: ModuleType) -> type[Any]:
     return Slider
 
 
-def _accepts(function: Callable[..., object], keyword: str) -> bool:
-    try:
-        parameter = inspect.signature(function).parameters.get(keyword)
-    except (TypeError, ValueError):
-        return False
-    return parameter is not None and parameter.kind in (parameter.POSITIONAL_OR_KEYWORD, parameter.KEYWORD_ONLY)
-
-
-def supports_energy_compensation() -> bool:
-    """Whether ``pb.eval`` takes ``energy_compensation=`` (the explorer shows a checkbox then)."""
-    return _accepts(importlib.import_module(__package__).eval, "energy_compensation")
-
-
 def _hex(linear: RealArrayLike) -> str:
     return "#" + "".join(f"{int(round(v * 255.0)):02x}" for v in _color.srgb_encode(linear))
 
@@ -227,8 +212,8 @@ class Explorer:
     ``base_color`` (ColorPicker, sRGB), ``model``, ``preset`` (Dropdowns),
     ``light_theta``, ``light_phi``, ``view_theta``, ``view_phi`` (degrees),
     ``exposure`` (stops), ``sky``, ``log_radius`` (Checkboxes),
-    ``energy_compensation`` (a Checkbox when ``pb.eval`` takes
-    ``energy_compensation=``, else None), ``images`` (``{name: Image}`` for
+    ``energy_compensation`` (a Checkbox: ``energy_compensation=`` of every
+    picture's kernel calls), ``images`` (``{name: Image}`` for
     :data:`OUTPUTS`), ``status`` (HTML: the last update's time) and
     ``widget``, the whole layout; the Explorer displays as that widget.
     ``timings``: seconds each picture took when last drawn;
@@ -307,8 +292,7 @@ class Explorer:
         self.exposure = slider("exposure (stops)", 0.0, -4.0, 4.0, 0.25, "+.2f", "exposure", _MAX_EXPOSURE_STOPS)
         self.sky = widgets.Checkbox(value=True, description="sky light on the sphere", indent=False)
         self.log_radius = widgets.Checkbox(value=False, description="log radius (polar)", indent=False)
-        self.energy_compensation = (widgets.Checkbox(value=False, description="energy compensation", indent=False)
-                                    if supports_energy_compensation() else None)
+        self.energy_compensation = widgets.Checkbox(value=False, description="energy compensation", indent=False)
 
         self.images = {name: widgets.Image(format="png") for name in OUTPUTS}
         self.status = widgets.HTML()
@@ -335,7 +319,7 @@ class Explorer:
             return widgets.Box([image], layout=widgets.Layout(width=f"{self._figures_size[0] + 8}px",
                                                              justify_content="center", align_items="center"))
 
-        checks = [self.sky, self.log_radius] + ([self.energy_compensation] if self.energy_compensation else [])
+        checks = [self.sky, self.log_radius, self.energy_compensation]
         controls = widgets.VBox(
             [header("Material"), self.preset, self.model, self.base_color, *self.sliders.values(),
              header("Light and view"), self.light_theta, self.light_phi, self.view_theta, self.view_phi,
@@ -362,8 +346,9 @@ class Explorer:
 
     def _controls(self) -> list[Any]:
         controls = [*self.sliders.values(), self.base_color, self.model, self.preset, self.light_theta,
-                    self.light_phi, self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius]
-        return controls + ([self.energy_compensation] if self.energy_compensation else [])
+                    self.light_phi, self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius,
+                    self.energy_compensation]
+        return controls
 
     @property
     def material(self) -> Material:
@@ -380,13 +365,8 @@ class Explorer:
             "exposure": float(self.exposure.value),
             "sky": bool(self.sky.value),
             "log": bool(self.log_radius.value),
-            "energy_compensation": bool(self.energy_compensation.value) if self.energy_compensation else None,
+            "energy_compensation": bool(self.energy_compensation.value),
         }
-
-    def _options(self, function: Callable[..., object], state: Mapping[str, Any]) -> dict[str, Any]:
-        """Keyword options the model takes beyond ``model=``, where ``function`` accepts them."""
-        ec = state["energy_compensation"]
-        return {"energy_compensation": ec} if ec is not None and _accepts(function, "energy_compensation") else {}
 
     @contextlib.contextmanager
     def hold(self) -> Iterator[Explorer]:
@@ -558,9 +538,9 @@ class Explorer:
         light = _direction(*state["light"])
         model = state["model"]
         n = self.resolution
-        options = self._options(_render.render_sphere, state)
         return _render.render_sphere(material, n, light=light, ambient=0.0 if state["sky"] else _AMBIENT, model=model,
-                                     environment="sky" if state["sky"] else None, samples=_SKY_SAMPLES, **options)
+                                     environment="sky" if state["sky"] else None, samples=_SKY_SAMPLES,
+                                     energy_compensation=state["energy_compensation"])
 
     def _build_polar(self, Figure: type[Figure]) -> None:
         fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
@@ -590,7 +570,7 @@ class Explorer:
         wi = np.empty((t.size, 3))
         wi[:, 0], wi[:, 1], wi[:, 2] = np.sin(t) * azimuth[0], np.sin(t) * azimuth[1], np.cos(t)
         wo = _direction(theta_v, phi_v)
-        values = _eval_lobes(material, wi, wo, model=state["model"], **self._options(_eval_lobes, state))
+        values = _eval_lobes(material, wi, wo, model=state["model"], energy_compensation=state["energy_compensation"])
         curves = {name: np.asarray(v, dtype=np.float64) @ _LUMINANCE for name, v in zip(_validate.LOBE_NAMES, values)}
         curves["total"] = cast("Float64Array", sum(curves.values()))  # (not 0: there are four lobes)
         peak = float(curves["total"].max())
@@ -656,7 +636,8 @@ class Explorer:
 
     def _draw_slice(self, material: Material, state: Mapping[str, Any]) -> bytes:
         s = self._slice
-        f = _eval_lobes(material, s["wi"], s["wo"], model=state["model"], **self._options(_eval_lobes, state))
+        f = _eval_lobes(material, s["wi"], s["wo"], model=state["model"],
+                        energy_compensation=state["energy_compensation"])
         luminance = np.asarray(f.total(), dtype=np.float64) @ _LUMINANCE
         shown = luminance[s["valid"]]
         top = float(shown.max()) if shown.size and shown.max() > 0.0 else 1.0
@@ -701,7 +682,7 @@ class Explorer:
         a = self._albedo
         ax, lines = a["ax"], a["lines"]
         result = _albedo(material, np.cos(np.radians(_ALBEDO_ANGLES)), samples=_ALBEDO_SAMPLES, seed=0,
-                         model=state["model"], **self._options(_albedo, state))
+                         model=state["model"], energy_compensation=state["energy_compensation"])
         curves: dict[str, tuple[FloatArray, FloatArray]] = {"total": (result.total, result.total_error)}
         curves.update({name: (value, error) for name, value, error in
                        zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)})
