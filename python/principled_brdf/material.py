@@ -86,7 +86,7 @@ class Material:
         values = dict(locals())
         for name, info in PARAMETERS.items():
             if name == "base_color" and isinstance(values[name], np.ndarray) and values[name].dtype == np.uint8:
-                raise TypeError("base_color: a uint8 colour (0-255) is not linear RGB; convert it explicitly, "
+                raise TypeError("base_color: a uint8 color (0-255) is not linear RGB; convert it explicitly, "
                                 "e.g. pb.srgb_to_linear(texture), which scales uint8 by 1/255")
             array = as_real_array(name, values[name])
             if info.slots == 3 and (array.ndim == 0 or array.shape[-1] != 3):
@@ -101,7 +101,7 @@ class Material:
         object.__setattr__(self, "_shape", broadcast_leading(**{name: self._leading_shape(name) for name in PARAMETERS}))
         if not flag("bright_base_color", bright_base_color) and self.base_color.size and self.base_color.max() > 1.0:
             warnings.warn(f"base_color: {self.base_color.max():g} > 1 reflects more than it receives (a 0-255 or "
-                          "display-encoded colour?); pass bright_base_color=True if it is meant", BrightColorWarning,
+                          "display-encoded color?); pass bright_base_color=True if it is meant", BrightColorWarning,
                           stacklevel=2)
 
     def __setattr__(self, name: str, value: object) -> NoReturn:
