@@ -15,6 +15,9 @@ import numpy as np
 if TYPE_CHECKING:
     from ._typing import Float64Array, RealArrayLike
 
+# Rec. 709 luminance of linear RGB: the tone curves' Y and plot's "luminance" channel.
+LUMINANCE_WEIGHTS = (0.2126, 0.7152, 0.0722)
+
 
 def srgb_encode(linear: RealArrayLike) -> Float64Array:
     """Linear to sRGB-encoded: ``12.92 c`` for ``c <= 0.0031308``, else ``1.055 c^(1/2.4) - 0.055``,

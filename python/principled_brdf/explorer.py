@@ -53,7 +53,8 @@ from ._batch import FLOAT32_LIMITS as _KERNEL_LIMITS
 from ._batch import eval_lobes as _eval_lobes
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material, srgb_to_linear
-from .plot import CHANNELS, slice_directions
+from .plot import _LOBE_COLORS as _PLOT_LOBE_COLORS
+from .plot import CHANNELS, _rgba, _uniform_material, slice_directions
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator, Mapping
@@ -79,8 +80,8 @@ OUTPUTS = ("sphere", "polar", "slice", "albedo")
 CUSTOM = "(custom)"
 
 _LUMINANCE = np.asarray(CHANNELS["luminance"], dtype=np.float64)
-_LOBE_COLORS = {"diffuse": "tab:orange", "sheen": "tab:purple", "specular": "tab:blue", "clearcoat": "tab:green",
-                "total": "black"}
+# plot's colors; the multiple-scattering lobe counts in the totals without a line of its own
+_LOBE_COLORS = {name: color for name, color in _PLOT_LOBE_COLORS.items() if name != "multiple_scattering"}
 # What each picture shows (keys of Explorer._state): it is redrawn only when one of these changes.
 _DEPENDS = {
     "sphere": ("material", "model", "energy_compensation", "light", "exposure", "sky"),
@@ -187,21 +188,10 @@ def _direction(theta_degrees: float, phi_degrees: float) -> Float64Array:
 
 
 def _uniform(material: object) -> tuple[Material, str | None]:
-    """(Material, preset name or None) from None, a Material or a preset name."""
+    """(Material, preset name or None) from None, a uniform Material or a preset name."""
     if material is None:
         return Material(), None
-    if isinstance(material, str):
-        try:
-            return _presets.get(material), material
-        except ValueError as error:
-            raise ValueError(f"material: {error}") from None
-    if not isinstance(material, Material):
-        raise TypeError(f"material: expected a principled_brdf.Material or a preset name, "
-                        f"got {type(material).__name__}")
-    if not material.is_uniform:
-        raise ValueError(f"material: expected a uniform material (one value per parameter), "
-                         f"got per-element parameters of shape {material.shape}")
-    return material, None
+    return _uniform_material("material", material), material if isinstance(material, str) else None
 
 
 class Explorer:
@@ -530,9 +520,7 @@ class Explorer:
         if self._sphere_linear[0] != key:  # an exposure change only tone maps again
             self._sphere_linear = (key, self._render_sphere(material, state))
         assert self._sphere_linear[1] is not None  # rendered above (key is never None)
-        rgb = _render.to_srgb8(self._sphere_linear[1], 2.0 ** state["exposure"])
-        alpha = np.where(self._inside, 255, 0).astype(np.uint8)
-        return _render.png_bytes(np.concatenate([rgb, alpha[..., None]], axis=-1))
+        return _render.png_bytes(_rgba(self._sphere_linear[1], self._inside, 2.0 ** state["exposure"]))
 
     def _render_sphere(self, material: Material, state: Mapping[str, Any]) -> Float32Array:
         light = _direction(*state["light"])

@@ -30,7 +30,6 @@ errors name the argument. matplotlib is imported on the first call, so ``import 
 
 from __future__ import annotations
 
-import numbers
 import typing
 
 import numpy as np
@@ -65,7 +64,7 @@ SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items() if info.slot
 
 #: Channel names accepted by the scalar plots and their weights on linear RGB.
 CHANNELS = {
-    "luminance": (0.2126, 0.7152, 0.0722),
+    "luminance": _color.LUMINANCE_WEIGHTS,
     "r": (1.0, 0.0, 0.0),
     "g": (0.0, 1.0, 0.0),
     "b": (0.0, 0.0, 1.0),
@@ -109,19 +108,6 @@ def _uniform_material(name: str, value: object) -> Material:
         raise ValueError(f"{name}: expected a uniform material (one value per parameter), "
                          f"got per-element parameters of shape {material.shape}")
     return material
-
-
-def _real(name: str, value: object, lower: float = -np.inf, upper: float = np.inf, open_upper: bool = False,
-          open_lower: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name}: expected a real number, got {type(value).__name__}")
-    x = float(value)
-    bad = not np.isfinite(x) or x < lower or x > upper or (open_upper and x == upper) or (open_lower and x == lower)
-    if bad:
-        lo = "(" if open_lower else "["
-        hi = ")" if open_upper else "]"
-        raise ValueError(f"{name}: {x!r} is outside {lo}{lower:g}, {upper:g}{hi}")
-    return x
 
 
 def _channel(value: object) -> Float64Array:
@@ -180,7 +166,7 @@ def slice_directions(resolution: int, phi_d: float = 90.0) -> tuple[FloatArray, 
     reflection about z (so ``h`` is their half vector and ``cos θd = wi·h``).
     """
     n = _validate.resolution("resolution", resolution)
-    phi = np.radians(_real("phi_d", phi_d))
+    phi = np.radians(_validate.real_number("phi_d", phi_d))
     theta = (np.arange(n) + 0.5) * (90.0 / n)
     th, td = np.meshgrid(np.radians(theta), np.radians(theta))  # [θd, θh]
     sd, cd = np.sin(td), np.cos(td)
@@ -225,11 +211,11 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
     _validate.model_index(model)
     value: float | Float64Array | None  # vmin or vmax in the loop, then the projected slice
     for name, value in (("vmin", vmin), ("vmax", vmax)):
-        if value is not None and _real(name, value, 0.0) <= 0.0 and log:
+        if value is not None and _validate.real_number(name, value, 0.0) <= 0.0 and log:
             raise ValueError(f"{name}: a logarithmic scale needs a positive value, got {value!r}")
-    percentile = (99.0 if log else 90.0) if percentile is None else _real("percentile", percentile, 0.0, 100.0,
-                                                                              open_lower=True)
-    exposure = _real("exposure", exposure, 0.0, open_lower=True)
+    percentile = ((99.0 if log else 90.0) if percentile is None
+                  else _validate.real_number("percentile", percentile, 0.0, 100.0, open_lower=True))
+    exposure = _validate.real_number("exposure", exposure, 0.0, open_lower=True)
     ax = _axes(ax)
     from matplotlib import colors, cm
 
@@ -307,10 +293,10 @@ def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True,
     ``"total"``, ``"diffuse"``, ... (their data: f, or log10 f with ``log``).
     """
     material = _uniform_material("material", material)
-    theta = _real("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
+    theta = _validate.real_number("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
     n = _validate.resolution("resolution", resolution, unit=" angles")
     weights = _channel(channel)
-    decades = _real("decades", decades, 0.0, open_lower=True)
+    decades = _validate.real_number("decades", decades, 0.0, open_lower=True)
     _validate.model_index(model)
     ax = typing.cast("PolarAxes", _axes(ax, polar=True))  # checked: its name is "polar"
     from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
@@ -385,8 +371,8 @@ def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealAr
     """
     material = _material("material", material)
     n = _validate.resolution("resolution", resolution)
-    exposure = _real("exposure", exposure, 0.0)
-    intensity = _real("light_intensity", light_intensity, 0.0)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
+    intensity = _validate.real_number("light_intensity", light_intensity, 0.0)
     if material.shape not in ((), (n, n)):
         raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
                          f"got {material.shape}")
@@ -489,7 +475,7 @@ def parameter_sweep(base: Material | str | None = None, *, parameters: str | Ite
                              f"choose from {', '.join(SCALAR_PARAMETERS)}")
     count = _validate.integer_in("steps", steps, 2, _validate.MAX_RESOLUTION)
     n = _validate.resolution("resolution", resolution)
-    exposure = _real("exposure", exposure, 0.0)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
     ranges = {} if ranges is None else dict(ranges)
     for name in ranges:
         if name not in names:
@@ -497,7 +483,7 @@ def parameter_sweep(base: Material | str | None = None, *, parameters: str | Ite
     spans = []
     for name in names:
         lo, hi = ranges.get(name, (0.0, 1.0))
-        spans.append((_real(f"ranges[{name!r}]", lo), _real(f"ranges[{name!r}]", hi)))
+        spans.append((_validate.real_number(f"ranges[{name!r}]", lo), _validate.real_number(f"ranges[{name!r}]", hi)))
 
     rows = len(names)
     params: dict[str, Any] = {"base_color": base.base_color}  # (Any: Material(**) also takes a bool keyword)
@@ -565,7 +551,7 @@ def blend_demo(a: Material | str, b: Material | str, *, mask: RealArrayLike | No
     a = _material("a", a)
     b = _material("b", b)
     n = _validate.resolution("resolution", resolution)
-    exposure = _real("exposure", exposure, 0.0)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
     if mask is None:
         mask = _checker(n)
     else:
@@ -595,7 +581,8 @@ def blend_demo(a: Material | str, b: Material | str, *, mask: RealArrayLike | No
 def _shapes(name: str, values: Iterable[float], lower: float, upper: float, open_lower: bool = False) -> list[float]:
     if isinstance(values, (str, bytes)) or not isinstance(values, typing.Iterable):
         raise TypeError(f"{name}: expected a sequence of numbers, got {type(values).__name__}")
-    return [_real(f"{name}[{k}]", value, lower, upper, open_lower=open_lower) for k, value in enumerate(values)]
+    return [_validate.real_number(f"{name}[{k}]", value, lower, upper, open_lower=open_lower)
+            for k, value in enumerate(values)]
 
 
 def _family_axes(axes: object) -> tuple[Axes, Axes] | None:
@@ -636,12 +623,12 @@ def microfacet_family(alpha: float = 0.3, *, student_t_gammas: Iterable[float] =
     Both panels carry the same line labels (``"GGX"``, ``"Beckmann"``, ``"Student-t γ = 1.6"``,
     ...); the legend (``legend``) is on the D panel.
     """
-    a = _real("alpha", alpha, 0.0, 1.0, open_lower=True)
+    a = _validate.real_number("alpha", alpha, 0.0, 1.0, open_lower=True)
     gammas = _shapes("student_t_gammas", student_t_gammas, 1.5, 1e12, open_lower=True)
     ps = _shapes("exponential_power_ps", exponential_power_ps, 0.1, 10.0)
     gtrs = _shapes("gtr_gammas", gtr_gammas, 0.0, 1e6, open_lower=True)
     n = _validate.resolution("resolution", resolution, minimum=8, unit=" angles")
-    decades = _real("decades", decades, 0.0, open_lower=True)
+    decades = _validate.real_number("decades", decades, 0.0, open_lower=True)
     drawn = _family_axes(axes)
     from . import microfacet as mf
 

@@ -88,14 +88,6 @@ def _light_direction(value: object) -> Float64Array:
     return light / length
 
 
-def _non_negative(name: str, value: object) -> float:
-    array = _validate.as_real_array(name, value)
-    if array.shape != ():
-        raise ValueError(f"{name}: expected one number, got shape {array.shape}")
-    _validate.require_in_domain(name, array, 0.0, np.inf)
-    return float(array)
-
-
 def sphere_frames(resolution: int) -> tuple[NDArray[np.bool_], Callable[[RealArrayLike], Float32Array]]:
     """Per-pixel local directions for a sphere image.
 
@@ -165,8 +157,8 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     kernel call. Background is 0. ``energy_compensation`` as in ``pb.eval``.
     """
     light = _light_direction(light)
-    light_intensity = _non_negative("light_intensity", light_intensity)
-    ambient = _non_negative("ambient", ambient)
+    light_intensity = _validate.real_number("light_intensity", light_intensity, 0.0)
+    ambient = _validate.real_number("ambient", ambient, 0.0)
     environment = _environment(environment)
     resolution = _validate.resolution("resolution", resolution)
     _samples(samples, _pixels(material, resolution) if environment is not None else 0)  # (unused without one)
@@ -295,7 +287,7 @@ def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "
     NaN is a ValueError naming the pixel."""
     if curve not in TONE_CURVES:
         raise ValueError(f"curve: expected one of {', '.join(TONE_CURVES)}, got {curve!r}")
-    exposure = _non_negative("exposure", exposure)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
     c = _validate.as_real_array("linear", linear)
     if c.ndim == 0 or c.shape[-1] != 3:
         raise ValueError(f"linear: expected RGB values of shape (..., 3), got {c.shape}")
@@ -306,7 +298,7 @@ def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "
     c = np.clip(c * exposure, 0.0, 1e30)
     if curve == "clip":
         return np.minimum(c, 1.0)
-    luminance = c @ np.array([0.2126, 0.7152, 0.0722])
+    luminance = c @ np.array(_color.LUMINANCE_WEIGHTS)
     mapped = _filmic(luminance) if curve == "filmic" else _reinhard(luminance)
     scale = np.divide(mapped, luminance, out=np.zeros_like(luminance), where=luminance > 0.0)
     c = c * scale[..., None]
@@ -362,7 +354,7 @@ def save_image(path: str | os.PathLike[str], linear: RealArrayLike, exposure: fl
     image = np.asarray(linear, dtype=np.float64)
     if image.ndim != 3 or image.shape[2] != 3:
         raise ValueError(f"linear: expected an (H, W, 3) RGB image, got shape {image.shape}")
-    exposure = _non_negative("exposure", exposure)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
     if extension == ".png":
         write_png(path, to_srgb8(image, exposure, curve))
     elif extension == ".npy":
