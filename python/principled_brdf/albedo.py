@@ -10,7 +10,7 @@ import numpy as np
 
 from ._batch import Lobes, random_uniforms, sample
 from ._validate import LOBE_NAMES, as_real_array, broadcast_leading, integer_in, require_in_domain, seed_value
-from .material import PARAMETERS, Material
+from .material import PARAMETERS, Material, _require_material
 
 if TYPE_CHECKING:
     from typing import Any, SupportsIndex
@@ -56,8 +56,7 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
     weights (``pb.sample``, seeded, so the call is reproducible); errors are
     the standard errors of those means. ``energy_compensation`` as in ``pb.sample``.
     """
-    if not isinstance(material, Material):
-        raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
+    _require_material("material", material)
     cos_o = as_real_array("cos_theta_o", cos_theta_o)
     require_in_domain("cos_theta_o", cos_o, 0.0, 1.0)
     if np.any(cos_o == 0.0):

@@ -54,7 +54,7 @@ from ._batch import eval_lobes as _eval_lobes
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material, srgb_to_linear
 from .plot import _LOBE_COLORS as _PLOT_LOBE_COLORS
-from .plot import CHANNELS, _rgba, _uniform_material, slice_directions
+from .plot import CHANNELS, _rgba, _uniform_material, _upper_half_disc, slice_directions
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator, Mapping
@@ -536,10 +536,7 @@ class Explorer:
         # The Axes becomes a square, the half disc (radius: half its side) centred in it: a radius of
         # 135 px, the horizon 75 px above the bottom (room for the legend); the title is a figure text.
         ax = cast("PolarAxes", fig.add_axes((0.117, 0.028, 0.767, 1.023), projection="polar"))
-        ax.set_theta_zero_location("N")
-        ax.set_theta_direction(-1)
-        ax.set_thetamin(-90)
-        ax.set_thetamax(90)
+        _upper_half_disc(ax)
         ax.set_thetagrids([-90, -60, -30, 0, 30, 60, 90])
         ax.set_rlabel_position(80)  # near the horizon on the side of wo
         t = np.radians((np.arange(_POLAR_STEPS) + 0.5) * (180.0 / _POLAR_STEPS) - 90.0)  # open: no horizon segment

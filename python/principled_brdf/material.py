@@ -168,9 +168,8 @@ class Material:
         ``t`` is a number or a per-element mask in [0, 1], broadcast against the
         materials' leading shapes (it applies to all three channels of base_color).
         """
-        for name, material in (("a", a), ("b", b)):
-            if not isinstance(material, Material):
-                raise TypeError(f"{name}: expected a Material, got {type(material).__name__}")
+        _require_material("a", a)
+        _require_material("b", b)
         weight = as_real_array("t", t)
         require_in_domain("t", weight, 0.0, 1.0)
         broadcast_leading(a=a.shape, b=b.shape, t=weight.shape)  # else numpy's message names no argument
@@ -229,6 +228,13 @@ class Material:
             else:
                 parts.append(f"{name}=<{array.shape} in [{array.min():g}, {array.max():g}]>")
         return "Material(" + ", ".join(parts) + ")"
+
+
+def _require_material(name: str, value: object) -> Material:
+    """``value``, if it is a Material; a TypeError naming the argument otherwise."""
+    if not isinstance(value, Material):
+        raise TypeError(f"{name}: expected a principled_brdf.Material, got {type(value).__name__}")
+    return value
 
 
 def _rebuilt(*values: RealArrayLike) -> Material:

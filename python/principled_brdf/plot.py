@@ -142,6 +142,14 @@ def _rgba(linear: RealArrayLike, inside: NDArray[np.bool_], exposure: float) -> 
     return np.concatenate([rgb, alpha[..., None]], axis=-1)
 
 
+def _upper_half_disc(ax: PolarAxes) -> None:
+    """The plane of incidence above the surface: the normal at the top, angles positive to the right."""
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(-90)
+    ax.set_thetamax(90)
+
+
 def _sphere_axes(ax: Axes, title: str) -> None:
     ax.set_xticks([])
     ax.set_yticks([])
@@ -325,10 +333,7 @@ def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True,
         ax.plot(t, radius(curve), color=_LOBE_COLORS[name], lw=1.3, label=name, zorder=3)
     top = float(radius(np.array(peak)))
     ax.plot([np.radians(theta)] * 2, [0.0, top], color="0.5", ls="--", lw=1.0, label="wo", zorder=1)
-    ax.set_theta_zero_location("N")
-    ax.set_theta_direction(-1)
-    ax.set_thetamin(-90)
-    ax.set_thetamax(90)
+    _upper_half_disc(ax)
     ax.set_ylim(0.0, top * 1.05)
     if log:  # a tick per decade (or per few), labelled with f itself
         step = max(1, int(np.ceil(decades / 4)))
