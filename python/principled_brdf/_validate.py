@@ -215,7 +215,8 @@ def integer_in(name: str, value: object, minimum: int, maximum: int, unit: str =
     return count
 
 
-def resolution(name: str, value: object, minimum: int = 2, maximum: int = MAX_RESOLUTION, unit: str = " pixels") -> int:
+def resolution(name: str, value: object, minimum: int = 2, maximum: int = MAX_RESOLUTION,
+               unit: str = " pixels") -> int:
     """The pictures' one rule for a resolution (``render``, ``plot``, the explorer): an integer,
     not a bool, from ``minimum`` (2 unless a picture needs more) to ``maximum``
     (:data:`MAX_RESOLUTION`, 16384), e.g. ``resolution: expected 2 to 16384 pixels, got 1``."""

@@ -335,10 +335,8 @@ class Explorer:
         return round(theta * 2.0) / 2.0, float(round(phi))
 
     def _controls(self) -> list[Any]:
-        controls = [*self.sliders.values(), self.base_color, self.model, self.preset, self.light_theta,
-                    self.light_phi, self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius,
-                    self.energy_compensation]
-        return controls
+        return [*self.sliders.values(), self.base_color, self.model, self.preset, self.light_theta, self.light_phi,
+                self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius, self.energy_compensation]
 
     @property
     def material(self) -> Material:
