@@ -48,7 +48,7 @@ def plots(path: str) -> None:
     pb.plot.albedo_curves(material, ax=fig.add_subplot(grid[0, 2]))
     pb.plot.lit_sphere(material, ax=fig.add_subplot(grid[1, 2]))
     fig.suptitle("car_paint: lobes in the plane of incidence (linear, log radius), the (θh, θd) slice "
-                 "(luminance, colour), directional albedo, lit sphere")
+                 "(luminance, color), directional albedo, lit sphere")
     fig.savefig(path, dpi=DPI)
     plt.close(fig)
 
@@ -66,7 +66,7 @@ def family(path: str) -> None:
 
 
 def shrink(path: str) -> None:
-    """To a 256-colour palette (dithered): a third of the size, no visible change at this size."""
+    """To a 256-color palette (dithered): a third of the size, no visible change at this size."""
     from PIL import Image  # matplotlib's own dependency
 
     with Image.open(path) as image:

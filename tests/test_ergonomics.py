@@ -49,10 +49,27 @@ def test_srgb_to_linear_is_the_exact_piecewise_curve():
         pb.srgb_to_linear([200.0, 0.0, 0.0])
 
 
+def test_linear_to_srgb_is_the_inverse_curve():
+    c = np.array([0.0, 0.0031308, 0.0031309, 0.21404114048223255, 1.0])
+    expected = np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1.0 / 2.4) - 0.055)
+    np.testing.assert_allclose(pb.linear_to_srgb(c), expected, rtol=1e-15)
+    assert pb.linear_to_srgb(0.21404114048223255) == pytest.approx(0.5, rel=1e-12)
+    grid = np.linspace(0.0, 1.0, 1001)
+    np.testing.assert_allclose(pb.srgb_to_linear(pb.linear_to_srgb(grid)), grid, rtol=1e-12, atol=1e-15)
+    # the 8-bit pictures use the same curve
+    linear = np.array([[[0.0, 0.002, 0.5]]])
+    np.testing.assert_array_equal(pb.render.to_srgb8(linear, curve="clip"),
+                                  np.round(pb.linear_to_srgb(linear) * 255.0).astype(np.uint8))
+    with pytest.raises(ValueError, match=r"color\[1\]: 1.5 is outside its domain \[0, 1\]"):
+        pb.linear_to_srgb([0.5, 1.5, 0.0])
+    with pytest.raises(TypeError, match="color"):
+        pb.linear_to_srgb("red")
+
+
 def test_uint8_and_bright_base_colors_are_not_taken_silently():
-    with pytest.raises(TypeError, match="base_color: a uint8 colour"):
+    with pytest.raises(TypeError, match="base_color: a uint8 color"):
         pb.Material(base_color=np.array([200, 100, 50], np.uint8))
-    with pytest.warns(pb.BrightColorWarning, match="base_color: 200 > 1"):
+    with pytest.warns(pb.BrightColorWarning, match=r"base_color: 200 > 1 .*\(a 0-255 or display-encoded color\?\)"):
         bright = pb.Material(base_color=(200.0, 100.0, 50.0))
     import warnings
     with warnings.catch_warnings():

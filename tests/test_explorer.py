@@ -9,7 +9,6 @@ the call says what to install.
 from __future__ import annotations
 
 import importlib
-import inspect
 import io
 import struct
 import sys
@@ -232,40 +231,31 @@ def test_arguments():
         pb.explorer(pb.Material(roughness=np.array([0.1, 0.2])))
 
 
-def test_energy_compensation_checkbox_follows_the_signature_of_eval(monkeypatch):
-    assert explorer_module.supports_energy_compensation() == (
-        "energy_compensation" in inspect.signature(pb.eval).parameters)
-    monkeypatch.setattr(explorer_module, "supports_energy_compensation", lambda: False)
-    ex = pb.explorer(resolution=32)
-    try:
-        assert ex.energy_compensation is None
-        assert not any(getattr(w, "description", "") == "energy compensation" for w in ex.widget.children[0].children)
-    finally:
-        ex.close()
-
-    # a pb.eval that takes it: the checkbox appears and reaches the calls that take it
-    real_eval, real_eval_lobes = pb.eval, explorer_module._eval_lobes
+def test_energy_compensation_checkbox_reaches_every_picture(monkeypatch):
+    real_eval_lobes, real_albedo, real_render = (explorer_module._eval_lobes, explorer_module._albedo,
+                                                 pb.render.render_sphere)
     seen = []
 
-    def eval_with(material, wi, wo, *, energy_compensation=False, **options):
-        return real_eval(material, wi, wo, **options)
+    def recorded(name, function):
+        def call(*args, energy_compensation, **options):
+            seen.append((name, energy_compensation))
+            return function(*args, energy_compensation=energy_compensation, **options)
+        return call
 
-    def eval_lobes_with(material, wi, wo, *, energy_compensation=False, **options):
-        seen.append(energy_compensation)
-        return real_eval_lobes(material, wi, wo, **options)
-
-    monkeypatch.undo()
-    monkeypatch.setattr(pb, "eval", eval_with)
-    monkeypatch.setattr(explorer_module, "_eval_lobes", eval_lobes_with)
-    assert explorer_module.supports_energy_compensation()
+    monkeypatch.setattr(explorer_module, "_eval_lobes", recorded("lobes", real_eval_lobes))
+    monkeypatch.setattr(explorer_module, "_albedo", recorded("albedo", real_albedo))
+    monkeypatch.setattr(pb.render, "render_sphere", recorded("sphere", real_render))
     ex = pb.explorer(resolution=32)
     try:
         assert isinstance(ex.energy_compensation, ipywidgets.Checkbox)
         assert ex.energy_compensation in ex.widget.children[0].children
-        assert seen and not any(seen)
+        assert sorted(seen) == [("albedo", False), ("lobes", False), ("lobes", False), ("sphere", False)]
         seen.clear()
+        before = ex.images["albedo"].value
         ex.energy_compensation.value = True
-        assert seen == [True, True]  # the polar plot and the slice
+        # the sphere, the polar plot, the slice and the albedo, each with the real kernels
+        assert sorted(seen) == [("albedo", True), ("lobes", True), ("lobes", True), ("sphere", True)]
+        assert ex.images["albedo"].value != before
     finally:
         ex.close()
 

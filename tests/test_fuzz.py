@@ -527,7 +527,7 @@ def test_fuzz_paired_outputs_counts_and_compensation(data, leading, seed, entry)
 @FUZZ
 @given(data=st.data(), seed=st.integers(0, 2**32 - 1),
        entry=st.sampled_from(("frame", "to_local", "to_world", "spherical", "half_diff", "wiwo", "gamma22",
-                              "srgb", "tone")))
+                              "srgb", "linear_srgb", "tone")))
 def test_fuzz_frames_and_colors(data, seed, entry):
     rng = rng_from(seed)
     leading = data.draw(LEADING)
@@ -549,6 +549,7 @@ def test_fuzz_frames_and_colors(data, seed, entry):
             "wiwo": lambda: pb.frames.wiwo_to_half_diff(vector, opposite),
             "gamma22": lambda: pb.gamma22_to_linear(color),
             "srgb": lambda: pb.srgb_to_linear(color),
+            "linear_srgb": lambda: pb.linear_to_srgb(color),
             "tone": lambda: pb.render.to_srgb8(color,
                                                exposure=data.draw(st.sampled_from((1.0, 0.0, -1.0, np.inf))),
                                                curve=data.draw(st.sampled_from(("filmic", "reinhard", "clip", "x"))))

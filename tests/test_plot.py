@@ -593,3 +593,42 @@ def test_microfacet_family_bad_arguments():
         pbplot.microfacet_family(axes=(fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2, projection="polar")))
     plt.close(fig)
     assert plt.get_fignums() == []
+
+
+@pytest.mark.parametrize("draw", [
+    lambda r: pbplot.brdf_slice(EVERYTHING, resolution=r),
+    lambda r: pbplot.lit_sphere(EVERYTHING, resolution=r),
+    lambda r: pbplot.blend_demo("gold", "blue_rubber", resolution=r),
+    lambda r: pbplot.parameter_sweep(resolution=r),
+    lambda r: pbplot.slice_directions(r),
+    lambda r: pb.render.render_sphere(EVERYTHING, r),
+    lambda r: pb.render.sphere_frames(r),
+], ids=["brdf_slice", "lit_sphere", "blend_demo", "parameter_sweep", "slice_directions", "render_sphere",
+        "sphere_frames"])
+def test_one_resolution_rule_for_every_picture(draw):
+    for bad in (1, pb.render.MAX_RESOLUTION + 1):
+        with pytest.raises(ValueError, match=rf"^resolution: expected 2 to 16384 pixels, got {bad}$"):
+            draw(bad)
+    for bad in (True, 64.0, "64"):
+        with pytest.raises(TypeError, match="^resolution: expected an integer"):
+            draw(bad)
+
+
+def test_one_rule_for_number_options():
+    ones = np.ones((2, 2, 3))
+    for call in (lambda e: pb.render.tone_map(ones, exposure=e), lambda e: pb.render.to_srgb8(ones, exposure=e),
+                 lambda e: pbplot.lit_sphere(EVERYTHING, resolution=8, exposure=e)):
+        with pytest.raises(ValueError, match=r"^exposure: -1.0 is outside its domain \[0, inf\)$"):
+            call(-1.0)
+        with pytest.raises(ValueError, match="^exposure: nan is not a finite number$"):
+            call(float("nan"))
+        with pytest.raises(TypeError, match="^exposure: expected a real number"):
+            call(True)
+        with pytest.raises(ValueError, match=r"^exposure: expected one number, got shape \(2,\)$"):
+            call([1.0, 2.0])
+        call(np.float32(2.0))
+        call(np.array(2.0))
+    with pytest.raises(ValueError, match=r"^exposure: 0.0 is outside its domain \(0, inf\)$"):
+        pbplot.brdf_slice(EVERYTHING, resolution=8, exposure=0)
+    with pytest.raises(ValueError, match=r"^theta_o: 90.0 is outside its domain \(-90, 90\)$"):
+        pbplot.polar_lobes(EVERYTHING, 90.0)

@@ -8,10 +8,10 @@ from .fit import FitResult, fit
 from ._batch import Lobes, Sample, ValuePdf, cpu_info, eval, eval_grad, eval_lobes, eval_pdf, pdf, random_uniforms, sample
 from ._gradient import GRADIENT_NAMES, Gradient
 from .albedo import Albedo, albedo
-from .material import PARAMETERS, BrightColorWarning, Material, gamma22_to_linear, srgb_to_linear
+from .material import PARAMETERS, BrightColorWarning, Material, gamma22_to_linear, linear_to_srgb, srgb_to_linear
 
 __all__ = [
-    "Material", "PARAMETERS", "BrightColorWarning", "srgb_to_linear", "gamma22_to_linear",
+    "Material", "PARAMETERS", "BrightColorWarning", "srgb_to_linear", "linear_to_srgb", "gamma22_to_linear",
     "eval", "eval_lobes", "eval_pdf", "pdf", "sample", "random_uniforms", "cpu_info",
     "Lobes", "Sample", "ValuePdf", "Albedo", "albedo",
     "eval_grad", "Gradient", "GRADIENT_NAMES", "fit", "FitResult",

@@ -31,6 +31,7 @@ SAMPLERS = {name: index for index, name in enumerate(_core.SAMPLER_NAMES)}  # of
 LOBE_NAMES = tuple(_core.LOBE_NAMES)  # of f, as eval_lobes returns them
 SAMPLED_LOBE_NAMES = tuple(_core.SAMPLED_LOBE_NAMES)  # by the index a sample reports
 FLOAT32_MAX = float(np.finfo(np.float32).max)
+MAX_RESOLUTION = 16384  # pixels (or angles) along a picture's side: 16384² pixels is 3 GB of float32 RGB
 _REAL_KINDS = "biuf"  # bool, signed and unsigned integers, floats
 
 
@@ -149,10 +150,33 @@ def require_in_domain(name: str, array: FloatArray, lower: float, upper: float) 
         i = first_true(bad)  # the first offending element, whichever the fault
         if not_finite.ravel()[i]:
             raise ValueError(_not_finite_message(name, i, array))
-        domain = f"[{lower:g}, {'inf' if np.isinf(upper) else f'{upper:g}'}{')' if np.isinf(upper) else ']'}"
-        raise ValueError(
-            f"{element_name(name, i, array.shape)}: {float(array.ravel()[i])!r} is outside its domain {domain}"
-        )
+        raise ValueError(f"{element_name(name, i, array.shape)}: {float(array.ravel()[i])!r} is outside its domain "
+                         f"{interval(lower, upper)}")
+
+
+def interval(lower: float, upper: float, open_lower: bool = False, open_upper: bool = False) -> str:
+    """``[0, 1]``, ``[0, inf)``, ``(0, 100]``: an infinite end is always open."""
+    left = "(" if open_lower or math.isinf(lower) else "["
+    right = ")" if open_upper or math.isinf(upper) else "]"
+    return f"{left}{lower:g}, {upper:g}{right}"
+
+
+def real_number(name: str, value: object, lower: float = -math.inf, upper: float = math.inf, *,
+                open_lower: bool = False, open_upper: bool = False) -> float:
+    """One real number (a Python or numpy number or a 0-d array, not a bool), finite and within
+    [lower, upper], an end excluded where ``open_lower``/``open_upper``: TypeError or ValueError
+    naming the argument (``exposure: -1.0 is outside its domain [0, inf)``)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name}: expected a real number, got {type(value).__name__}")
+    array = as_real_array(name, value)
+    if array.shape != ():
+        raise ValueError(f"{name}: expected one number, got shape {array.shape}")
+    number = float(array)
+    if not math.isfinite(number):
+        raise ValueError(f"{name}: {number!r} is not a finite number")
+    if not lower <= number <= upper or (open_lower and number == lower) or (open_upper and number == upper):
+        raise ValueError(f"{name}: {number!r} is outside its domain {interval(lower, upper, open_lower, open_upper)}")
+    return number
 
 
 def directions(name: str, value: object) -> Float64Array:
@@ -179,6 +203,24 @@ def integer(name: str, value: object) -> int:
         return operator.index(value)  # type: ignore[arg-type]  # a TypeError here is the check
     except TypeError:
         raise TypeError(f"{name}: expected an integer, got {type(value).__name__}") from None
+
+
+def integer_in(name: str, value: object, minimum: int, maximum: int, unit: str = "") -> int:
+    """An integer (not a bool) from ``minimum`` to ``maximum``: TypeError otherwise, ValueError
+    outside, both naming the argument (``samples: expected 2 to 67108864, got 1``; ``unit``,
+    e.g. ``" per pixel"``, follows the bounds)."""
+    count = integer(name, value)
+    if not minimum <= count <= maximum:
+        raise ValueError(f"{name}: expected {minimum} to {maximum}{unit}, got {count}")
+    return count
+
+
+def resolution(name: str, value: object, minimum: int = 2, maximum: int = MAX_RESOLUTION,
+               unit: str = " pixels") -> int:
+    """The pictures' one rule for a resolution (``render``, ``plot``, the explorer): an integer,
+    not a bool, from ``minimum`` (2 unless a picture needs more) to ``maximum``
+    (:data:`MAX_RESOLUTION`, 16384), e.g. ``resolution: expected 2 to 16384 pixels, got 1``."""
+    return integer_in(name, value, minimum, maximum, unit)
 
 
 def seed_value(seed: object) -> int:

@@ -9,8 +9,8 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ._batch import Lobes, random_uniforms, sample
-from ._validate import LOBE_NAMES, as_real_array, broadcast_leading, integer, require_in_domain, seed_value
-from .material import PARAMETERS, Material
+from ._validate import LOBE_NAMES, as_real_array, broadcast_leading, integer_in, require_in_domain, seed_value
+from .material import PARAMETERS, Material, _require_material
 
 if TYPE_CHECKING:
     from typing import Any, SupportsIndex
@@ -56,15 +56,12 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
     weights (``pb.sample``, seeded, so the call is reproducible); errors are
     the standard errors of those means. ``energy_compensation`` as in ``pb.sample``.
     """
-    if not isinstance(material, Material):
-        raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
+    _require_material("material", material)
     cos_o = as_real_array("cos_theta_o", cos_theta_o)
     require_in_domain("cos_theta_o", cos_o, 0.0, 1.0)
     if np.any(cos_o == 0.0):
         raise ValueError("cos_theta_o: the albedo is defined for cos θo > 0")
-    count = integer("samples", samples)
-    if not 2 <= count <= MAX_SAMPLES:
-        raise ValueError(f"samples: expected 2 to {MAX_SAMPLES}, got {count}")
+    count = integer_in("samples", samples, 2, MAX_SAMPLES)
     seed = seed_value(seed)
     leading = broadcast_leading(cos_theta_o=cos_o.shape, material=material.shape)
     expanded = _with_sample_axis(material, leading)

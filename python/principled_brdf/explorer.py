@@ -40,22 +40,21 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import importlib
-import inspect
 import math
 import time
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from . import _validate
+from . import _color, _validate
 from . import presets as _presets
 from . import render as _render
 from ._batch import FLOAT32_LIMITS as _KERNEL_LIMITS
 from ._batch import eval_lobes as _eval_lobes
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material, srgb_to_linear
-from .plot import CHANNELS, slice_directions
+from .plot import _LOBE_COLORS as _PLOT_LOBE_COLORS
+from .plot import CHANNELS, _rgba, _uniform_material, _upper_half_disc, slice_directions
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator, Mapping
@@ -81,8 +80,8 @@ OUTPUTS = ("sphere", "polar", "slice", "albedo")
 CUSTOM = "(custom)"
 
 _LUMINANCE = np.asarray(CHANNELS["luminance"], dtype=np.float64)
-_LOBE_COLORS = {"diffuse": "tab:orange", "sheen": "tab:purple", "specular": "tab:blue", "clearcoat": "tab:green",
-                "total": "black"}
+# plot's colors; the multiple-scattering lobe counts in the totals without a line of its own
+_LOBE_COLORS = {name: color for name, color in _PLOT_LOBE_COLORS.items() if name != "multiple_scattering"}
 # What each picture shows (keys of Explorer._state): it is redrawn only when one of these changes.
 _DEPENDS = {
     "sphere": ("material", "model", "energy_compensation", "light", "exposure", "sky"),
@@ -157,26 +156,8 @@ def _slider_class(widgets: ModuleType) -> type[Any]:
     return Slider
 
 
-def _accepts(function: Callable[..., object], keyword: str) -> bool:
-    try:
-        parameter = inspect.signature(function).parameters.get(keyword)
-    except (TypeError, ValueError):
-        return False
-    return parameter is not None and parameter.kind in (parameter.POSITIONAL_OR_KEYWORD, parameter.KEYWORD_ONLY)
-
-
-def supports_energy_compensation() -> bool:
-    """Whether ``pb.eval`` takes ``energy_compensation=`` (the explorer shows a checkbox then)."""
-    return _accepts(importlib.import_module(__package__).eval, "energy_compensation")
-
-
-def _linear_to_srgb(c: RealArrayLike) -> Float64Array:
-    c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)
-    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-
-
 def _hex(linear: RealArrayLike) -> str:
-    return "#" + "".join(f"{int(round(v * 255.0)):02x}" for v in _linear_to_srgb(linear))
+    return "#" + "".join(f"{int(round(v * 255.0)):02x}" for v in _color.srgb_encode(linear))
 
 
 def _picked(value: str) -> tuple[float, ...]:
@@ -207,21 +188,10 @@ def _direction(theta_degrees: float, phi_degrees: float) -> Float64Array:
 
 
 def _uniform(material: object) -> tuple[Material, str | None]:
-    """(Material, preset name or None) from None, a Material or a preset name."""
+    """(Material, preset name or None) from None, a uniform Material or a preset name."""
     if material is None:
         return Material(), None
-    if isinstance(material, str):
-        try:
-            return _presets.get(material), material
-        except ValueError as error:
-            raise ValueError(f"material: {error}") from None
-    if not isinstance(material, Material):
-        raise TypeError(f"material: expected a principled_brdf.Material or a preset name, "
-                        f"got {type(material).__name__}")
-    if not material.is_uniform:
-        raise ValueError(f"material: expected a uniform material (one value per parameter), "
-                         f"got per-element parameters of shape {material.shape}")
-    return material, None
+    return _uniform_material("material", material), material if isinstance(material, str) else None
 
 
 class Explorer:
@@ -232,8 +202,8 @@ class Explorer:
     ``base_color`` (ColorPicker, sRGB), ``model``, ``preset`` (Dropdowns),
     ``light_theta``, ``light_phi``, ``view_theta``, ``view_phi`` (degrees),
     ``exposure`` (stops), ``sky``, ``log_radius`` (Checkboxes),
-    ``energy_compensation`` (a Checkbox when ``pb.eval`` takes
-    ``energy_compensation=``, else None), ``images`` (``{name: Image}`` for
+    ``energy_compensation`` (a Checkbox: ``energy_compensation=`` of every
+    picture's kernel calls), ``images`` (``{name: Image}`` for
     :data:`OUTPUTS`), ``status`` (HTML: the last update's time) and
     ``widget``, the whole layout; the Explorer displays as that widget.
     ``timings``: seconds each picture took when last drawn;
@@ -267,9 +237,7 @@ class Explorer:
         widgets, self._matplotlib, Figure = _imports()
         material, preset = _uniform(material)
         _validate.model_index(model)
-        resolution = _validate.integer("resolution", resolution)
-        if not 2 <= resolution <= _render.MAX_RESOLUTION:
-            raise ValueError(f"resolution: expected 2 to {_render.MAX_RESOLUTION} pixels, got {resolution}")
+        resolution = _validate.resolution("resolution", resolution)
         self.resolution = resolution
         self._holding = 0
         self._quiet = False  # while the preset menu sets the sliders
@@ -314,8 +282,7 @@ class Explorer:
         self.exposure = slider("exposure (stops)", 0.0, -4.0, 4.0, 0.25, "+.2f", "exposure", _MAX_EXPOSURE_STOPS)
         self.sky = widgets.Checkbox(value=True, description="sky light on the sphere", indent=False)
         self.log_radius = widgets.Checkbox(value=False, description="log radius (polar)", indent=False)
-        self.energy_compensation = (widgets.Checkbox(value=False, description="energy compensation", indent=False)
-                                    if supports_energy_compensation() else None)
+        self.energy_compensation = widgets.Checkbox(value=False, description="energy compensation", indent=False)
 
         self.images = {name: widgets.Image(format="png") for name in OUTPUTS}
         self.status = widgets.HTML()
@@ -342,7 +309,7 @@ class Explorer:
             return widgets.Box([image], layout=widgets.Layout(width=f"{self._figures_size[0] + 8}px",
                                                              justify_content="center", align_items="center"))
 
-        checks = [self.sky, self.log_radius] + ([self.energy_compensation] if self.energy_compensation else [])
+        checks = [self.sky, self.log_radius, self.energy_compensation]
         controls = widgets.VBox(
             [header("Material"), self.preset, self.model, self.base_color, *self.sliders.values(),
              header("Light and view"), self.light_theta, self.light_phi, self.view_theta, self.view_phi,
@@ -368,9 +335,8 @@ class Explorer:
         return round(theta * 2.0) / 2.0, float(round(phi))
 
     def _controls(self) -> list[Any]:
-        controls = [*self.sliders.values(), self.base_color, self.model, self.preset, self.light_theta,
-                    self.light_phi, self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius]
-        return controls + ([self.energy_compensation] if self.energy_compensation else [])
+        return [*self.sliders.values(), self.base_color, self.model, self.preset, self.light_theta, self.light_phi,
+                self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius, self.energy_compensation]
 
     @property
     def material(self) -> Material:
@@ -387,13 +353,8 @@ class Explorer:
             "exposure": float(self.exposure.value),
             "sky": bool(self.sky.value),
             "log": bool(self.log_radius.value),
-            "energy_compensation": bool(self.energy_compensation.value) if self.energy_compensation else None,
+            "energy_compensation": bool(self.energy_compensation.value),
         }
-
-    def _options(self, function: Callable[..., object], state: Mapping[str, Any]) -> dict[str, Any]:
-        """Keyword options the model takes beyond ``model=``, where ``function`` accepts them."""
-        ec = state["energy_compensation"]
-        return {"energy_compensation": ec} if ec is not None and _accepts(function, "energy_compensation") else {}
 
     @contextlib.contextmanager
     def hold(self) -> Iterator[Explorer]:
@@ -557,17 +518,15 @@ class Explorer:
         if self._sphere_linear[0] != key:  # an exposure change only tone maps again
             self._sphere_linear = (key, self._render_sphere(material, state))
         assert self._sphere_linear[1] is not None  # rendered above (key is never None)
-        rgb = _render.to_srgb8(self._sphere_linear[1], 2.0 ** state["exposure"])
-        alpha = np.where(self._inside, 255, 0).astype(np.uint8)
-        return _render.png_bytes(np.concatenate([rgb, alpha[..., None]], axis=-1))
+        return _render.png_bytes(_rgba(self._sphere_linear[1], self._inside, 2.0 ** state["exposure"]))
 
     def _render_sphere(self, material: Material, state: Mapping[str, Any]) -> Float32Array:
         light = _direction(*state["light"])
         model = state["model"]
         n = self.resolution
-        options = self._options(_render.render_sphere, state)
         return _render.render_sphere(material, n, light=light, ambient=0.0 if state["sky"] else _AMBIENT, model=model,
-                                     environment="sky" if state["sky"] else None, samples=_SKY_SAMPLES, **options)
+                                     environment="sky" if state["sky"] else None, samples=_SKY_SAMPLES,
+                                     energy_compensation=state["energy_compensation"])
 
     def _build_polar(self, Figure: type[Figure]) -> None:
         fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
@@ -575,10 +534,7 @@ class Explorer:
         # The Axes becomes a square, the half disc (radius: half its side) centred in it: a radius of
         # 135 px, the horizon 75 px above the bottom (room for the legend); the title is a figure text.
         ax = cast("PolarAxes", fig.add_axes((0.117, 0.028, 0.767, 1.023), projection="polar"))
-        ax.set_theta_zero_location("N")
-        ax.set_theta_direction(-1)
-        ax.set_thetamin(-90)
-        ax.set_thetamax(90)
+        _upper_half_disc(ax)
         ax.set_thetagrids([-90, -60, -30, 0, 30, 60, 90])
         ax.set_rlabel_position(80)  # near the horizon on the side of wo
         t = np.radians((np.arange(_POLAR_STEPS) + 0.5) * (180.0 / _POLAR_STEPS) - 90.0)  # open: no horizon segment
@@ -597,7 +553,7 @@ class Explorer:
         wi = np.empty((t.size, 3))
         wi[:, 0], wi[:, 1], wi[:, 2] = np.sin(t) * azimuth[0], np.sin(t) * azimuth[1], np.cos(t)
         wo = _direction(theta_v, phi_v)
-        values = _eval_lobes(material, wi, wo, model=state["model"], **self._options(_eval_lobes, state))
+        values = _eval_lobes(material, wi, wo, model=state["model"], energy_compensation=state["energy_compensation"])
         curves = {name: np.asarray(v, dtype=np.float64) @ _LUMINANCE for name, v in zip(_validate.LOBE_NAMES, values)}
         curves["total"] = cast("Float64Array", sum(curves.values()))  # (not 0: there are four lobes)
         peak = float(curves["total"].max())
@@ -663,7 +619,8 @@ class Explorer:
 
     def _draw_slice(self, material: Material, state: Mapping[str, Any]) -> bytes:
         s = self._slice
-        f = _eval_lobes(material, s["wi"], s["wo"], model=state["model"], **self._options(_eval_lobes, state))
+        f = _eval_lobes(material, s["wi"], s["wo"], model=state["model"],
+                        energy_compensation=state["energy_compensation"])
         luminance = np.asarray(f.total(), dtype=np.float64) @ _LUMINANCE
         shown = luminance[s["valid"]]
         top = float(shown.max()) if shown.size and shown.max() > 0.0 else 1.0
@@ -708,7 +665,7 @@ class Explorer:
         a = self._albedo
         ax, lines = a["ax"], a["lines"]
         result = _albedo(material, np.cos(np.radians(_ALBEDO_ANGLES)), samples=_ALBEDO_SAMPLES, seed=0,
-                         model=state["model"], **self._options(_albedo, state))
+                         model=state["model"], energy_compensation=state["energy_compensation"])
         curves: dict[str, tuple[FloatArray, FloatArray]] = {"total": (result.total, result.total_error)}
         curves.update({name: (value, error) for name, value, error in
                        zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)})

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _core
+from . import _color, _core
 from ._validate import as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
 
 if TYPE_CHECKING:
@@ -86,7 +86,7 @@ class Material:
         values = dict(locals())
         for name, info in PARAMETERS.items():
             if name == "base_color" and isinstance(values[name], np.ndarray) and values[name].dtype == np.uint8:
-                raise TypeError("base_color: a uint8 colour (0-255) is not linear RGB; convert it explicitly, "
+                raise TypeError("base_color: a uint8 color (0-255) is not linear RGB; convert it explicitly, "
                                 "e.g. pb.srgb_to_linear(texture), which scales uint8 by 1/255")
             array = as_real_array(name, values[name])
             if info.slots == 3 and (array.ndim == 0 or array.shape[-1] != 3):
@@ -101,7 +101,7 @@ class Material:
         object.__setattr__(self, "_shape", broadcast_leading(**{name: self._leading_shape(name) for name in PARAMETERS}))
         if not flag("bright_base_color", bright_base_color) and self.base_color.size and self.base_color.max() > 1.0:
             warnings.warn(f"base_color: {self.base_color.max():g} > 1 reflects more than it receives (a 0-255 or "
-                          "display-encoded colour?); pass bright_base_color=True if it is meant", BrightColorWarning,
+                          "display-encoded color?); pass bright_base_color=True if it is meant", BrightColorWarning,
                           stacklevel=2)
 
     def __setattr__(self, name: str, value: object) -> NoReturn:
@@ -168,9 +168,8 @@ class Material:
         ``t`` is a number or a per-element mask in [0, 1], broadcast against the
         materials' leading shapes (it applies to all three channels of base_color).
         """
-        for name, material in (("a", a), ("b", b)):
-            if not isinstance(material, Material):
-                raise TypeError(f"{name}: expected a Material, got {type(material).__name__}")
+        _require_material("a", a)
+        _require_material("b", b)
         weight = as_real_array("t", t)
         require_in_domain("t", weight, 0.0, 1.0)
         broadcast_leading(a=a.shape, b=b.shape, t=weight.shape)  # else numpy's message names no argument
@@ -231,6 +230,13 @@ class Material:
         return "Material(" + ", ".join(parts) + ")"
 
 
+def _require_material(name: str, value: object) -> Material:
+    """``value``, if it is a Material; a TypeError naming the argument otherwise."""
+    if not isinstance(value, Material):
+        raise TypeError(f"{name}: expected a principled_brdf.Material, got {type(value).__name__}")
+    return value
+
+
 def _rebuilt(*values: RealArrayLike) -> Material:
     return Material(*values, bright_base_color=True)
 
@@ -247,7 +253,17 @@ def srgb_to_linear(color: RealArrayLike) -> Float64Array:
         color = color / 255.0
     array = as_real_array("color", color)
     require_in_domain("color", array, 0.0, 1.0)
-    return np.where(array <= 0.04045, array / 12.92, ((array + 0.055) / 1.055) ** 2.4)
+    return _color.srgb_decode(array)
+
+
+def linear_to_srgb(color: RealArrayLike) -> Float64Array:
+    """Linear RGB to sRGB-encoded color, the inverse of :func:`srgb_to_linear`: ``12.92 c``
+    for ``c <= 0.0031308``, else ``1.055 c ** (1 / 2.4) - 0.055``. Values must lie in
+    [0, 1] (tone-map brighter ones first, e.g. with ``pb.render.tone_map``); float64 out,
+    times 255 and rounded for 8 bits."""
+    array = as_real_array("color", color)
+    require_in_domain("color", array, 0.0, 1.0)
+    return _color.srgb_encode(array)
 
 
 def gamma22_to_linear(color: RealArrayLike) -> Float64Array:

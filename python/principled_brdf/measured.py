@@ -80,11 +80,11 @@ def wiwo_to_half_diff(wi: RealArrayLike,
 def half_diff_to_wiwo(theta_h: RealArrayLike, phi_h: RealArrayLike, theta_d: RealArrayLike,
                       phi_d: RealArrayLike) -> tuple[Float64Array, Float64Array]:
     """(wi, wo) ``(..., 3)`` from Rusinkiewicz's angles, the inverse of :func:`wiwo_to_half_diff`."""
-    angles = {"theta_h": theta_h, "phi_h": phi_h, "theta_d": theta_d, "phi_d": phi_d}
-    for name, value in angles.items():
-        angles[name] = _validate.as_real_array(name, value)
-        _validate.require_finite(name, angles[name])
-    theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(*angles.values())
+    angles: list[Float64Array] = []
+    for name, value in (("theta_h", theta_h), ("phi_h", phi_h), ("theta_d", theta_d), ("phi_d", phi_d)):
+        angles.append(_validate.as_real_array(name, value))
+        _validate.require_finite(name, angles[-1])
+    theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(*angles)
     diff = np.stack([np.sin(theta_d) * np.cos(phi_d), np.sin(theta_d) * np.sin(phi_d), np.cos(theta_d)], axis=-1)
     half = np.stack([np.sin(theta_h) * np.cos(phi_h), np.sin(theta_h) * np.sin(phi_h), np.cos(theta_h)], axis=-1)
     wi = _rotate_z(_rotate_y(diff, theta_h), phi_h)

@@ -21,14 +21,15 @@ argument is a :class:`~principled_brdf.Material` or the name of a preset
 
 Scalar pictures show one channel of the RGB result: ``"luminance"`` (Rec. 709
 weights of linear RGB, 0.2126 R + 0.7152 G + 0.0722 B), or ``"r"``, ``"g"``,
-``"b"``. matplotlib is imported on the first call, so ``import principled_brdf``
+``"b"``. A ``resolution`` (pixels, or angles for :func:`polar_lobes` and
+:func:`microfacet_family`) is an integer from 2 (8 for :func:`microfacet_family`)
+to 16384, ``pb.render.MAX_RESOLUTION``, as ``pb.render.render_sphere``'s; the
+errors name the argument. matplotlib is imported on the first call, so ``import principled_brdf``
 (and ``import principled_brdf.plot``) work without it.
 """
 
 from __future__ import annotations
 
-import numbers
-import operator
 import typing
 
 import numpy as np
@@ -36,7 +37,8 @@ import numpy as np
 from . import presets as _presets
 from ._batch import eval as _eval
 from ._batch import eval_lobes as _eval_lobes
-from . import _validate
+from . import _color, _validate
+from .albedo import MAX_SAMPLES as _ALBEDO_MAX_SAMPLES
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material
 from . import render as _render
@@ -44,7 +46,7 @@ from . import render as _render
 if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
     from collections.abc import Iterable, Mapping
     from types import ModuleType
-    from typing import Any, SupportsIndex
+    from typing import Any
 
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -62,7 +64,7 @@ SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items() if info.slot
 
 #: Channel names accepted by the scalar plots and their weights on linear RGB.
 CHANNELS = {
-    "luminance": (0.2126, 0.7152, 0.0722),
+    "luminance": _color.LUMINANCE_WEIGHTS,
     "r": (1.0, 0.0, 0.0),
     "g": (0.0, 1.0, 0.0),
     "b": (0.0, 0.0, 1.0),
@@ -108,31 +110,6 @@ def _uniform_material(name: str, value: object) -> Material:
     return material
 
 
-def _resolution(value: SupportsIndex, name: str = "resolution", minimum: int = 2) -> int:
-    if isinstance(value, bool):
-        raise TypeError(f"{name}: expected an integer, got bool")
-    try:
-        count = operator.index(value)
-    except TypeError:
-        raise TypeError(f"{name}: expected an integer, got {type(value).__name__}") from None
-    if count < minimum:
-        raise ValueError(f"{name}: expected an integer >= {minimum}, got {count}")
-    return count
-
-
-def _real(name: str, value: object, lower: float = -np.inf, upper: float = np.inf, open_upper: bool = False,
-          open_lower: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name}: expected a real number, got {type(value).__name__}")
-    x = float(value)
-    bad = not np.isfinite(x) or x < lower or x > upper or (open_upper and x == upper) or (open_lower and x == lower)
-    if bad:
-        lo = "(" if open_lower else "["
-        hi = ")" if open_upper else "]"
-        raise ValueError(f"{name}: {x!r} is outside {lo}{lower:g}, {upper:g}{hi}")
-    return x
-
-
 def _channel(value: object) -> Float64Array:
     if not isinstance(value, str) or value not in CHANNELS:
         raise ValueError(f"channel: expected one of {', '.join(repr(c) for c in CHANNELS)}, got {value!r}")
@@ -165,6 +142,14 @@ def _rgba(linear: RealArrayLike, inside: NDArray[np.bool_], exposure: float) -> 
     return np.concatenate([rgb, alpha[..., None]], axis=-1)
 
 
+def _upper_half_disc(ax: PolarAxes) -> None:
+    """The plane of incidence above the surface: the normal at the top, angles positive to the right."""
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(-90)
+    ax.set_thetamax(90)
+
+
 def _sphere_axes(ax: Axes, title: str) -> None:
     ax.set_xticks([])
     ax.set_yticks([])
@@ -188,8 +173,8 @@ def slice_directions(resolution: int, phi_d: float = 90.0) -> tuple[FloatArray, 
     with ``d = (sin θd cos φd, sin θd sin φd, cos θd)`` and ``d'`` its
     reflection about z (so ``h`` is their half vector and ``cos θd = wi·h``).
     """
-    n = _resolution(resolution)
-    phi = np.radians(_real("phi_d", phi_d))
+    n = _validate.resolution("resolution", resolution)
+    phi = np.radians(_validate.real_number("phi_d", phi_d))
     theta = (np.arange(n) + 0.5) * (90.0 / n)
     th, td = np.meshgrid(np.radians(theta), np.radians(theta))  # [θd, θh]
     sd, cd = np.sin(td), np.cos(td)
@@ -200,15 +185,6 @@ def slice_directions(resolution: int, phi_d: float = 90.0) -> tuple[FloatArray, 
         return np.stack([x * ch + z * sh, y, z * ch - x * sh], axis=-1)
 
     return theta, theta.copy(), rotate(dx, dy, cd), rotate(-dx, -dy, cd)
-
-
-def _srgb_encode(c: Float64Array) -> Float64Array:
-    c = np.clip(c, 0.0, 1.0)
-    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-
-
-def _srgb_decode(c: Float64Array) -> Float64Array:
-    return np.where(c <= 0.04045, c / 12.92, np.power((c + 0.055) / 1.055, 2.4))
 
 
 def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
@@ -237,17 +213,17 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
     gives the plotted values, indexed ``[θd, θh]`` with row 0 at θd ≈ 0).
     """
     material = _uniform_material("material", material)
-    n = _resolution(resolution)
+    n = _validate.resolution("resolution", resolution)
     rgb_mode = channel == "rgb"
     weights = np.asarray(CHANNELS["luminance"]) if rgb_mode else _channel(channel)
     _validate.model_index(model)
     value: float | Float64Array | None  # vmin or vmax in the loop, then the projected slice
     for name, value in (("vmin", vmin), ("vmax", vmax)):
-        if value is not None and _real(name, value, 0.0) <= 0.0 and log:
+        if value is not None and _validate.real_number(name, value, 0.0) <= 0.0 and log:
             raise ValueError(f"{name}: a logarithmic scale needs a positive value, got {value!r}")
-    percentile = (99.0 if log else 90.0) if percentile is None else _real("percentile", percentile, 0.0, 100.0,
-                                                                              open_lower=True)
-    exposure = _real("exposure", exposure, 0.0, open_lower=True)
+    percentile = ((99.0 if log else 90.0) if percentile is None
+                  else _validate.real_number("percentile", percentile, 0.0, 100.0, open_lower=True))
+    exposure = _validate.real_number("exposure", exposure, 0.0, open_lower=True)
     ax = _axes(ax)
     from matplotlib import colors, cm
 
@@ -276,11 +252,11 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
     if rgb_mode:
         # display brightness (sRGB-encoded) = the luminance's place on the scale, as on the grey color bar
         level = np.clip(np.ma.filled(norm(np.maximum(value, norm.vmin)), 0.0), 0.0, 1.0)
-        scale = np.divide(_srgb_decode(level), value, out=np.zeros_like(value), where=value > 0.0)
+        scale = np.divide(_color.srgb_decode(level), value, out=np.zeros_like(value), where=value > 0.0)
         color = f * scale[..., None]
         color = color / np.maximum(1.0, color.max(axis=-1, keepdims=True))  # keep the hue where it clips
         image = np.empty(color.shape[:-1] + (4,))
-        image[..., :3] = np.where(valid[..., None], _srgb_encode(color), colors.to_rgb(_BACKGROUND))
+        image[..., :3] = np.where(valid[..., None], _color.srgb_encode(color), colors.to_rgb(_BACKGROUND))
         image[..., 3] = 1.0
         ax.imshow(image, origin="lower", extent=extent, interpolation="nearest")
         if colorbar:
@@ -325,10 +301,10 @@ def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True,
     ``"total"``, ``"diffuse"``, ... (their data: f, or log10 f with ``log``).
     """
     material = _uniform_material("material", material)
-    theta = _real("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
-    n = _resolution(resolution)
+    theta = _validate.real_number("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
+    n = _validate.resolution("resolution", resolution, unit=" angles")
     weights = _channel(channel)
-    decades = _real("decades", decades, 0.0, open_lower=True)
+    decades = _validate.real_number("decades", decades, 0.0, open_lower=True)
     _validate.model_index(model)
     ax = typing.cast("PolarAxes", _axes(ax, polar=True))  # checked: its name is "polar"
     from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
@@ -357,10 +333,7 @@ def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True,
         ax.plot(t, radius(curve), color=_LOBE_COLORS[name], lw=1.3, label=name, zorder=3)
     top = float(radius(np.array(peak)))
     ax.plot([np.radians(theta)] * 2, [0.0, top], color="0.5", ls="--", lw=1.0, label="wo", zorder=1)
-    ax.set_theta_zero_location("N")
-    ax.set_theta_direction(-1)
-    ax.set_thetamin(-90)
-    ax.set_thetamax(90)
+    _upper_half_disc(ax)
     ax.set_ylim(0.0, top * 1.05)
     if log:  # a tick per decade (or per few), labelled with f itself
         step = max(1, int(np.ceil(decades / 4)))
@@ -402,13 +375,13 @@ def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealAr
     ``energy_compensation`` as in ``pb.eval``.
     """
     material = _material("material", material)
-    n = _resolution(resolution)
-    exposure = _real("exposure", exposure, 0.0)
-    intensity = _real("light_intensity", light_intensity, 0.0)
+    n = _validate.resolution("resolution", resolution)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
+    intensity = _validate.real_number("light_intensity", light_intensity, 0.0)
     if material.shape not in ((), (n, n)):
         raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
                          f"got {material.shape}")
-    count = _resolution(environment_samples, "environment_samples", minimum=1)
+    count = _validate.integer_in("environment_samples", environment_samples, 1, _render.MAX_SAMPLES, " per pixel")
     _validate.model_index(model)
     environment = _render._environment(environment)
     ax = _axes(ax)
@@ -445,7 +418,7 @@ def albedo_curves(material: Material | str, *, angles: RealArrayLike = np.linspa
         raise ValueError("angles: expected a 1-d array of finite angles in degrees")
     if np.any(theta < 0.0) or np.any(theta >= 90.0):
         raise ValueError(f"angles: expected degrees in [0, 90), got values from {theta.min():g} to {theta.max():g}")
-    _resolution(samples, "samples")
+    _validate.integer_in("samples", samples, 2, _ALBEDO_MAX_SAMPLES)
     _validate.model_index(model)
     ax = _axes(ax)
 
@@ -505,9 +478,9 @@ def parameter_sweep(base: Material | str | None = None, *, parameters: str | Ite
         if name not in SCALAR_PARAMETERS:
             raise ValueError(f"parameters: unknown scalar parameter {name!r}; "
                              f"choose from {', '.join(SCALAR_PARAMETERS)}")
-    count = _resolution(steps, "steps")
-    n = _resolution(resolution)
-    exposure = _real("exposure", exposure, 0.0)
+    count = _validate.integer_in("steps", steps, 2, _validate.MAX_RESOLUTION)
+    n = _validate.resolution("resolution", resolution)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
     ranges = {} if ranges is None else dict(ranges)
     for name in ranges:
         if name not in names:
@@ -515,7 +488,7 @@ def parameter_sweep(base: Material | str | None = None, *, parameters: str | Ite
     spans = []
     for name in names:
         lo, hi = ranges.get(name, (0.0, 1.0))
-        spans.append((_real(f"ranges[{name!r}]", lo), _real(f"ranges[{name!r}]", hi)))
+        spans.append((_validate.real_number(f"ranges[{name!r}]", lo), _validate.real_number(f"ranges[{name!r}]", hi)))
 
     rows = len(names)
     params: dict[str, Any] = {"base_color": base.base_color}  # (Any: Material(**) also takes a bool keyword)
@@ -582,8 +555,8 @@ def blend_demo(a: Material | str, b: Material | str, *, mask: RealArrayLike | No
     """
     a = _material("a", a)
     b = _material("b", b)
-    n = _resolution(resolution)
-    exposure = _real("exposure", exposure, 0.0)
+    n = _validate.resolution("resolution", resolution)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
     if mask is None:
         mask = _checker(n)
     else:
@@ -613,7 +586,8 @@ def blend_demo(a: Material | str, b: Material | str, *, mask: RealArrayLike | No
 def _shapes(name: str, values: Iterable[float], lower: float, upper: float, open_lower: bool = False) -> list[float]:
     if isinstance(values, (str, bytes)) or not isinstance(values, typing.Iterable):
         raise TypeError(f"{name}: expected a sequence of numbers, got {type(values).__name__}")
-    return [_real(f"{name}[{k}]", value, lower, upper, open_lower=open_lower) for k, value in enumerate(values)]
+    return [_validate.real_number(f"{name}[{k}]", value, lower, upper, open_lower=open_lower)
+            for k, value in enumerate(values)]
 
 
 def _family_axes(axes: object) -> tuple[Axes, Axes] | None:
@@ -654,12 +628,12 @@ def microfacet_family(alpha: float = 0.3, *, student_t_gammas: Iterable[float] =
     Both panels carry the same line labels (``"GGX"``, ``"Beckmann"``, ``"Student-t γ = 1.6"``,
     ...); the legend (``legend``) is on the D panel.
     """
-    a = _real("alpha", alpha, 0.0, 1.0, open_lower=True)
+    a = _validate.real_number("alpha", alpha, 0.0, 1.0, open_lower=True)
     gammas = _shapes("student_t_gammas", student_t_gammas, 1.5, 1e12, open_lower=True)
     ps = _shapes("exponential_power_ps", exponential_power_ps, 0.1, 10.0)
     gtrs = _shapes("gtr_gammas", gtr_gammas, 0.0, 1e6, open_lower=True)
-    n = _resolution(resolution, minimum=8)
-    decades = _real("decades", decades, 0.0, open_lower=True)
+    n = _validate.resolution("resolution", resolution, minimum=8, unit=" angles")
+    decades = _validate.real_number("decades", decades, 0.0, open_lower=True)
     drawn = _family_axes(axes)
     from . import microfacet as mf
 

@@ -11,7 +11,7 @@ from . import _gradient
 from . import _validate
 from ._gradient import Gradient
 from ._batch import Lobes, Sample
-from .material import Material
+from .material import Material, _require_material
 
 if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
     from collections.abc import Callable
@@ -54,8 +54,7 @@ def _as_layout(array: NDArray[_Scalar], soa: bool, trailing: int = 1) -> NDArray
 
 def _prepare(material: Material, wi: RealArrayLike, wo: RealArrayLike,
              model: Model) -> tuple[tuple[int, ...], Float64Array, Float64Array, Float64Array, int]:
-    if not isinstance(material, Material):
-        raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
+    _require_material("material", material)
     model_id = _validate.model_index(model)
     wi = _validate.directions("wi", wi)
     wo = _validate.directions("wo", wo)
@@ -154,11 +153,6 @@ def _to_shape(rows: NDArray[_Scalar], shape: tuple[int, ...], trailing: tuple[in
     return rows.reshape(shape + trailing)
 
 
-def _check_material(material: object) -> None:
-    if not isinstance(material, Material):
-        raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
-
-
 def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos",
            energy_compensation: bool = False) -> Sample:
@@ -172,7 +166,7 @@ def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Mo
     both are 0 when ``wi`` or ``wo`` is at or below the horizon. ``layout="soa"``:
     ``wo``, ``u``, ``wi`` and ``weight`` as ``(3, ...)``.
     """
-    _check_material(material)
+    _require_material("material", material)
     model_id = _validate.model_index(model)
     sampler_id = _validate.sampler_index(specular_sampler)
     soa = _layout(layout)
@@ -198,7 +192,7 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
     ``model`` (accepted for symmetry with :func:`sample`; only the weights do)
     unless ``energy_compensation``, whose lobe's weight reads the model's tables.
     """
-    _check_material(material)
+    _require_material("material", material)
     model_id = _validate.model_index(model)
     sampler_id = _validate.sampler_index(specular_sampler)
     soa = _layout(layout)
@@ -218,7 +212,7 @@ def lobe_probabilities(material: Material, wo: RealArrayLike, *, model: Model = 
     """``(P0, P1, P2)`` on the last axis, ``(..., 3)``: the chances of the cosine, primary
     specular and clearcoat lobes at ``wo`` (docs/sampling.md); with
     ``energy_compensation`` the cosine lobe's includes the multiple-scattering lobe's."""
-    _check_material(material)
+    _require_material("material", material)
     model_id = _validate.model_index(model)
     compensated = _validate.flag("energy_compensation", energy_compensation)
     wo = _validate.directions("wo", wo)

@@ -19,7 +19,7 @@ import zlib
 
 import numpy as np
 
-from . import _validate
+from . import _color, _validate
 from ._batch import eval as _eval
 from ._batch import random_uniforms as _random_uniforms
 from ._batch import sample as _sample
@@ -48,7 +48,7 @@ __all__ = ["render_sphere", "render_environment", "sky_environment", "sphere_fra
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
 
 
-MAX_RESOLUTION = 16384
+MAX_RESOLUTION = _validate.MAX_RESOLUTION  # pixels along a side (16384)
 DEFAULT_SAMPLES = 64  # sky samples per pixel: with the lattice below, no visible noise on any preset
 MAX_SAMPLES = 1 << 16  # sky samples per pixel
 # Sky samples in all (pixels x samples, every sphere of a batch counted): 16384² pixels at the default
@@ -56,18 +56,9 @@ MAX_SAMPLES = 1 << 16  # sky samples per pixel
 MAX_SAMPLE_WORK = 1 << 34
 
 
-def _resolution(value: object) -> int:
-    value = _validate.integer("resolution", value)
-    if not 2 <= value <= MAX_RESOLUTION:
-        raise ValueError(f"resolution: expected 2 to {MAX_RESOLUTION} pixels, got {value}")
-    return value
-
-
 def _samples(value: object, pixels: int) -> int:
     """Sky samples per pixel: an integer from 1 to MAX_SAMPLES, and pixels x samples at most MAX_SAMPLE_WORK."""
-    samples = _validate.integer("samples", value)
-    if not 1 <= samples <= MAX_SAMPLES:
-        raise ValueError(f"samples: expected 1 to {MAX_SAMPLES} per pixel, got {samples}")
+    samples = _validate.integer_in("samples", value, 1, MAX_SAMPLES, " per pixel")
     if pixels * samples > MAX_SAMPLE_WORK:
         raise ValueError(f"samples: {samples} per pixel over {pixels} pixels is {pixels * samples} samples, beyond "
                          f"the {MAX_SAMPLE_WORK} (2^34) a picture takes; at most {max(MAX_SAMPLE_WORK // pixels, 0)} "
@@ -97,14 +88,6 @@ def _light_direction(value: object) -> Float64Array:
     return light / length
 
 
-def _non_negative(name: str, value: object) -> float:
-    array = _validate.as_real_array(name, value)
-    if array.shape != ():
-        raise ValueError(f"{name}: expected one number, got shape {array.shape}")
-    _validate.require_in_domain(name, array, 0.0, np.inf)
-    return float(array)
-
-
 def sphere_frames(resolution: int) -> tuple[NDArray[np.bool_], Callable[[RealArrayLike], Float32Array]]:
     """Per-pixel local directions for a sphere image.
 
@@ -113,7 +96,7 @@ def sphere_frames(resolution: int) -> tuple[NDArray[np.bool_], Callable[[RealArr
     vector ``d`` (3,) to each pixel's local shading frame, ``(H, W, 3)`` float32
     (pixels off the sphere get the normal, so every vector is valid).
     """
-    resolution = _resolution(resolution)
+    resolution = _validate.resolution("resolution", resolution)
     coords = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
     x, y = np.meshgrid(coords, -coords)  # row 0 at the top
     r2 = x * x + y * y
@@ -156,6 +139,8 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
                   seed: int = 0, energy_compensation: bool = False) -> Float32Array:
     """Linear RGB ``(resolution, resolution, 3)`` image of ``material`` on a sphere.
 
+    ``resolution``: pixels along a side, an integer from 2 to :data:`MAX_RESOLUTION`
+    (16384), the rule of every picture of ``render``, ``plot`` and the explorer.
     Lit by a directional light (``light``: direction towards it in camera
     space, x right, y up, z to the viewer; ``light_intensity``: its
     irradiance, 0 turns it off) and by ``environment``: ``"sky"`` (default,
@@ -172,10 +157,10 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     kernel call. Background is 0. ``energy_compensation`` as in ``pb.eval``.
     """
     light = _light_direction(light)
-    light_intensity = _non_negative("light_intensity", light_intensity)
-    ambient = _non_negative("ambient", ambient)
+    light_intensity = _validate.real_number("light_intensity", light_intensity, 0.0)
+    ambient = _validate.real_number("ambient", ambient, 0.0)
     environment = _environment(environment)
-    resolution = _resolution(resolution)
+    resolution = _validate.resolution("resolution", resolution)
     _samples(samples, _pixels(material, resolution) if environment is not None else 0)  # (unused without one)
     inside, to_local = sphere_frames(resolution)
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
@@ -243,7 +228,7 @@ def render_environment(material: Material, resolution: int = 256, environment: _
     as in ``pb.sample``."""
     # (False, which _environment maps to None, is not checked here: calling it fails as before)
     environment = typing.cast("_Environment", sky_environment if environment is None else _environment(environment))
-    resolution = _resolution(resolution)
+    resolution = _validate.resolution("resolution", resolution)
     samples = _samples(samples, _pixels(material, resolution))
     inside, to_local = sphere_frames(resolution)
     wo = to_local((0.0, 0.0, 1.0))
@@ -302,7 +287,7 @@ def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "
     NaN is a ValueError naming the pixel."""
     if curve not in TONE_CURVES:
         raise ValueError(f"curve: expected one of {', '.join(TONE_CURVES)}, got {curve!r}")
-    exposure = _non_negative("exposure", exposure)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
     c = _validate.as_real_array("linear", linear)
     if c.ndim == 0 or c.shape[-1] != 3:
         raise ValueError(f"linear: expected RGB values of shape (..., 3), got {c.shape}")
@@ -313,7 +298,7 @@ def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "
     c = np.clip(c * exposure, 0.0, 1e30)
     if curve == "clip":
         return np.minimum(c, 1.0)
-    luminance = c @ np.array([0.2126, 0.7152, 0.0722])
+    luminance = c @ np.array(_color.LUMINANCE_WEIGHTS)
     mapped = _filmic(luminance) if curve == "filmic" else _reinhard(luminance)
     scale = np.divide(mapped, luminance, out=np.zeros_like(luminance), where=luminance > 0.0)
     c = c * scale[..., None]
@@ -322,9 +307,7 @@ def tone_map(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "
 
 def to_srgb8(linear: RealArrayLike, exposure: float = 1.0, curve: _ToneCurve = "filmic") -> NDArray[np.uint8]:
     """Linear RGB to 8-bit sRGB for saving or showing: :func:`tone_map`, then the sRGB encoding."""
-    c = tone_map(linear, exposure, curve)
-    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-    return np.round(srgb * 255.0).astype(np.uint8)
+    return np.round(_color.srgb_encode(tone_map(linear, exposure, curve)) * 255.0).astype(np.uint8)
 
 
 def png_bytes(image: RealArrayLike) -> bytes:
@@ -371,7 +354,7 @@ def save_image(path: str | os.PathLike[str], linear: RealArrayLike, exposure: fl
     image = np.asarray(linear, dtype=np.float64)
     if image.ndim != 3 or image.shape[2] != 3:
         raise ValueError(f"linear: expected an (H, W, 3) RGB image, got shape {image.shape}")
-    exposure = _non_negative("exposure", exposure)
+    exposure = _validate.real_number("exposure", exposure, 0.0)
     if extension == ".png":
         write_png(path, to_srgb8(image, exposure, curve))
     elif extension == ".npy":
