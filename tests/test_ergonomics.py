@@ -124,7 +124,7 @@ def test_frames_and_spherical_angles():
     along = frames.frame_from_normal(normals, tangent)
     projected = tangent - np.sum(tangent * normals, axis=-1, keepdims=True) * normals
     np.testing.assert_allclose(along[:, 0], projected / np.linalg.norm(projected, axis=-1, keepdims=True), atol=1e-12)
-    with pytest.raises(ValueError, match="tangent: parallel to the normal"):
+    with pytest.raises(ValueError, match="tangent: zero or parallel to the normal"):
         frames.frame_from_normal([0.0, 0.0, 1.0], [0.0, 0.0, 2.0])
     theta, phi = rng.uniform(0, np.pi, 500), rng.uniform(-np.pi, np.pi, 500)
     d = frames.spherical_to_direction(theta, phi)

@@ -47,9 +47,12 @@ def frame_from_normal(normal: RealArrayLike, tangent: RealArrayLike | None = Non
     across n.z = 0's sign change; with one, the tangent is its part
     orthogonal to the normal (Gram-Schmidt), so anisotropic materials follow it.
     The normal passes the direction check (docs/bad-input.md) and is then
-    normalised, so the frames are orthonormal to float64's rounding."""
+    normalized (one unit to 1e-14 is kept as given), so the frames are
+    orthonormal to float64's rounding."""
     n = _validate.directions("normal", normal)
-    n = n / np.sqrt(np.sum(n * n, axis=-1, keepdims=True))
+    length2 = np.sum(n * n, axis=-1, keepdims=True)
+    # normals already unit to float64's rounding stay exactly as given (the frame's last row)
+    n = np.where(np.abs(length2 - 1.0) > 1e-14, n / np.sqrt(length2), n)
     if tangent is None:
         sign = np.where(n[..., 2] >= 0.0, 1.0, -1.0)
         a = -1.0 / (sign + n[..., 2])
