@@ -285,7 +285,7 @@ def test_diffuse_and_sheen_lobe_bounds(params, pairs):
     assert np.all(smooth <= upper * lambert * (1 + 1e-14) + 1e-300)  # + 1e-300: denormal base colors
     lum = 0.3 * base[0] + 0.6 * base[1] + 0.1 * base[2]
     tint = base / lum if lum >= 2.0 ** -126 else np.ones(3)
-    c_sheen = 1.0 + (tint - 1.0) * params["sheen_tint"]
+    c_sheen = (1.0 - params["sheen_tint"]) + tint * params["sheen_tint"]  # mix in the form that keeps tiny tints
     assert np.all(lobes.sheen <= params["sheen"] * c_sheen * (1.0 - params["metallic"]) * (1 + 1e-14) + 1e-300)
 
 
