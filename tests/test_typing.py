@@ -298,7 +298,9 @@ pb.reference.sample(m, wi)  # E: call-arg
 
 _core.reference_eval(wi, wi, wi, 0)  # E: call-arg
 _core.microfacet.ggx_d(wi, 0.3)  # E: call-arg
-_core.batch_eval_grad(wi, 0, wi, 0, [], wi, wi, 0, 1, 0, False, 1e-3, 0, isa=None)  # E: arg-type
+_core.SampleOptions(seed=1, threads=0, isa=None)  # E: arg-type
+options = _core.EvalOptions()
+_core.batch_pdf(wi=wi, wi_layout=0, wo=wi, wo_layout=0, params=[], pdf=wi, n=1, options=options)  # E: arg-type
 '''
 
 
