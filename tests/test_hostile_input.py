@@ -345,12 +345,15 @@ def test_the_kernels_never_see_misaligned_data():
     n = 8
     wi = misaligned(np.tile(np.float32([0, 0, 1]), (n, 1)))
     params = pb._batch._params(pb.Material(), (n,))
+    options = pb._core.EvalOptions(threads=1)
+    wo = np.float32([0, 0, 1])
     with pytest.raises(ValueError, match="wi: array data is not aligned"):
-        pb._core.batch_eval(wi, 0, np.float32([0, 0, 1]), 2, params, [np.empty((n, 3), np.float32)], 0, n, 0,
-                            False, False, 0.0, 1, "")
+        pb._core.batch_eval(wi=wi, wi_layout=0, wo=wo, wo_layout=2, params=params,
+                            outputs=[np.empty((n, 3), np.float32)], out_layout=0, n=n, lobes=False, options=options)
     with pytest.raises(ValueError, match="out: array data is not aligned"):
-        pb._core.batch_eval(wi.copy(), 0, np.float32([0, 0, 1]), 2, params,
-                            [misaligned(np.empty((n, 3), np.float32))], 0, n, 0, False, False, 0.0, 1, "")
+        pb._core.batch_eval(wi=wi.copy(), wi_layout=0, wo=wo, wo_layout=2, params=params,
+                            outputs=[misaligned(np.empty((n, 3), np.float32))], out_layout=0, n=n, lobes=False,
+                            options=options)
 
 
 # ------------------------------------------------------------------ tiny colors, long vectors, frames, helpers

@@ -95,6 +95,8 @@ def _kind(annotation: str) -> str | None:
     text = re.sub(r"\s*\|\s*None$", "", annotation.strip())
     if text == "object":
         return None
+    if isinstance(getattr(_core, text.removeprefix("principled_brdf._core."), None), type):
+        return text.removeprefix("principled_brdf._core.")  # one of the module's classes
     if re.match(r"(collections\.abc\.)?Sequence\b", text):
         return "sequence"
     if "SupportsInt" in text:
@@ -108,7 +110,7 @@ def _kind(annotation: str) -> str | None:
     for dtype in ("float32", "float64", "int32"):
         if re.search(rf"\b(numpy|np)\.{dtype}\b", text):
             return f"{dtype} array"
-    assert text in ("bool", "str", "int", "None"), f"unexpected annotation {annotation!r}"
+    assert text in ("bool", "str", "int", "float", "None"), f"unexpected annotation {annotation!r}"
     return text
 
 
@@ -130,7 +132,11 @@ def _compare(runtime: ast.FunctionDef, stub: ast.FunctionDef, aliases: dict[str,
     assert [d is None for d in stub.args.kw_defaults] == [d is None for d in runtime.args.kw_defaults], where
     for stub_default, runtime_default in zip(stub.args.defaults, runtime.args.defaults):
         assert ast.unparse(stub_default) == ast.unparse(runtime_default), f"{where}: default"
-    for stub_arg, runtime_arg in zip(stub.args.args, runtime.args.args):
+    for stub_default, runtime_default in zip(stub.args.kw_defaults, runtime.args.kw_defaults):
+        if stub_default is not None and runtime_default is not None:
+            assert ast.unparse(stub_default) == ast.unparse(runtime_default), f"{where}: default"
+    named = zip(stub.args.args + stub.args.kwonlyargs, runtime.args.args + runtime.args.kwonlyargs)
+    for stub_arg, runtime_arg in named:
         assert runtime_arg.annotation is not None and stub_arg.annotation is not None
         expected = _kind(ast.unparse(runtime_arg.annotation))
         if expected is not None:
@@ -151,6 +157,33 @@ def test_stub_signatures_match_pybind11s():
     assert len(functions) == len(compiled)
     for function, node in functions:
         _compare(_runtime_signature(function), node, aliases)
+
+
+def test_stub_classes_match_pybind11s():
+    """The options classes: the constructor's keywords, and each field's type."""
+    tree = _stub_tree()
+    aliases = _aliases(tree)
+    classes = [node for node in _public_stub_names(tree.body).values() if isinstance(node, ast.ClassDef)]
+    assert {node.name for node in classes} == {name for name in _public_runtime_names(_core)
+                                               if isinstance(getattr(_core, name), type)}
+    for node in classes:
+        runtime_class = getattr(_core, node.name)
+        (init,) = [n for n in node.body if isinstance(n, ast.FunctionDef) and n.name == "__init__"]
+        runtime_init = _runtime_signature(runtime_class.__init__)
+        for signature in (init, runtime_init):
+            assert signature.args.args[0].arg == "self"
+            del signature.args.args[0]
+        _compare(runtime_init, init, aliases)
+        fields = {n.target.id: n.annotation for n in node.body
+                  if isinstance(n, ast.AnnAssign) and isinstance(n.target, ast.Name)}
+        properties = {name for name, value in vars(runtime_class).items() if isinstance(value, property)}
+        assert set(fields) == properties, node.name
+        for name, annotation in fields.items():
+            # pybind11's getter signature has no name: "(self: ...) -> int"
+            first = getattr(runtime_class, name).fget.__doc__.strip().splitlines()[0]
+            getter = ast.parse(f"def {name}{first}: ...").body[0]
+            assert isinstance(getter, ast.FunctionDef) and getter.returns is not None
+            assert _kind(_resolve(annotation, aliases)) == _kind(ast.unparse(getter.returns)), f"{node.name}.{name}"
 
 
 def test_stub_constants_have_their_runtime_types():
@@ -307,7 +340,9 @@ pb.reference.sample(m, wi)  # E: call-arg
 
 _core.reference_eval(wi, wi, wi, 0)  # E: call-arg
 _core.microfacet.ggx_d(wi, 0.3)  # E: call-arg
-_core.batch_eval_grad(wi, 0, wi, 0, [], wi, wi, 0, 1, 0, False, 1e-3, 0, isa=None)  # E: arg-type
+_core.SampleOptions(seed=1, threads=0, isa=None)  # E: arg-type
+options = _core.EvalOptions()
+_core.batch_pdf(wi=wi, wi_layout=0, wo=wi, wo_layout=0, params=[], pdf=wi, n=1, options=options)  # E: arg-type
 '''
 
 

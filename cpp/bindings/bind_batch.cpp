@@ -87,45 +87,73 @@ void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, p
     }
 }
 
-// The inputs of an evaluation: directions, parameters, model, cosine and check.
+// The options of the batched calls, by name: the scalar fields of EvalJob and
+// SampleJob (batch.hpp) and the threads and isa of eval() and sample().
+// EvalOptions (batch_eval, batch_eval_grad), PdfOptions (batch_pdf) and
+// SampleOptions (batch_sample) are Python classes with read-write fields; the
+// Python side (principled_brdf/_batch.py) validated the values, and the
+// indices are checked again here. The functions below take them by value: the
+// work reads a copy, whatever Python code assigns to the caller's object once
+// the GIL is released.
+struct BatchOptions {
+    int model = 0;                     // index into kModelNames
+    bool energy_compensation = false;  // the multiple-scattering lobe
+    double check_tolerance = 0.0;      // > 0: the direction check of docs/bad-input.md
+    int threads = 0;                   // 0: all cores
+    std::string isa;                   // "": the active instruction set
+};
+
+struct EvalOptions : BatchOptions {
+    bool cosine = false;  // multiply by cos θl
+};
+
+struct PdfOptions : EvalOptions {
+    int sampler = 0;  // index into kSpecularSamplerNames
+};
+
+struct SampleOptions : BatchOptions {
+    int sampler = 0;         // index into kSpecularSamplerNames
+    std::uint64_t seed = 0;  // of the counter-based uniforms, without u
+};
+
+// The inputs of an evaluation: directions, parameters and options.
 EvalJob eval_job(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout, const py::sequence& params,
-                 std::int64_t n, int model, Output output, bool cosine, double check_tolerance, py::list& keep_alive) {
+                 std::int64_t n, Output output, const EvalOptions& options, py::list& keep_alive) {
     EvalJob job;
     job.wi = vec3_view(wi, wi_layout, n, "wi");
     job.wo = vec3_view(wo, wo_layout, n, "wo");
     fill_params(params, n, job.params, keep_alive);
-    job.model = model_from(model);
+    job.model = model_from(options.model);
     job.output = output;
-    job.cosine = cosine;
-    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
+    job.cosine = options.cosine;
+    job.energy_compensation = options.energy_compensation;
+    if (options.check_tolerance > 0.0) job.check = direction_check(options.check_tolerance);
     return job;
 }
 
 // Returns -1, or with check_tolerance > 0 the index of an element whose wi or
 // wo is not a unit vector (the outputs then hold the results of some elements only).
 std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
-                        const py::sequence& params, const py::sequence& outputs, int out_layout, std::int64_t n, int model,
-                        bool lobes, bool cosine, double check_tolerance, int threads, const std::string& isa,
-                        bool energy_compensation) {
+                        const py::sequence& params, const py::sequence& outputs, int out_layout, std::int64_t n,
+                        bool lobes, const EvalOptions options) {
     py::list keep_alive;
-    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, model, lobes ? Output::kLobes : Output::kTotal, cosine,
-                           check_tolerance, keep_alive);
-    job.energy_compensation = energy_compensation;
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, lobes ? Output::kLobes : Output::kTotal, options,
+                           keep_alive);
     std::vector<Float32Array> keep_outputs;
     output_views(outputs, lobes ? kLobeCount : 1, out_layout, n, "out", job.out, keep_outputs);
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return eval(job, n, threads, isa);
+    return eval(job, n, options.threads, options.isa);
 }
 
 // f (out) and its Jacobian: (N, 3) and (N, 3, 13) arrays, or (3, N) and (3, 13, N) with out_layout rows.
 std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                              const py::sequence& params, Float32Array out, Float32Array jacobian, int out_layout,
-                             std::int64_t n, int model, bool cosine, double check_tolerance, int threads,
-                             const std::string& isa) {
+                             std::int64_t n, const EvalOptions options) {
+    if (options.energy_compensation)
+        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
     py::list keep_alive;
-    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, model, Output::kGradient, cosine, check_tolerance,
-                           keep_alive);
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kGradient, options, keep_alive);
     job.out[0] = output_view(out, out_layout, n, "out");
     const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
     const bool shape_ok = rows ? (jacobian.ndim() == 3 && jacobian.shape(0) == 3 && jacobian.shape(1) == kParamSlots &&
@@ -139,7 +167,7 @@ std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float3
     job.jacobian_row_stride = rows ? n : 0;
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return eval(job, n, threads, isa);
+    return eval(job, n, options.threads, options.isa);
 }
 
 template <class T>
@@ -152,15 +180,13 @@ T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const ch
 
 // The sampling pdf alone (out is None) or with f into out, in one pass.
 std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
-                       const py::sequence& params, Float32Array pdf, std::int64_t n, int sampler,
-                       double check_tolerance, int threads, const std::string& isa, const py::object& out,
-                       int out_layout, int model, bool cosine, bool energy_compensation) {
+                       const py::sequence& params, Float32Array pdf, const py::object& out, int out_layout,
+                       std::int64_t n, const PdfOptions options) {
     py::list keep_alive;
     const bool with_value = !out.is_none();
-    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, model, with_value ? Output::kValuePdf : Output::kPdf,
-                           cosine, check_tolerance, keep_alive);
-    job.energy_compensation = energy_compensation;
-    job.sampler = sampler_from(sampler);
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, with_value ? Output::kValuePdf : Output::kPdf,
+                           options, keep_alive);
+    job.sampler = sampler_from(options.sampler);
     job.pdf = scalar_output(pdf, n, "pdf");
     Float32Array value;
     if (with_value) {
@@ -170,27 +196,26 @@ std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array
     }
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return eval(job, n, threads, isa);
+    return eval(job, n, options.threads, options.isa);
 }
 
 std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::object& u, int u_layout,
-                          std::uint64_t seed, const py::sequence& params, Float32Array wi, Float32Array weight,
-                          int out_layout, Float32Array pdf, py::array_t<std::int32_t, py::array::c_style> lobe,
-                          std::int64_t n, int model, int sampler, double check_tolerance, int threads,
-                          const std::string& isa, const py::object& lobe_weights, bool energy_compensation) {
+                          const py::sequence& params, Float32Array wi, Float32Array weight, Float32Array pdf,
+                          py::array_t<std::int32_t, py::array::c_style> lobe, const py::object& lobe_weights,
+                          int out_layout, std::int64_t n, const SampleOptions options) {
     SampleJob job;
-    job.energy_compensation = energy_compensation;
     job.wo = vec3_view(wo, wo_layout, n, "wo");
     Float32Array u_array;
     if (!u.is_none()) {
         u_array = py::cast<Float32Array>(u);
         job.u = vec3_view(u_array, u_layout, n, "u");
     }
-    job.seed = seed;
+    job.seed = options.seed;
     py::list keep_alive;
     fill_params(params, n, job.params, keep_alive);
-    job.model = model_from(model);
-    job.sampler = sampler_from(sampler);
+    job.model = model_from(options.model);
+    job.sampler = sampler_from(options.sampler);
+    job.energy_compensation = options.energy_compensation;
     job.wi = output_view(wi, out_layout, n, "wi");
     job.weight = output_view(weight, out_layout, n, "weight");
     job.pdf = scalar_output(pdf, n, "pdf");
@@ -199,10 +224,10 @@ std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::objec
     if (!lobe_weights.is_none())
         output_views(lobe_weights.cast<py::sequence>(), kLobeCount, out_layout, n, "lobe_weights", job.lobe_weight,
                      keep_outputs);
-    if (check_tolerance > 0.0) job.check = direction_check(check_tolerance);
+    if (options.check_tolerance > 0.0) job.check = direction_check(options.check_tolerance);
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return sample(job, n, threads, isa);
+    return sample(job, n, options.threads, options.isa);
 }
 
 py::array_t<float> uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n) {
@@ -241,28 +266,101 @@ py::dict cpu_info() {
     return info;
 }
 
+// The fields every options class has, read-write, and a repr that names them all.
+template <class Options>
+py::class_<Options> options_class(py::module_& m, const char* name, const char* doc, std::vector<const char*> fields) {
+    py::class_<Options> options(m, name, doc);
+    options.def_readwrite("model", &Options::model, "Index into MODEL_NAMES.")
+        .def_readwrite("energy_compensation", &Options::energy_compensation,
+                       "Include the multiple-scattering energy compensation.")
+        .def_readwrite("check_tolerance", &Options::check_tolerance,
+                       "Above 0: check that directions are unit vectors within this tolerance.")
+        .def_readwrite("threads", &Options::threads, "Threads to use (0: all cores).")
+        .def_readwrite("isa", &Options::isa,
+                       "Instruction set: \"\" (the CPU's choice) or one of cpu_info()[\"available\"].")
+        .def("__repr__", [name, fields](const py::object& self) {
+            std::string text = std::string(name) + "(";
+            for (std::size_t k = 0; k < fields.size(); ++k)
+                text += std::string(k ? ", " : "") + fields[k] + "=" +
+                        py::repr(self.attr(fields[k])).cast<std::string>();
+            return text + ")";
+        });
+    return options;
+}
+
 }  // namespace
 
 void bind_batch(py::module_& m) {
-    m.def("batch_eval", &batch_eval, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
-          py::arg("params"), py::arg("outputs"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
-          py::arg("lobes"), py::arg("cosine"), py::arg("check_tolerance"), py::arg("threads"), py::arg("isa"),
-          py::arg("energy_compensation") = false,
-          "SIMD evaluation into preallocated float32 outputs (validated by the caller).");
-    m.def("batch_eval_grad", &batch_eval_grad, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
-          py::arg("params"), py::arg("out"), py::arg("jacobian"), py::arg("out_layout"), py::arg("n"), py::arg("model"),
-          py::arg("cosine"), py::arg("check_tolerance"), py::arg("threads"), py::arg("isa"),
+    options_class<EvalOptions>(m, "EvalOptions", "The options of batch_eval and batch_eval_grad.",
+                               {"model", "cosine", "energy_compensation", "check_tolerance", "threads", "isa"})
+        .def(py::init([](int model, bool cosine, bool energy_compensation, double check_tolerance, int threads,
+                         std::string isa) {
+                 EvalOptions options;
+                 options.model = model;
+                 options.cosine = cosine;
+                 options.energy_compensation = energy_compensation;
+                 options.check_tolerance = check_tolerance;
+                 options.threads = threads;
+                 options.isa = std::move(isa);
+                 return options;
+             }),
+             py::kw_only(), py::arg("model") = 0, py::arg("cosine") = false, py::arg("energy_compensation") = false,
+             py::arg("check_tolerance") = 0.0, py::arg("threads") = 0, py::arg("isa") = "")
+        .def_readwrite("cosine", &EvalOptions::cosine, "Multiply by cos θl.");
+    options_class<PdfOptions>(m, "PdfOptions", "The options of batch_pdf (model and cosine: of the value, if any).",
+                              {"model", "sampler", "cosine", "energy_compensation", "check_tolerance", "threads", "isa"})
+        .def(py::init([](int model, int sampler, bool cosine, bool energy_compensation, double check_tolerance,
+                         int threads, std::string isa) {
+                 PdfOptions options;
+                 options.model = model;
+                 options.sampler = sampler;
+                 options.cosine = cosine;
+                 options.energy_compensation = energy_compensation;
+                 options.check_tolerance = check_tolerance;
+                 options.threads = threads;
+                 options.isa = std::move(isa);
+                 return options;
+             }),
+             py::kw_only(), py::arg("model") = 0, py::arg("sampler") = 0, py::arg("cosine") = false,
+             py::arg("energy_compensation") = false, py::arg("check_tolerance") = 0.0, py::arg("threads") = 0,
+             py::arg("isa") = "")
+        .def_readwrite("sampler", &PdfOptions::sampler, "Index into SAMPLER_NAMES.")
+        .def_readwrite("cosine", &PdfOptions::cosine, "Multiply the value by cos θl.");
+    options_class<SampleOptions>(m, "SampleOptions", "The options of batch_sample.",
+                                 {"model", "sampler", "energy_compensation", "seed", "check_tolerance", "threads", "isa"})
+        .def(py::init([](int model, int sampler, bool energy_compensation, std::uint64_t seed, double check_tolerance,
+                         int threads, std::string isa) {
+                 SampleOptions options;
+                 options.model = model;
+                 options.sampler = sampler;
+                 options.energy_compensation = energy_compensation;
+                 options.seed = seed;
+                 options.check_tolerance = check_tolerance;
+                 options.threads = threads;
+                 options.isa = std::move(isa);
+                 return options;
+             }),
+             py::kw_only(), py::arg("model") = 0, py::arg("sampler") = 0, py::arg("energy_compensation") = false,
+             py::arg("seed") = 0, py::arg("check_tolerance") = 0.0, py::arg("threads") = 0, py::arg("isa") = "")
+        .def_readwrite("sampler", &SampleOptions::sampler, "Index into SAMPLER_NAMES.")
+        .def_readwrite("seed", &SampleOptions::seed, "Seed of the counter-based uniforms (without u).");
+
+    // Every argument by keyword: the arrays with their layout codes, and the options.
+    m.def("batch_eval", &batch_eval, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
+          py::arg("wo_layout"), py::arg("params"), py::arg("outputs"), py::arg("out_layout"), py::arg("n"),
+          py::arg("lobes"), py::arg("options"),
+          "SIMD evaluation (f, or the lobes) into preallocated float32 outputs (validated by the caller).");
+    m.def("batch_eval_grad", &batch_eval_grad, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
+          py::arg("wo_layout"), py::arg("params"), py::arg("out"), py::arg("jacobian"), py::arg("out_layout"),
+          py::arg("n"), py::arg("options"),
           "SIMD f and its Jacobian over the parameter slots into preallocated float32 outputs.");
-    m.def("batch_pdf", &batch_pdf, py::arg("wi"), py::arg("wi_layout"), py::arg("wo"), py::arg("wo_layout"),
-          py::arg("params"), py::arg("pdf"), py::arg("n"), py::arg("sampler"), py::arg("check_tolerance"),
-          py::arg("threads"), py::arg("isa"), py::arg("out") = py::none(), py::arg("out_layout") = 0,
-          py::arg("model") = 0, py::arg("cosine") = false, py::arg("energy_compensation") = false,
+    m.def("batch_pdf", &batch_pdf, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
+          py::arg("wo_layout"), py::arg("params"), py::arg("pdf"), py::arg("out") = py::none(),
+          py::arg("out_layout") = 0, py::arg("n"), py::arg("options"),
           "SIMD sampling pdf into a preallocated float32 array (and f into out, in the same pass, if given).");
-    m.def("batch_sample", &batch_sample, py::arg("wo"), py::arg("wo_layout"), py::arg("u"), py::arg("u_layout"),
-          py::arg("seed"), py::arg("params"), py::arg("wi"), py::arg("weight"), py::arg("out_layout"), py::arg("pdf"),
-          py::arg("lobe"), py::arg("n"), py::arg("model"), py::arg("sampler"), py::arg("check_tolerance"),
-          py::arg("threads"), py::arg("isa"), py::arg("lobe_weights") = py::none(),
-          py::arg("energy_compensation") = false,
+    m.def("batch_sample", &batch_sample, py::kw_only(), py::arg("wo"), py::arg("wo_layout"), py::arg("u"),
+          py::arg("u_layout"), py::arg("params"), py::arg("wi"), py::arg("weight"), py::arg("pdf"), py::arg("lobe"),
+          py::arg("lobe_weights") = py::none(), py::arg("out_layout"), py::arg("n"), py::arg("options"),
           "SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given).");
     m.def("counter_uniforms", &uniforms, py::arg("seed"), py::arg("first"), py::arg("n"),
           "The counter-based uniforms (n, 3) that sampling uses for elements first .. first + n - 1.");

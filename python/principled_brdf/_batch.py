@@ -320,19 +320,31 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     if gradient:
         value, jacobian = outputs
         width = len(GRADIENT_NAMES)
-        bad = _core.batch_eval_grad(wi_flat, wi_code, wo_flat, wo_code, params, _flat_vec3(value, layout)[0],
-                                    jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)), out_layout, n,
-                                    model_id, cosine, tolerance, thread_count, isa_name)
+        options = _core.EvalOptions(model=model_id, cosine=cosine, check_tolerance=tolerance, threads=thread_count,
+                                    isa=isa_name)
+        bad = _core.batch_eval_grad(
+            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+            out=_flat_vec3(value, layout)[0],
+            jacobian=jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)),
+            out_layout=out_layout, n=n, options=options,
+        )
     elif pdf_sampler is not None:
         value = _flat_vec3(outputs[1], layout)[0] if len(outputs) == 2 else None  # eval_pdf: f in the same pass
-        bad = _core.batch_pdf(wi_flat, wi_code, wo_flat, wo_code, params, outputs[0].reshape(n), n, pdf_sampler,
-                              tolerance, thread_count, isa_name, value, out_layout, model_id, cosine,
-                              energy_compensation)
+        pdf_options = _core.PdfOptions(model=model_id, sampler=pdf_sampler, cosine=cosine,
+                                       energy_compensation=energy_compensation, check_tolerance=tolerance,
+                                       threads=thread_count, isa=isa_name)
+        bad = _core.batch_pdf(
+            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+            pdf=outputs[0].reshape(n), out=value, out_layout=out_layout, n=n, options=pdf_options,
+        )
     else:
-        flat_outputs = [_flat_vec3(o, layout)[0] for o in outputs]
-        bad = _core.batch_eval(wi_flat, wi_code, wo_flat, wo_code, params, flat_outputs,
-                               out_layout, n, model_id, len(outputs) == len(LOBE_NAMES),
-                               cosine, tolerance, thread_count, isa_name, energy_compensation)
+        options = _core.EvalOptions(model=model_id, cosine=cosine, energy_compensation=energy_compensation,
+                                    check_tolerance=tolerance, threads=thread_count, isa=isa_name)
+        bad = _core.batch_eval(
+            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+            outputs=[_flat_vec3(o, layout)[0] for o in outputs], lobes=len(outputs) == len(LOBE_NAMES),
+            out_layout=out_layout, n=n, options=options,
+        )
     if bad >= 0:
         raise _direction_error(bad, leading, wi_dirs, wo_dirs)
     return outputs
@@ -570,11 +582,14 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     shares = [np.empty_like(wi_out) for _ in LOBE_NAMES] if with_lobes else None
     wo_flat, wo_code = wo_dirs.flat(leading)
     u_flat, u_code = uniforms.flat(leading) if uniforms is not None else (None, 0)
+    options = _core.SampleOptions(model=model_id, sampler=sampler, energy_compensation=energy_compensation, seed=seed,
+                                  check_tolerance=DIRECTION_LENGTH_TOLERANCE if check else 0.0,
+                                  threads=thread_count, isa=isa_name)
     bad = _core.batch_sample(
-        wo_flat, wo_code, u_flat, u_code, seed, _params(material, leading), _flat_vec3(wi_out, layout)[0],
-        _flat_vec3(weight_out, layout)[0], _INTERLEAVED if layout == "aos" else _ROWS, pdf_out.reshape(n),
-        lobe_out.reshape(n), n, model_id, sampler, DIRECTION_LENGTH_TOLERANCE if check else 0.0, thread_count,
-        isa_name, None if shares is None else [_flat_vec3(share, layout)[0] for share in shares], energy_compensation,
+        wo=wo_flat, wo_layout=wo_code, u=u_flat, u_layout=u_code, params=_params(material, leading),
+        wi=_flat_vec3(wi_out, layout)[0], weight=_flat_vec3(weight_out, layout)[0], pdf=pdf_out.reshape(n),
+        lobe=lobe_out.reshape(n), lobe_weights=None if shares is None else [_flat_vec3(s, layout)[0] for s in shares],
+        out_layout=_INTERLEAVED if layout == "aos" else _ROWS, n=n, options=options,
     )
     if bad >= 0:
         raise _direction_error(bad, leading, wo_dirs)

@@ -5,10 +5,11 @@ packed arguments the Python side has already checked: directions as float32
 (N, 3), (3, N) or (3,) arrays with a layout code (0 (N, 3), 1 (3, N), 2 one
 (3,) vector for every element), ``model`` an index into MODEL_NAMES,
 ``sampler`` one into SAMPLER_NAMES, ``isa`` "" (the CPU's choice) or one of
-``cpu_info()["available"]``. The batch functions write into the float32
-arrays they are given and return -1, or the index of an element whose
-direction failed the check. tests/test_typing.py keeps these in step with the
-module's own signatures.
+``cpu_info()["available"]``. The batch functions take every argument by
+keyword, their scalar options as one EvalOptions, PdfOptions or
+SampleOptions; they write into the float32 arrays they are given and return
+-1, or the index of an element whose direction failed the check.
+tests/test_typing.py keeps these in step with the module's own signatures.
 """
 
 from collections.abc import Sequence
@@ -71,7 +72,72 @@ def reference_lobe_probabilities(
 ) -> NDArray[np.float64]:
     """Lobe probabilities (N,3) at wo for validated rows (N or one shared row each)."""
 
+class EvalOptions:
+    """The options of batch_eval and batch_eval_grad."""
+
+    model: int
+    cosine: bool
+    energy_compensation: bool
+    check_tolerance: float
+    threads: int
+    isa: str
+    def __init__(
+        self,
+        *,
+        model: _Int = 0,
+        cosine: bool = False,
+        energy_compensation: bool = False,
+        check_tolerance: _Float = 0.0,
+        threads: _Int = 0,
+        isa: str = "",
+    ) -> None: ...
+
+class PdfOptions:
+    """The options of batch_pdf (model and cosine: of the value, if any)."""
+
+    model: int
+    sampler: int
+    cosine: bool
+    energy_compensation: bool
+    check_tolerance: float
+    threads: int
+    isa: str
+    def __init__(
+        self,
+        *,
+        model: _Int = 0,
+        sampler: _Int = 0,
+        cosine: bool = False,
+        energy_compensation: bool = False,
+        check_tolerance: _Float = 0.0,
+        threads: _Int = 0,
+        isa: str = "",
+    ) -> None: ...
+
+class SampleOptions:
+    """The options of batch_sample."""
+
+    model: int
+    sampler: int
+    energy_compensation: bool
+    seed: int
+    check_tolerance: float
+    threads: int
+    isa: str
+    def __init__(
+        self,
+        *,
+        model: _Int = 0,
+        sampler: _Int = 0,
+        energy_compensation: bool = False,
+        seed: _Int = 0,
+        check_tolerance: _Float = 0.0,
+        threads: _Int = 0,
+        isa: str = "",
+    ) -> None: ...
+
 def batch_eval(
+    *,
     wi: _Float32In,
     wi_layout: _Int,
     wo: _Float32In,
@@ -80,17 +146,13 @@ def batch_eval(
     outputs: Sequence[_Float32Out],
     out_layout: _Int,
     n: _Int,
-    model: _Int,
     lobes: bool,
-    cosine: bool,
-    check_tolerance: _Float,
-    threads: _Int,
-    isa: str,
-    energy_compensation: bool = False,
+    options: EvalOptions,
 ) -> int:
-    """SIMD evaluation into preallocated float32 outputs (validated by the caller)."""
+    """SIMD evaluation (f, or the lobes) into preallocated float32 outputs (validated by the caller)."""
 
 def batch_eval_grad(
+    *,
     wi: _Float32In,
     wi_layout: _Int,
     wo: _Float32In,
@@ -100,54 +162,40 @@ def batch_eval_grad(
     jacobian: _Float32Out,
     out_layout: _Int,
     n: _Int,
-    model: _Int,
-    cosine: bool,
-    check_tolerance: _Float,
-    threads: _Int,
-    isa: str,
+    options: EvalOptions,
 ) -> int:
     """SIMD f and its Jacobian over the parameter slots into preallocated float32 outputs."""
 
 def batch_pdf(
+    *,
     wi: _Float32In,
     wi_layout: _Int,
     wo: _Float32In,
     wo_layout: _Int,
     params: _Params,
     pdf: _Float32Out,
-    n: _Int,
-    sampler: _Int,
-    check_tolerance: _Float,
-    threads: _Int,
-    isa: str,
     out: _Float32Out | None = None,
     out_layout: _Int = 0,
-    model: _Int = 0,
-    cosine: bool = False,
-    energy_compensation: bool = False,
+    n: _Int,
+    options: PdfOptions,
 ) -> int:
     """SIMD sampling pdf into a preallocated float32 array (and f into out, in the same pass, if given)."""
 
 def batch_sample(
+    *,
     wo: _Float32In,
     wo_layout: _Int,
     u: _Float32In | None,
     u_layout: _Int,
-    seed: _Int,
     params: _Params,
     wi: _Float32Out,
     weight: _Float32Out,
-    out_layout: _Int,
     pdf: _Float32Out,
     lobe: NDArray[np.int32],
-    n: _Int,
-    model: _Int,
-    sampler: _Int,
-    check_tolerance: _Float,
-    threads: _Int,
-    isa: str,
     lobe_weights: Sequence[_Float32Out] | None = None,
-    energy_compensation: bool = False,
+    out_layout: _Int,
+    n: _Int,
+    options: SampleOptions,
 ) -> int:
     """SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given)."""
 
