@@ -128,6 +128,41 @@ py::array_t<double> sample_alphas(const Float64Array& u1, const Float64Array& u2
                        [&](py::ssize_t i) { return Sampler(c1.scalar(i), c2.scalar(i), ax.scalar(i), ay.scalar(i)); });
 }
 
+// f(cos θ, η[, k]) -> scalar: the Fresnel factors.
+py::array_t<double> fresnel_dielectric(const Float64Array& cos_theta, const Float64Array& eta) {
+    Column c(cos_theta, 1, "cos_theta"), e(eta, 1, "eta");
+    const py::ssize_t n = common_rows({&c, &e});
+    return scalar_rows(n, [&](py::ssize_t i) { return mf::fresnel_dielectric(c.scalar(i), e.scalar(i)); });
+}
+
+py::array_t<double> fresnel_conductor(const Float64Array& cos_theta, const Float64Array& eta, const Float64Array& k) {
+    Column c(cos_theta, 1, "cos_theta"), e(eta, 1, "eta"), kc(k, 1, "k");
+    const py::ssize_t n = common_rows({&c, &e, &kc});
+    return scalar_rows(n, [&](py::ssize_t i) { return mf::fresnel_conductor(c.scalar(i), e.scalar(i), kc.scalar(i)); });
+}
+
+py::array_t<double> refract(const Float64Array& w, const Float64Array& eta) {
+    Column wc(w, 3, "w"), e(eta, 1, "eta");
+    const py::ssize_t n = common_rows({&wc, &e});
+    return vector_rows(n, [&](py::ssize_t i) { return mf::refract(wc.unit_vector(i), e.scalar(i)); });
+}
+
+py::array_t<double> generalized_half_vector(const Float64Array& wi, const Float64Array& wo, const Float64Array& eta) {
+    Column a(wi, 3, "wi"), b(wo, 3, "wo"), e(eta, 1, "eta");
+    const py::ssize_t n = common_rows({&a, &b, &e});
+    return vector_rows(n, [&](py::ssize_t i) {
+        return mf::generalized_half_vector(a.unit_vector(i), b.unit_vector(i), e.scalar(i));
+    });
+}
+
+py::array_t<double> refraction_jacobian(const Float64Array& wi, const Float64Array& wo, const Float64Array& eta) {
+    Column a(wi, 3, "wi"), b(wo, 3, "wo"), e(eta, 1, "eta");
+    const py::ssize_t n = common_rows({&a, &b, &e});
+    return scalar_rows(n, [&](py::ssize_t i) {
+        return mf::refraction_jacobian(a.unit_vector(i), b.unit_vector(i), e.scalar(i));
+    });
+}
+
 py::array_t<double> gtr_d(const Float64Array& cos_theta_h, const Float64Array& alpha, const Float64Array& gamma,
                           bool closed_forms) {
     Column c(cos_theta_h, 1, "cos_theta_h"), a(alpha, 1, "alpha"), g(gamma, 1, "gamma");
@@ -293,6 +328,11 @@ void bind_microfacet(py::module_& m) {
             py::arg("alpha_y"), py::arg("form"));
     sub.def("beckmann_sample_visible", &beckmann_sample_visible, py::arg("wo"), py::arg("u1"), py::arg("u2"),
             py::arg("alpha_x"), py::arg("alpha_y"));
+    sub.def("fresnel_dielectric", &fresnel_dielectric, py::arg("cos_theta"), py::arg("eta"));
+    sub.def("fresnel_conductor", &fresnel_conductor, py::arg("cos_theta"), py::arg("eta"), py::arg("k"));
+    sub.def("refract", &refract, py::arg("w"), py::arg("eta"));
+    sub.def("generalized_half_vector", &generalized_half_vector, py::arg("wi"), py::arg("wo"), py::arg("eta"));
+    sub.def("refraction_jacobian", &refraction_jacobian, py::arg("wi"), py::arg("wo"), py::arg("eta"));
     sub.def("hyp2f1", &hyp2f1, py::arg("a"), py::arg("b"), py::arg("c"), py::arg("z"));
 }
 

@@ -94,6 +94,12 @@ __all__ = [
     "ExponentialPower",
     "GTR",
     "hyp2f1",
+    "fresnel_dielectric",
+    "fresnel_conductor",
+    "refract",
+    "generalized_half_vector",
+    "refraction_jacobian",
+    "ETA_RANGE",
     "MIN_ALPHA",
     "MAX_ALPHA",
     "MAX_GAMMA",
@@ -1486,3 +1492,144 @@ def hyp2f1(a: RealArrayLike, b: RealArrayLike, c: RealArrayLike, z: RealArrayLik
     for name, array in zip("abcz", values):
         _validate.require_in_domain(name, array, -np.inf, np.inf)
     return _run(_core_mf.hyp2f1, a=values[0], b=values[1], c=values[2], z=values[3])
+
+
+# --------------------------------------------------------------------------
+# interfaces: the Fresnel factors and the geometry of refraction
+#
+# The interface is the tangent plane, normal n = (0, 0, 1); ``eta`` is the relative
+# index of refraction, the index of the far side over that of the near side, within
+# ETA_RANGE (beyond it 1/η² leaves the double range's comfortable middle for no physical use).
+
+ETA_RANGE = (1e-6, 1e6)
+
+
+def _cosines(cos_theta: RealArrayLike) -> Float64Array:
+    array = _validate.as_real_array("cos_theta", cos_theta)
+    _validate.require_in_domain("cos_theta", array, -1.0, 1.0)
+    return array
+
+
+def _eta(eta: RealArrayLike) -> Float64Array:
+    return _in_range("eta", eta, ETA_RANGE[0], ETA_RANGE[1])
+
+
+def fresnel_dielectric(cos_theta: RealArrayLike, eta: RealArrayLike) -> Float64Array:
+    """The unpolarised Fresnel reflectance of a smooth dielectric interface, exact.
+
+    With ``c = |cos_theta|`` and ``cos²θt = 1 - (1 - c²) / η²`` (Snell's law),
+    ``rs = (c - η cos θt) / (c + η cos θt)``, ``rp = (η c - cos θt) / (η c + cos θt)`` and
+    ``F = (rs² + rp²) / 2`` (Walter et al. 2007 eq. 22); ``F = 1`` under total internal
+    reflection (``η < 1`` beyond the critical angle). It is the model's own Fresnel factor.
+
+    Parameters
+    ----------
+    cos_theta : float or array_like
+        Cosine between the direction and the interface's normal, in [-1, 1] (the light
+        arrives from the near side whatever its sign).
+    eta : float or array_like
+        Relative index of refraction, in ``ETA_RANGE`` (1.5: air to glass; 1/1.5: glass to air).
+
+    Returns
+    -------
+    numpy.ndarray
+        F in [0, 1], float64, the broadcast shape of the arguments.
+    """
+    return _run(_core_mf.fresnel_dielectric, cos_theta=_cosines(cos_theta), eta=_eta(eta))
+
+
+def fresnel_conductor(cos_theta: RealArrayLike, eta: RealArrayLike, k: RealArrayLike) -> Float64Array:
+    """The unpolarised Fresnel reflectance of a conductor of complex index ``eta + i k``.
+
+    As :func:`fresnel_dielectric` with a complex index ``n = η + ik``:
+    ``cos θt = sqrt(1 - (1 - c²) / n²)``, ``rs = (c - n cos θt) / (c + n cos θt)``,
+    ``rp = (n c - cos θt) / (n c + cos θt)``, ``F = (|rs|² + |rp|²) / 2``. Per channel: pass
+    RGB arrays of ``eta`` and ``k`` (e.g. measured indices of gold) for an RGB ``F``.
+
+    Parameters
+    ----------
+    cos_theta : float or array_like
+        Cosine between the direction and the normal, in [-1, 1].
+    eta : float or array_like
+        Real part of the relative index, in ``ETA_RANGE``.
+    k : float or array_like
+        Extinction coefficient, >= 0 (0 gives :func:`fresnel_dielectric`).
+
+    Returns
+    -------
+    numpy.ndarray
+        F in [0, 1], float64.
+    """
+    extinction = _validate.as_real_array("k", k)
+    _validate.require_in_domain("k", extinction, 0.0, 1e10)
+    return _run(_core_mf.fresnel_conductor, cos_theta=_cosines(cos_theta), eta=_eta(eta),
+                k=extinction)
+
+
+def refract(w: RealArrayLike, eta: RealArrayLike) -> Float64Array:
+    """The direction refracted from ``w`` through the interface (Snell's law).
+
+    ``wt = -w / η + (c / η - cos θt) sign(w·n) n`` with ``c = |w·n|``: a unit vector on the
+    far side, its azimuth opposite to ``w``'s (both point away from the surface). Zero
+    under total internal reflection.
+
+    Parameters
+    ----------
+    w : array_like
+        Unit directions ``(..., 3)`` on the near side, pointing away from the surface.
+    eta : float or array_like
+        Relative index of refraction, in ``ETA_RANGE``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(..., 3)`` float64.
+    """
+    return _run(_core_mf.refract, returns_vector=True, w=_Vector(_validate.directions("w", w)),
+                eta=_eta(eta))
+
+
+def generalized_half_vector(wi: RealArrayLike, wo: RealArrayLike, eta: RealArrayLike) -> Float64Array:
+    """The generalized half vector of a pair, ``h = normalize(wo + η wi)`` turned to ``h·n >= 0``.
+
+    Each direction is weighted by the index of its own side (Walter et al. 2007 eq. 16):
+    ``eta`` is the index on ``wi``'s side over that on ``wo``'s. For a reflection
+    (``eta = 1``) it is the usual half vector; for a refraction it is the microfacet normal
+    that refracts one direction into the other. Zero where ``wo + η wi = 0``.
+
+    Parameters
+    ----------
+    wi, wo : array_like
+        Unit directions ``(..., 3)``.
+    eta : float or array_like
+        Index on ``wi``'s side over that on ``wo``'s, in ``ETA_RANGE``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(..., 3)`` float64 unit vectors.
+    """
+    return _run(_core_mf.generalized_half_vector, returns_vector=True, wi=_Vector(_validate.directions("wi", wi)),
+                wo=_Vector(_validate.directions("wo", wo)), eta=_eta(eta))
+
+
+def refraction_jacobian(wi: RealArrayLike, wo: RealArrayLike, eta: RealArrayLike) -> Float64Array:
+    """``dω_h / dω_i`` of refraction: ``η² |wi·h| / (wo·h + η wi·h)²`` (Walter et al. 2007 eq. 17).
+
+    ``h`` is :func:`generalized_half_vector` of the pair. A density of half vectors times
+    it is the density of the refracted direction ``wi``: the transmission pdf.
+
+    Parameters
+    ----------
+    wi, wo : array_like
+        Unit directions ``(..., 3)``, on opposite sides of the interface.
+    eta : float or array_like
+        Index on ``wi``'s side over that on ``wo``'s, in ``ETA_RANGE``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(...)`` float64; +inf where the denominator vanishes.
+    """
+    return _run(_core_mf.refraction_jacobian, wi=_Vector(_validate.directions("wi", wi)),
+                wo=_Vector(_validate.directions("wo", wo)), eta=_eta(eta))

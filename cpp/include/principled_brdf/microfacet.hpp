@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 
 #include "model/f64.hpp"
 
@@ -291,6 +292,46 @@ inline double beckmann_lambda(const Vec3& w, double alpha_x, double alpha_y) {
 
 inline double beckmann_g1(const Vec3& w, double alpha_x, double alpha_y) {
     return beckmann_of(alpha_x, alpha_y).g1(upper(w));
+}
+
+// ---------------------------------------------------------------- interfaces
+// Dielectric interfaces are the model's (model/dielectric.hpp): η is the
+// index of the far side over that of the near side.
+
+inline ModelVec3 to_model(const Vec3& w) { return {w.x, w.y, w.z}; }
+inline Vec3 from_model(const ModelVec3& w) { return {w.x, w.y, w.z}; }
+
+// Unpolarised Fresnel reflectance at |cos θi|, 1 under total internal reflection.
+inline double fresnel_dielectric(double cos_theta_i, double eta) { return f64::fresnel_dielectric(cos_theta_i, eta); }
+
+// The same for a conductor of complex index n = η + ik (relative to the near side):
+// with cos θt = sqrt((c² + (n - 1)(n + 1)) / n²) complex,
+//   rs = (cos θi - n cos θt) / (cos θi + n cos θt),  rp = (n cos θi - cos θt) / (n cos θi + cos θt),
+//   F = (|rs|² + |rp|²) / 2;  at k = 0 it is fresnel_dielectric.
+inline double fresnel_conductor(double cos_theta_i, double eta, double k) {
+    const double c = std::min(std::abs(cos_theta_i), 1.0);
+    const std::complex<double> n(eta, k);
+    const std::complex<double> cos_t = std::sqrt((c * c + (n - 1.0) * (n + 1.0)) / (n * n));
+    const std::complex<double> rs = (c - n * cos_t) / (c + n * cos_t);
+    const std::complex<double> rp = (n * c - cos_t) / (n * c + cos_t);
+    return 0.5 * (std::norm(rs) + std::norm(rp));
+}
+
+// Snell's law through the tangent plane; (0, 0, 0) under total internal reflection.
+inline Vec3 refract(const Vec3& w, double eta) { return from_model(f64::refract(to_model(w), eta)); }
+
+// h = normalize(wo + η wi) turned to the side of n: η the index on wi's side
+// over that on wo's (1: the usual half vector). (0, 0, 0) where wo + η wi = 0.
+inline Vec3 generalized_half_vector(const Vec3& wi, const Vec3& wo, double eta) {
+    const Vec3 h = from_model(f64::generalized_half_vector(to_model(wi), to_model(wo), eta));
+    const double length2 = dot(h, h);
+    return length2 > 0.0 ? scale(h, 1.0 / std::sqrt(length2)) : Vec3{0.0, 0.0, 0.0};
+}
+
+// dωh/dωi of refraction at h = generalized_half_vector(wi, wo, η): η² |wi·h| / (wo·h + η wi·h)².
+inline double refraction_jacobian(const Vec3& wi, const Vec3& wo, double eta) {
+    const Vec3 h = generalized_half_vector(wi, wo, eta);
+    return f64::refraction_jacobian(to_model(wi), to_model(wo), to_model(h), eta);
 }
 
 }  // namespace principled_brdf::microfacet

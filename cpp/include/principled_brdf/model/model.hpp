@@ -20,6 +20,7 @@
 
 #include "vector.hpp"
 #include "distributions.hpp"
+#include "dielectric.hpp"
 #include "lobes.hpp"
 #include "principled.hpp"
 #include "energy.hpp"
