@@ -41,10 +41,11 @@ from . import _color, _validate
 from .albedo import MAX_SAMPLES as _ALBEDO_MAX_SAMPLES
 from .albedo import albedo as _albedo
 from .material import PARAMETERS, Material
+from . import measured as _measured
 from . import render as _render
 
 if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
-    from collections.abc import Iterable, Mapping
+    from collections.abc import Callable, Iterable, Mapping
     from types import ModuleType
     from typing import Any
 
@@ -108,6 +109,47 @@ def _uniform_material(name: str, value: object) -> Material:
         raise ValueError(f"{name}: expected a uniform material (one value per parameter), "
                          f"got per-element parameters of shape {material.shape}")
     return material
+
+
+class _Brdf(typing.NamedTuple):
+    """What a plot draws: a uniform material (its lobes too), measured data or any f(wi, wo)."""
+
+    f: Callable[[Float64Array, Float64Array], Float64Array]  # (..., 3) float64 in 1/sr, NaN where no data
+    material: Material | None  # set for a Material or a preset: the library's lobes and albedo
+
+
+def _brdf(name: str, value: object, model: Model, cosine: bool = False) -> _Brdf:
+    """A Material, a preset name, a :class:`~principled_brdf.measured.MerlBRDF` or a callable
+    ``f(wi, wo) -> (..., 3)`` in 1/sr; errors name ``name``."""
+    if isinstance(value, (Material, str)):
+        material = _uniform_material(name, value)
+        return _Brdf(lambda wi, wo: _eval(material, wi.astype(np.float32), wo.astype(np.float32), model=model,
+                                          cosine=cosine).astype(np.float64), material)
+    if isinstance(value, _measured.MerlBRDF):
+        table = value
+
+        def measured(wi: Float64Array, wo: Float64Array) -> Float64Array:
+            f = table.eval(wi, wo)
+            return f * np.abs(wi[..., 2:3]) if cosine else f
+        return _Brdf(measured, None)
+    if callable(value):
+        function = value
+
+        def called(wi: Float64Array, wo: Float64Array) -> Float64Array:
+            wi, wo = np.broadcast_arrays(wi, wo)
+            f = np.asarray(function(wi, wo), dtype=np.float64)
+            if f.shape != wi.shape:
+                raise ValueError(f"{name}: expected the callable to return f of shape {wi.shape} (RGB per pair), "
+                                 f"got {f.shape}")
+            bad = ~((f >= 0.0) & (f < np.inf)) & ~np.isnan(f)
+            if bad.any():
+                i = _validate.first_true(bad)
+                raise ValueError(f"{name}: the callable returned {float(f.ravel()[i])!r}; expected f >= 0, finite "
+                                 "(or NaN where there is no data)")
+            return f * np.abs(wi[..., 2:3]) if cosine else f
+        return _Brdf(called, None)
+    raise TypeError(f"{name}: expected a principled_brdf.Material, a preset name, a MerlBRDF or a callable "
+                    f"f(wi, wo), got {type(value).__name__}")
 
 
 def _channel(value: object) -> Float64Array:
@@ -187,7 +229,7 @@ def slice_directions(resolution: int, phi_d: float = 90.0) -> tuple[FloatArray, 
     return theta, theta.copy(), rotate(dx, dy, cd), rotate(-dx, -dy, cd)
 
 
-def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
+def brdf_slice(material: Material | str | _measured.MerlBRDF | Callable[..., Any], *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
                log: bool = True, model: Model = "disney2014", vmin: float | None = None, vmax: float | None = None,
                percentile: float | None = None, exposure: float = 1.0, cmap: str = "inferno", colorbar: bool = True,
                ax: Axes | None = None) -> Axes:
@@ -211,8 +253,15 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
     f before it is mapped (above 1 brightens, the color bar relabelled to
     match). Returns the Axes; the image is ``ax.images[-1]`` (``get_array()``
     gives the plotted values, indexed ``[θd, θh]`` with row 0 at θd ≈ 0).
+
+    ``material``: a uniform Material or a preset name (evaluated by the kernels
+    with ``model``), measured data (a :class:`~principled_brdf.measured.MerlBRDF`;
+    cells without data are masked like the horizon) or any callable ``f(wi, wo)``
+    returning ``(..., 3)`` in 1/sr for float64 ``(..., 3)`` directions, e.g. a
+    fitted material beside its measurements.
     """
-    material = _uniform_material("material", material)
+    _validate.model_index(model)
+    brdf = _brdf("material", material, model)
     n = _validate.resolution("resolution", resolution)
     rgb_mode = channel == "rgb"
     weights = np.asarray(CHANNELS["luminance"]) if rgb_mode else _channel(channel)
@@ -228,8 +277,9 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
     from matplotlib import colors, cm
 
     theta_h, theta_d, wi, wo = slice_directions(n, phi_d)
-    f = _eval(material, wi, wo, model=model).astype(np.float64)
-    valid = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
+    f = brdf.f(np.asarray(wi, np.float64), np.asarray(wo, np.float64))
+    valid = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0) & ~np.isnan(f).any(axis=-1)
+    f = np.where(valid[..., None], f, 0.0)
     value = _project(f, weights)
     shown = value[valid]
     top = float(vmax) if vmax is not None else (float(np.percentile(shown, percentile)) if shown.size else 0.0)
@@ -282,9 +332,10 @@ def brdf_slice(material: Material | str, *, resolution: int = 256, phi_d: float 
 # 2. polar plot in the plane of incidence
 
 
-def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True, cosine: bool = False,
+def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., Any], theta_o: float, *, lobes: bool = True, cosine: bool = False,
                 model: Model = "disney2014", resolution: int = 721, channel: str = "luminance", log: bool = False,
-                decades: float = 4.0, legend: bool = True, ax: Axes | None = None) -> PolarAxes:
+                decades: float = 4.0, legend: bool = True, ax: Axes | None = None,
+                label: str = "total") -> PolarAxes:
     """f(wi, wo) in the plane of incidence, per lobe and in total, on a polar Axes.
 
     ``wo = (sin θo, 0, cos θo)`` (``theta_o`` in degrees, in (-90, 90)), ``wi =
@@ -299,8 +350,13 @@ def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True,
     view direction is drawn as a grey dashed line labelled ``"wo"``. ``ax``
     must be a polar Axes. Returns the polar Axes; lines carry labels
     ``"total"``, ``"diffuse"``, ... (their data: f, or log10 f with ``log``).
+    ``material`` may also be measured data or a callable ``f(wi, wo)`` (as for
+    :func:`brdf_slice`): then the total alone is drawn, with gaps where there is
+    no data, dashed. ``label`` names the total's line (e.g. ``"measured"`` and
+    ``"fitted"`` on one Axes).
     """
-    material = _uniform_material("material", material)
+    _validate.model_index(model)
+    brdf = _brdf("material", material, model, cosine=_validate.flag("cosine", cosine))
     theta = _validate.real_number("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
     n = _validate.resolution("resolution", resolution, unit=" angles")
     weights = _channel(channel)
@@ -313,10 +369,14 @@ def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True,
     wi = np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
     wi[[0, -1], 2] = 0.0  # exactly on the horizon (cos(±π/2) is 6e-17)
     wo = np.array([np.sin(np.radians(theta)), 0.0, np.cos(np.radians(theta))])
-    values = _eval_lobes(material, wi, wo, cosine=cosine, model=model)
-    curves = {name: _project(v, weights) for name, v in zip(_validate.LOBE_NAMES, values)}
-    total = typing.cast("Float64Array", sum(curves.values()))  # (not 0: there are four lobes)
-    peak = float(total.max()) if total.max() > 0 else 1.0
+    if brdf.material is not None:
+        values = _eval_lobes(brdf.material, wi, wo, cosine=cosine, model=model)
+        curves = {name: _project(v, weights) for name, v in zip(_validate.LOBE_NAMES, values)}
+        total = typing.cast("Float64Array", sum(curves.values()))  # (not 0: there are four lobes)
+    else:
+        curves = {}
+        total = _project(brdf.f(wi, np.broadcast_to(wo, wi.shape)), weights)  # NaN (no data): gaps in the line
+    peak = float(np.nanmax(total)) if np.nanmax(total, initial=0.0) > 0 else 1.0
     if log:
         floor = np.log10(peak) - decades
 
@@ -328,7 +388,7 @@ def polar_lobes(material: Material | str, theta_o: float, *, lobes: bool = True,
 
     drawn = [(name, curve) for name, curve in curves.items() if lobes and np.any(curve > 0.0)]
     ax.plot(t, radius(total), color=_LOBE_COLORS["total"], lw=4.0 if drawn else 1.8, alpha=0.3 if drawn else 1.0,
-            label="total", zorder=2)
+            label=label, zorder=2, ls="-" if brdf.material is not None else "--")
     for name, curve in drawn:
         ax.plot(t, radius(curve), color=_LOBE_COLORS[name], lw=1.3, label=name, zorder=3)
     top = float(radius(np.array(peak)))
@@ -399,9 +459,9 @@ def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealAr
 # 4. directional albedo
 
 
-def albedo_curves(material: Material | str, *, angles: RealArrayLike = np.linspace(0, 89, 46), samples: int = 1 << 14,
+def albedo_curves(material: Material | str | _measured.MerlBRDF | Callable[..., Any], *, angles: RealArrayLike = np.linspace(0, 89, 46), samples: int = 1 << 14,
                   seed: int = 0, model: Model = "disney2014", channel: str = "luminance", lobes: bool = True,
-                  ax: Axes | None = None, energy_compensation: bool = False) -> Axes:
+                  ax: Axes | None = None, energy_compensation: bool = False, label: str = "total") -> Axes:
     """Directional albedo ``E(θo) = ∫ f cos θl dωi`` against θo (``pb.albedo``), per lobe and in total.
 
     ``angles``: view angles in degrees, in [0, 90). Each point is the mean of
@@ -410,8 +470,15 @@ def albedo_curves(material: Material | str, *, angles: RealArrayLike = np.linspa
     an upper bound). Lobes whose albedo is zero at every angle are left out.
     Returns the Axes; lines carry labels ``"total"``, ``"diffuse"``, ...
     (``"multiple_scattering"`` with ``energy_compensation``, as in ``pb.albedo``).
+
+    ``material`` may also be measured data or a callable ``f(wi, wo)`` (as for
+    :func:`brdf_slice`): then the total alone is drawn, integrated by the
+    midpoint rule on a grid of ``ALBEDO_QUADRATURE`` (cos² θl, φl) cells over
+    the upper hemisphere (cells without data count as 0), dashed, without a
+    band. ``label`` names the total's line.
     """
-    material = _uniform_material("material", material)
+    _validate.model_index(model)
+    brdf = _brdf("material", material, model)
     weights = _channel(channel)
     theta = np.asarray(angles, dtype=np.float64) if not isinstance(angles, str) else None
     if theta is None or theta.ndim != 1 or theta.size < 1 or not np.all(np.isfinite(theta)):
@@ -422,25 +489,54 @@ def albedo_curves(material: Material | str, *, angles: RealArrayLike = np.linspa
     _validate.model_index(model)
     ax = _axes(ax)
 
-    result = _albedo(material, np.cos(np.radians(theta)), samples=samples, seed=seed, model=model,
-                     energy_compensation=energy_compensation)
-    curves: list[tuple[str, FloatArray, FloatArray]] = [("total", result.total, result.total_error)]
-    if lobes:
-        curves += [(name, value, error) for name, value, error in zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)]
+    if brdf.material is None:
+        total = _albedo_by_quadrature(brdf.f, np.radians(theta))
+        curves: list[tuple[str, FloatArray, FloatArray]] = [("total", total, np.zeros_like(total))]
+    else:
+        result = _albedo(brdf.material, np.cos(np.radians(theta)), samples=samples, seed=seed, model=model,
+                         energy_compensation=energy_compensation)
+        curves = [("total", result.total, result.total_error)]
+        if lobes:
+            curves += [(name, value, error)
+                       for name, value, error in zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)]
     for name, value, error in curves:
         mean, band = _project(value, weights), _project(error, weights) * 2.0
         if name != "total" and not np.any(mean > 0.0):
             continue
         color = _LOBE_COLORS[name]
-        ax.plot(theta, mean, color=color, lw=1.8 if name == "total" else 1.2, label=name)
+        ax.plot(theta, mean, color=color, lw=1.8 if name == "total" else 1.2, label=label if name == "total" else name,
+                ls="-" if brdf.material is not None else "--")
         ax.fill_between(theta, mean - band, mean + band, color=color, alpha=0.25, lw=0)
     ax.set_xlim(0.0, 90.0)
     ax.set_ylim(bottom=0.0)
     ax.set_xlabel("θo (degrees)")
     ax.set_ylabel(f"directional albedo ({channel}, unitless)")
-    ax.set_title(f"directional albedo, ±2 s.e. ({samples} samples)")
+    ax.set_title(f"directional albedo, ±2 s.e. ({samples} samples)" if brdf.material is not None
+                 else "directional albedo (quadrature)")
     ax.legend(loc="best", fontsize="small", frameon=False)  # where it covers the fewest points
     return ax
+
+
+#: (cos² θl cells, φl cells) of the quadrature that :func:`albedo_curves` applies to measured data and callables
+ALBEDO_QUADRATURE = (256, 256)
+
+
+def _albedo_by_quadrature(f: Callable[[Float64Array, Float64Array], Float64Array],
+                          theta_o: Float64Array) -> Float64Array:
+    """∫ f cos θl dωi over the upper hemisphere, (len(theta_o), 3): with x = cos² θl,
+    cos θl dωi = dx dφ / 2, so the midpoint rule in (x, φ) weighs every cell alike."""
+    n_x, n_phi = ALBEDO_QUADRATURE
+    x = (np.arange(n_x) + 0.5) / n_x
+    phi = (np.arange(n_phi) + 0.5) / n_phi * 2.0 * np.pi
+    x_, phi_ = np.meshgrid(x, phi, indexing="ij")
+    sin = np.sqrt(1.0 - x_)
+    wi = np.stack([sin * np.cos(phi_), sin * np.sin(phi_), np.sqrt(x_)], axis=-1).reshape(-1, 3)
+    cell = 0.5 * (1.0 / n_x) * (2.0 * np.pi / n_phi)
+    totals = []
+    for t in theta_o:
+        wo = np.broadcast_to([np.sin(t), 0.0, np.cos(t)], wi.shape)
+        totals.append(np.nansum(f(wi, wo), axis=0) * cell)
+    return np.array(totals)
 
 
 # --------------------------------------------------------------------------
