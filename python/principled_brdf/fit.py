@@ -45,6 +45,8 @@ _RELATIVE_FLOOR_FRACTION = 1e-3
 _RELATIVE_FLOOR = 1e-9
 _MAX_WEIGHT = 1e30  # weights times squared residuals (at most ~1e95) stay finite
 _NO_DATA = "no data: every sample of this problem is missing (NaN); the result is the start"
+_ANISOTROPY_HELD = ("anisotropic held at its start (default 0): the pairs' half vectors all lie in one plane "
+                    "through the normal, which cannot determine it; name it in fit= to fit it anyway")
 _NOTHING_FITTED = "nothing to fit: every parameter in fit is held by equal bounds; the result is the start"
 
 
@@ -61,6 +63,7 @@ class FitResult:
     success: np.bool_ | NDArray[np.bool_]  # scipy's convergence flag, per problem (False: no data)
     message: str | tuple[str, ...]  # scipy's message, per problem, or why it was not fitted
     names: tuple[str, ...]  # the fitted parameters (slot names, base_color as three)
+    notes: tuple[str, ...] = ()  # what the fit decided by itself (e.g. a parameter the data cannot determine)
 
     def summary(self) -> str:
         rows = np.atleast_2d(self.slots)
@@ -77,6 +80,7 @@ class FitResult:
                 shown.append(f"{name}=({', '.join(f'{c:.4g}' for c in v)})" if info.slots == 3 else f"{name}={v[0]:.4g}")
             lines.append("  " + ", ".join(shown))
         lines.append("  fitted: " + ", ".join(self.names))
+        lines += [f"  note: {note}" for note in self.notes]
         return "\n".join(lines)
 
     def __str__(self) -> str:
@@ -206,7 +210,10 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     marks a missing sample; values beyond float32's range are refused (no
     material reaches them). ``init``: the start (a uniform Material or a dict;
     default ``Material()``), which also holds the parameters not in ``fit``
-    (names; default all, ``base_color`` as three channels).
+    (names; default all, ``base_color`` as three channels, except that
+    ``anisotropic`` is held at its start when the pairs cannot determine it:
+    every half vector in one plane through the normal, as a MERL table's
+    pairs; the result's ``notes`` and ``summary()`` say so).
     ``loss``: ``"log"`` (``log(1 + f c) - log(1 + m c)``, c = cos θl if
     ``cosine`` else 1: robust over the dynamic range of specular peaks),
     ``"relative"`` (``(f - m) / max(m, 1e-3 max m, 1e-9)``, max m over the
@@ -273,6 +280,11 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
                              f"is not a weight (expected finite values from 0 to {_MAX_WEIGHT:g})")
         weights = np.broadcast_to(weights, (count, n))
     requested = _gradient.columns(fit, "fit")
+    notes: list[str] = []
+    anisotropic = GRADIENT_NAMES.index("anisotropic")
+    if fit is None and not _determines_anisotropy(wi, wo):
+        requested.remove(anisotropic)
+        notes.append(_ANISOTROPY_HELD)
     lower, upper = _slot_bounds(bounds)
     start = _initial_slots(init)
     start[requested] = np.clip(start[requested], lower[requested], upper[requested])
@@ -337,4 +349,22 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
     return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
                      residuals=take(residuals_out), iterations=take(iterations), success=take(success),
-                     message=tuple(messages) if batched else messages[0], names=tuple(GRADIENT_NAMES[k] for k in slots))
+                     message=tuple(messages) if batched else messages[0], names=tuple(GRADIENT_NAMES[k] for k in slots),
+                     notes=tuple(notes))
+
+
+def _determines_anisotropy(wi: NDArray[Any], wo: NDArray[Any]) -> bool:
+    """Whether the pairs' half vectors span more than one plane through the normal: with
+    every half vector at one azimuth φh (mod π), as a MERL table's pairs
+    (``merl_pairs()``), an anisotropic GGX of roughness r and one of another aspect
+    match at every pair for some r', so the data cannot tell them apart."""
+    h = wi + wo
+    h_xy = h[..., :2].reshape(-1, 2)
+    length = np.hypot(h_xy[:, 0], h_xy[:, 1])
+    off_normal = length > 1e-6 * np.linalg.norm(h.reshape(-1, 3), axis=1)
+    if off_normal.sum() < 2:
+        return False
+    # the doubled azimuth (φh and φh + π are one plane) as a unit vector; one plane = one point
+    phi = np.arctan2(h_xy[off_normal, 1], h_xy[off_normal, 0])
+    doubled = np.stack([np.cos(2.0 * phi), np.sin(2.0 * phi)], axis=-1)
+    return bool(np.max(np.linalg.norm(doubled - doubled[0], axis=1)) > 1e-3)

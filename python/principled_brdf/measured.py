@@ -115,12 +115,18 @@ def _centres() -> tuple[Float64Array, Float64Array, Float64Array]:
     return theta_h, i_d / MERL_SHAPE[1] * _HALF_PI, i_p / MERL_SHAPE[2] * np.pi
 
 
-def merl_pairs() -> tuple[Float64Array, Float64Array]:
+def merl_pairs(phi_h: float = 0.0) -> tuple[Float64Array, Float64Array]:
     """(wi, wo), each ``(90 · 90 · 180, 3)``, at the cells' centres in the file's
-    order (φh = 0): the pairs to evaluate a model at, or to fit one to a
-    table's :meth:`MerlBRDF.values`. Some lie below the horizon (θh + θd > 90°)."""
+    order, with the half vector at azimuth ``phi_h`` (radians; the table holds an
+    isotropic BRDF, the same at every φh): the pairs to evaluate a model at, or to
+    fit one to a table's :meth:`MerlBRDF.values`. Some lie below the horizon
+    (θh + θd > 90°)."""
+    phi = _validate.as_real_array("phi_h", phi_h)
+    if phi.ndim != 0:
+        raise ValueError(f"phi_h: expected one angle in radians, got shape {phi.shape}")
+    _validate.require_finite("phi_h", phi)
     theta_h, theta_d, phi_d = _centres()
-    wi, wo = half_diff_to_wiwo(theta_h.reshape(-1), 0.0, theta_d.reshape(-1), phi_d.reshape(-1))
+    wi, wo = half_diff_to_wiwo(theta_h.reshape(-1), float(phi), theta_d.reshape(-1), phi_d.reshape(-1))
     return wi, wo
 
 
