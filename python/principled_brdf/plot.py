@@ -58,7 +58,7 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
     from .render import _EnvironmentArg
 
 __all__ = ["brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves", "parameter_sweep", "blend_demo",
-           "microfacet_family", "slice_directions", "SCALAR_PARAMETERS", "CHANNELS"]
+           "microfacet_family", "slice_directions", "SCALAR_PARAMETERS", "CHANNELS", "ALBEDO_QUADRATURE"]
 
 #: The ten scalar parameters of the model, in the library's order.
 SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items() if info.slots == 1)
