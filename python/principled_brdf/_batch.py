@@ -165,6 +165,18 @@ class _Directions:
         n = _size(leading)
         return (array.reshape(n, 3), _INTERLEAVED) if self.layout == "aos" else (array.reshape(3, n), _ROWS)
 
+    def segment(self, outer: tuple[int, ...], inner: tuple[int, ...]) -> tuple[Float32Array, int]:
+        """(array, layout code) of the segment at the outer index ``outer`` of a call split
+        into segments of shape ``inner`` (layout "aos"): a view, one vector or ``inner``'s."""
+        own = self.leading
+        depth = len(outer) + len(inner)
+        padded = (1,) * (depth - len(own)) + own
+        index = tuple(0 if size == 1 else i for i, size in zip(outer, padded[:len(outer)]))
+        block = self.array.reshape(padded + (3,))[index]
+        if all(size == 1 for size in padded[len(outer):]):
+            return block.reshape(3), _SINGLE
+        return block.reshape(-1, 3), _INTERLEAVED
+
     def _own_index(self, element: int, leading: tuple[int, ...]) -> tuple[int, ...]:
         """The index into this argument's own leading shape of ``element`` of the broadcast ``leading``."""
         index = np.unravel_index(element, leading) if leading else ()
@@ -288,6 +300,39 @@ def _flat_vec3(array: Float32Array, layout: str) -> tuple[Float32Array, int]:
     return (array.reshape(n, 3), _INTERLEAVED) if layout == "aos" else (array.reshape(3, n), _ROWS)
 
 
+# A call whose arguments broadcast over some leading axes runs as one kernel call per
+# index of those axes when each call still covers at least this many elements:
+# the arguments are then read in place (numpy views), never copied to the full shape.
+_SMALLEST_SEGMENT = 1024
+
+
+def _segment_split(leading: tuple[int, ...], material_shape: tuple[int, ...],
+                   *direction_shapes: tuple[int, ...]) -> int | None:
+    """The number of outer axes over which to split a call so that each argument is read in
+    place, or None when one call reads everything in place (or segments would be small).
+
+    Within a segment (the inner axes ``leading[s:]``) a direction is one vector or an array
+    of the inner shape, whatever it does over the outer axes; the material must not vary
+    over the outer axes (its per-element arrays serve every segment)."""
+    shapes = [material_shape, *direction_shapes]
+    if all(shape in ((), leading) for shape in shapes):
+        return None
+
+    def padded(shape: tuple[int, ...]) -> tuple[int, ...]:
+        return (1,) * (len(leading) - len(shape)) + shape
+
+    for split in range(1, len(leading)):
+        inner = leading[split:]
+        if _size(inner) < _SMALLEST_SEGMENT:
+            return None
+        material = padded(material_shape)
+        if material_shape and not (all(d == 1 for d in material[:split]) and material[split:] == inner):
+            continue
+        if all(padded(shape)[split:] in (inner, (1,) * len(inner)) for shape in direction_shapes):
+            return split
+    return None
+
+
 def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine: bool, layout: Layout,
               threads: SupportsIndex | None, check: bool, isa: str | None,
               outputs_for_shape: Callable[[tuple[int, ...], str], list[Float32Array]], pdf_sampler: int | None = None,
@@ -305,46 +350,59 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     wi_dirs = _Directions("wi", wi, layout)
     wo_dirs = _Directions("wo", wo, layout)
     leading = broadcast_leading(wi=wi_dirs.leading, wo=wo_dirs.leading, material=material.shape)
-    params = _params(material, leading)
     outputs = outputs_for_shape(leading, layout)
-    n = _size(leading)
-    wi_flat, wi_code = wi_dirs.flat(leading)
-    wo_flat, wo_code = wo_dirs.flat(leading)
-    for output in outputs:
-        _require_no_partial_overlap(output, {"wi": wi_flat, "wo": wo_flat})
     # The check rides along with the evaluation (docs/bad-input.md): on a bad
     # direction the call raises, and an out= buffer may hold partial results.
     tolerance = DIRECTION_LENGTH_TOLERANCE if check else 0.0
     out_layout = _INTERLEAVED if layout == "aos" else _ROWS
-    value: Float32Array | None  # f: the output (gradient), or eval_pdf's optional one
-    if gradient:
-        value, jacobian = outputs
-        width = len(GRADIENT_NAMES)
-        options = _core.EvalOptions(model=model_id, cosine=cosine, check_tolerance=tolerance, threads=thread_count,
-                                    isa=isa_name)
-        bad = _core.batch_eval_grad(
+    options = _core.EvalOptions(model=model_id, cosine=cosine, energy_compensation=energy_compensation and not gradient,
+                                check_tolerance=tolerance, threads=thread_count, isa=isa_name)
+    pdf_options = _core.PdfOptions(model=model_id, sampler=pdf_sampler or 0, cosine=cosine,
+                                   energy_compensation=energy_compensation, check_tolerance=tolerance,
+                                   threads=thread_count, isa=isa_name)
+
+    def run(wi_flat: Float32Array, wi_code: int, wo_flat: Float32Array, wo_code: int,
+            params: list[float | tuple[float, ...] | Float32Array], segment: list[Float32Array], n: int) -> int:
+        """One kernel call over ``n`` elements; the first element it rejects, or -1."""
+        if gradient:
+            value, jacobian = segment
+            width = len(GRADIENT_NAMES)
+            return int(_core.batch_eval_grad(
+                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+                out=_flat_vec3(value, layout)[0],
+                jacobian=jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)),
+                out_layout=out_layout, n=n, options=options))
+        if pdf_sampler is not None:
+            f = _flat_vec3(segment[1], layout)[0] if len(segment) == 2 else None  # eval_pdf: f in the same pass
+            return int(_core.batch_pdf(
+                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+                pdf=segment[0].reshape(n), out=f, out_layout=out_layout, n=n, options=pdf_options))
+        return int(_core.batch_eval(
             wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-            out=_flat_vec3(value, layout)[0],
-            jacobian=jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)),
-            out_layout=out_layout, n=n, options=options,
-        )
-    elif pdf_sampler is not None:
-        value = _flat_vec3(outputs[1], layout)[0] if len(outputs) == 2 else None  # eval_pdf: f in the same pass
-        pdf_options = _core.PdfOptions(model=model_id, sampler=pdf_sampler, cosine=cosine,
-                                       energy_compensation=energy_compensation, check_tolerance=tolerance,
-                                       threads=thread_count, isa=isa_name)
-        bad = _core.batch_pdf(
-            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-            pdf=outputs[0].reshape(n), out=value, out_layout=out_layout, n=n, options=pdf_options,
-        )
+            outputs=[_flat_vec3(o, layout)[0] for o in segment], lobes=len(segment) == len(LOBE_NAMES),
+            out_layout=out_layout, n=n, options=options))
+
+    split = _segment_split(leading, material.shape, wi_dirs.leading, wo_dirs.leading) if layout == "aos" else None
+    if split is None:
+        wi_flat, wi_code = wi_dirs.flat(leading)
+        wo_flat, wo_code = wo_dirs.flat(leading)
+        for output in outputs:
+            _require_no_partial_overlap(output, {"wi": wi_flat, "wo": wo_flat})
+        bad = run(wi_flat, wi_code, wo_flat, wo_code, _params(material, leading), outputs, _size(leading))
     else:
-        options = _core.EvalOptions(model=model_id, cosine=cosine, energy_compensation=energy_compensation,
-                                    check_tolerance=tolerance, threads=thread_count, isa=isa_name)
-        bad = _core.batch_eval(
-            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-            outputs=[_flat_vec3(o, layout)[0] for o in outputs], lobes=len(outputs) == len(LOBE_NAMES),
-            out_layout=out_layout, n=n, options=options,
-        )
+        for output in outputs:
+            _require_no_partial_overlap(output, {"wi": wi_dirs.array, "wo": wo_dirs.array})
+        inner = leading[split:]
+        params = _params(material, inner)
+        inner_n = _size(inner)
+        bad = -1
+        for segment_index, outer in enumerate(np.ndindex(leading[:split])):
+            wi_flat, wi_code = wi_dirs.segment(outer, inner)
+            wo_flat, wo_code = wo_dirs.segment(outer, inner)
+            local = run(wi_flat, wi_code, wo_flat, wo_code, params, [output[outer] for output in outputs], inner_n)
+            if local >= 0:
+                bad = segment_index * inner_n + local
+                break
     if bad >= 0:
         raise _direction_error(bad, leading, wi_dirs, wo_dirs)
     return outputs
