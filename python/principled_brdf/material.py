@@ -45,6 +45,9 @@ class Material:
     leading shape; ``base_color`` is linear RGB, shape ``(3,)`` or ``(..., 3)``.
     Values are checked on construction: out of domain, NaN or infinite values
     raise ``ValueError`` naming the parameter and the first bad element.
+    ``ior=`` (keyword, instead of ``specular``) sets ``specular`` from an index of
+    refraction (:func:`specular_of_ior`); :attr:`ior` reads it back. It is not a
+    second stored parameter.
     """
 
     __slots__ = tuple(PARAMETERS) + ("_shape", "_float32_cache", "_kernel_numbers")
@@ -81,8 +84,13 @@ class Material:
         clearcoat: RealArrayLike = PARAMETERS["clearcoat"].default,
         clearcoat_gloss: RealArrayLike = PARAMETERS["clearcoat_gloss"].default,
         *,
+        ior: RealArrayLike | None = None,
         bright_base_color: bool = False,
     ) -> None:
+        if ior is not None:
+            if specular is not PARAMETERS["specular"].default:
+                raise ValueError("ior: give specular or ior, not both (ior sets specular)")
+            specular = specular_of_ior(ior)
         values = dict(locals())
         for name, info in PARAMETERS.items():
             if name == "base_color" and isinstance(values[name], np.ndarray) and values[name].dtype == np.uint8:
@@ -116,6 +124,14 @@ class Material:
         return self._shape
 
     @property
+    def ior(self) -> Float64Array:
+        """The index of refraction that ``specular`` stands for, ``η = 2 / (1 - sqrt(0.08 specular)) - 1``
+        (``((η - 1)/(η + 1))² = 0.08 specular``: 0.5 is 1.5); +inf from ``specular`` 12.5 on."""
+        root = np.sqrt(0.08 * self.specular)
+        with np.errstate(divide="ignore"):
+            return np.where(root < 1.0, 2.0 / (1.0 - np.minimum(root, 1.0)) - 1.0, np.inf)
+
+    @property
     def is_uniform(self) -> bool:
         return self.shape == ()
 
@@ -124,7 +140,11 @@ class Material:
         return array.shape[:-1] if PARAMETERS[name].slots == 3 else array.shape
 
     def replace(self, **changes: RealArrayLike) -> Material:
-        """A copy with some parameters changed."""
+        """A copy with some parameters changed (``ior=`` changes ``specular``)."""
+        if "ior" in changes:
+            if "specular" in changes:
+                raise ValueError("ior: give specular or ior, not both (ior sets specular)")
+            changes["specular"] = specular_of_ior(changes.pop("ior"))
         unknown = set(changes) - set(PARAMETERS)
         if unknown:
             raise TypeError(f"unknown parameter(s): {', '.join(sorted(unknown))}")
@@ -239,6 +259,13 @@ def _require_material(name: str, value: object) -> Material:
 
 def _rebuilt(*values: RealArrayLike) -> Material:
     return Material(*values, bright_base_color=True)
+
+
+def specular_of_ior(ior: RealArrayLike) -> Float64Array:
+    """``specular`` for an index of refraction η >= 1: ``((η - 1)/(η + 1))² / 0.08`` (1.5 gives 0.5)."""
+    eta = as_real_array("ior", ior)
+    require_in_domain("ior", eta, 1.0, np.inf)
+    return ((eta - 1.0) / (eta + 1.0)) ** 2 / 0.08
 
 
 class BrightColorWarning(UserWarning):
