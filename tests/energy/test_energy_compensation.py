@@ -30,7 +30,7 @@ import chi_square as cs
 import numpy_model
 from conftest import MODELS, random_direction_pairs, random_material_arrays, seeded_rng
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 import energy_tables  # noqa: E402  (the generator: its quadrature of the specular albedo)
 

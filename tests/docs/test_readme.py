@@ -6,9 +6,9 @@ import pathlib
 
 import numpy as np
 
-from test_docs import page_sandbox, python_blocks, run_blocks  # noqa: F401 - page_sandbox is a fixture
+from test_pages_run_and_links_resolve import page_sandbox, python_blocks, run_blocks  # noqa: F401 - page_sandbox is a fixture
 
-README = pathlib.Path(__file__).resolve().parent.parent / "README.md"
+README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
 
 
 def test_there_are_python_blocks():

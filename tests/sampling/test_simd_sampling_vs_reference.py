@@ -9,7 +9,7 @@ import pytest
 import chi_square as cs
 import principled_brdf as pb
 from conftest import random_direction_pairs, random_directions, random_material_arrays, seeded_rng
-from test_reference_sampling import MATERIALS, VIEW_ANGLES, mirror, peak_width, view
+from test_reference_sampler import MATERIALS, VIEW_ANGLES, mirror, peak_width, view
 
 ISAS = pb.cpu_info()["available"]
 N = 1_000_000
