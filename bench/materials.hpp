@@ -1,6 +1,7 @@
 // The benchmark's material set: the benchmark material (every lobe on), the
-// ten presets of python/principled_brdf/presets.py (tests/test_bench_materials.py
-// keeps the two in step), each a uniform material in params.hpp's slot order
+// ten presets of python/principled_brdf/presets.py
+// (tests/repository/test_bench_materials_are_the_presets.py keeps the two in
+// step), each a uniform material in params.hpp's slot order
 // with the defaults elsewhere; random per-element materials are made in
 // bench_eval.cpp.
 #pragma once

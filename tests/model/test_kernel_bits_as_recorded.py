@@ -12,8 +12,8 @@ import pytest
 
 import principled_brdf as pb
 
-ROOT = Path(__file__).resolve().parents[1]
-RECORDED = json.loads((Path(__file__).parent / "kernel_bits.json").read_text())
+ROOT = Path(__file__).resolve().parents[2]
+RECORDED = json.loads((Path(__file__).resolve().parents[1] / "kernel_bits.json").read_text())
 
 
 def kernel_bits_module():

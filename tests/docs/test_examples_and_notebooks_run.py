@@ -30,7 +30,7 @@ import pytest
 
 import principled_brdf as pb
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 NOTEBOOKS = ("tour.ipynb", "validation.ipynb", "fitting.ipynb")
 CELL_TIMEOUT = 300  # seconds per cell
 MAX_NOTEBOOK_BYTES = 1_500_000  # stored with outputs: figures at dpi 80-100 stay well below

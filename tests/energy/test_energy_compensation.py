@@ -10,7 +10,8 @@
   anisotropic materials' error (r_eff = (ax ay)^(1/4)) held at its known size;
 - reciprocity, no φ dependence, the F_avg tint, and f_ms -> 0 as r -> 0;
 - SIMD against the float64 reference with the accuracy bounds of
-  tests/test_simd_accuracy.py, on every instruction set here;
+  tests/model/test_simd_accuracy_vs_float64.py, on every instruction set
+  here;
 - pdf and sample with the option: pdf integrates to 1, the sampler passes a
   chi-square test against pdf (tests/chi_square.py), weights are f cos / pdf;
 - off: the same bits as without the keyword.
@@ -30,7 +31,7 @@ import chi_square as cs
 import numpy_model
 from conftest import MODELS, random_direction_pairs, random_material_arrays, seeded_rng
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 import energy_tables  # noqa: E402  (the generator: its quadrature of the specular albedo)
 

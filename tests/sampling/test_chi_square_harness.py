@@ -2,7 +2,8 @@
 it accepts correct samplers and rejects samplers with small known errors.
 
 Samplers and densities come from the float64 toolkit ``pb.microfacet`` (tested
-on its own in test_microfacet.py) and from closed forms written here.
+on its own in tests/microfacet/test_ggx_beckmann_gtr.py) and from closed forms
+written here.
 """
 
 from __future__ import annotations

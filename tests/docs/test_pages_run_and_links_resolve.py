@@ -18,9 +18,10 @@ import pathlib
 import re
 import tempfile
 
+import numpy as np
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 EXAMPLES = ROOT / "examples"
 PAGES = sorted(DOCS.glob("*.md"))
@@ -152,3 +153,26 @@ def test_every_page_is_listed_in_the_index_and_the_readme():
         if page.name != "index.md":
             assert f"({page.name}" in index, f"docs/index.md does not list {page.name}"
             assert f"(docs/{page.name}" in readme, f"README.md does not link {page.name}"
+
+
+# ---------------------------------------------------------------------------------------------
+# The README: its blocks run the same way, and a few of the numbers its tour shows are
+# checked on every instruction set.
+
+README = ROOT / "README.md"
+
+
+def test_the_readme_has_python_blocks():
+    assert len(python_blocks(README)) >= 1
+
+
+def test_every_readme_python_block_runs_as_written(page_sandbox):
+    namespace = run_blocks(python_blocks(README), "README.md")
+    import principled_brdf as pb
+
+    # what the tour shows, rounded so that every instruction set prints it
+    m, wi, wo = namespace["m"], namespace["wi"], namespace["wo"]
+    np.testing.assert_array_equal(np.round(pb.eval(m, wi, wo), 4), np.float32([[0.0896, 0.0598, 0.0199]]))
+    for isa in pb.cpu_info()["available"]:
+        np.testing.assert_allclose(pb.eval(m, wi, wo, isa=isa), [[0.0896414, 0.05976094, 0.01992031]], rtol=1e-6)
+    assert set(pb.cpu_info()) == {"isa", "float_lanes", "available", "threads"}

@@ -8,7 +8,7 @@ and wi = wo pairs), so 200 examples cover ~10^4 triples per property.
 Where a property compares two float64 evaluations of the same quantity the
 tolerance is 1e-12 relative (symmetrically, against max(|a|, |b|)), plus the
 float64 conditioning of Schlick(cos θd) = (1 - cos θd)^5 near cos θd = 1 (see
-``conftest.schlick_tolerance`` and test_reference.py).
+``conftest.schlick_tolerance`` and tests/model/test_reference_vs_numpy_model.py).
 """
 
 from __future__ import annotations

@@ -28,7 +28,7 @@ import pytest
 
 import principled_brdf as pb
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DIST = ROOT / "dist"
 RAW = ROOT / "build" / "wheel-raw"  # scripts/build-wheel.sh's wheel before auditwheel
 PY_TAG = f"cp{sys.version_info.major}{sys.version_info.minor}"

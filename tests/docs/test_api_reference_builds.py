@@ -11,7 +11,7 @@ import types
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 # The modules the reference documents: the package's top level and its public submodules.
 MODULES = ["principled_brdf", "principled_brdf.reference", "principled_brdf.microfacet", "principled_brdf.frames",
            "principled_brdf.measured", "principled_brdf.presets", "principled_brdf.render", "principled_brdf.plot",

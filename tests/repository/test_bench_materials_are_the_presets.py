@@ -10,7 +10,7 @@ import numpy as np
 
 import principled_brdf as pb
 
-TABLE = pathlib.Path(__file__).resolve().parent.parent / "bench" / "materials.hpp"
+TABLE = pathlib.Path(__file__).resolve().parents[2] / "bench" / "materials.hpp"
 SLOT_ORDER = ("base_color", "metallic", "subsurface", "specular", "specular_tint", "roughness", "anisotropic",
               "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss")
 
