@@ -347,3 +347,13 @@ def model(request) -> str:
 @pytest.fixture
 def default_material() -> pb.Material:
     return pb.Material()
+
+
+# The tests a run selected (after -k and -m), for fixtures that run the heavy
+# cases of a module together before its tests read their results.
+SELECTED_TESTS = pytest.StashKey[list]()
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    config.stash[SELECTED_TESTS] = items

@@ -3,7 +3,7 @@ solid model ``disney2015`` and the thin sheet ``disney2015_thin`` as the
 repository's docs state them (docs/model-2015.md), written from the equations
 in numpy and never from the C++ code. The library's float64 reference and its
 kernels are held to it; its own properties (reciprocity, the energy bound,
-the limits) are checked in tests/test_numpy_model_2015.py.
+the limits) are checked in tests/model/test_numpy_model_2015_properties.py.
 
 Conventions: local frame, n = (0, 0, 1); wi towards the light, wo towards the
 viewer, both unit, anywhere on the sphere; the outside is the side of n (index

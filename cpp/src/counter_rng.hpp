@@ -11,7 +11,7 @@
 // apart. The counter is spread by the golden-ratio multiplier (a Weyl
 // sequence) before the hash: lowbias32 of plain consecutive counters fails a
 // 256-bin uniformity test at 2^20 values, this passes it and the 2-D and 3-D
-// tests of tests/test_simd_sampling.py. The key depends only on the seed and
+// tests of tests/sampling/test_simd_sampler.py. The key depends only on the seed and
 // the high half of the index, so for a batch of lanes it is one scalar, and
 // so is the first lane's spread counter (the others add a constant); a lane
 // costs one hash (two multiplies) per uniform.

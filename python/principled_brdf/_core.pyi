@@ -9,7 +9,7 @@ packed arguments the Python side has already checked: directions as float32
 keyword, their scalar options as one EvalOptions, PdfOptions or
 SampleOptions; they write into the float32 arrays they are given and return
 -1, or the index of an element whose direction failed the check.
-tests/test_typing.py keeps these in step with the module's own signatures.
+tests/api/test_stubs_and_mypy.py keeps these in step with the module's own signatures.
 """
 
 from collections.abc import Sequence

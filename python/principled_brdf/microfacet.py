@@ -551,7 +551,7 @@ class GGX(_Anisotropic):
         within 18.5% of the exact G1, but its separable V falls up to 82% below the
         height-correlated one (both directions grazing, α = 1); Hammon's V is within 27.6%
         (grazing directions at α = 0.05), within 1.3% at α = 0.95
-        (``tests/test_microfacet_family.py`` asserts these).
+        (``tests/microfacet/test_distribution_family.py`` asserts these).
 
         Parameters
         ----------
@@ -891,7 +891,7 @@ class BlinnPhong(_Anisotropic):
         An approximation, good for smooth surfaces only: against the Smith G1 of Blinn-Phong's
         own D, G1 is off by 2e-5 at α = 0.05, 2e-2 at 0.3, 0.13 at 0.6 and 0.64 at 1 (85°
         views), and the weak white furnace misses 1 by 3e-4, 3e-2, 0.15 and 0.73 (88° views;
-        checked in ``tests/test_microfacet_family.py``). 0 at the normal, +inf at exactly grazing.
+        checked in ``tests/microfacet/test_distribution_family.py``). 0 at the normal, +inf at exactly grazing.
 
         Parameters
         ----------

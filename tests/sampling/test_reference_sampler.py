@@ -30,6 +30,7 @@ import chi_square as cs
 import principled_brdf as pb
 from conftest import (
     MODELS,
+    SELECTED_TESTS,
     assert_relative_close,
     below_horizon_directions,
     corner_materials,
@@ -532,7 +533,7 @@ def heavy_results(request):
     """Runs every selected case of the statistical tests once, on a thread pool (the C++ loops
     and most numpy work release the GIL), and hands each test its own result."""
     jobs = {}
-    for item in request.session.items:
+    for item in request.config.stash[SELECTED_TESTS]:
         entry = HEAVY_TESTS.get(getattr(item, "originalname", None))
         if entry is not None and item.module is request.module:
             identify, runner = entry

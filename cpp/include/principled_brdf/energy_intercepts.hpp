@@ -6,7 +6,7 @@
 // μ |s|), not 2^-24 |1 - E|, which is small where the line cancels. A row may
 // be read so if on every interval |v0| + μ_b+1 |s| is within 16 times the
 // line's smaller end value (both positive), as every row of the 2014 model's
-// table is (tests/test_energy_compensation.py), whose uniform materials'
+// table is (tests/energy/test_energy_compensation.py), whose uniform materials'
 // kernels read them (kernel_material.hpp). A blend of two such rows is then
 // within 16 too (each of its terms is a mean of the rows' with the same
 // weights), and a lookup of it, from v0 and s rounded once more, within
