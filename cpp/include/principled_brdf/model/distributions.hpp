@@ -57,11 +57,15 @@ struct Ggx {
         return d;
     }
 
-    // D(h), h = H/|H|: norm |H|⁴ / (Hx²/ax² + Hy²/ay² + Hz²)²
+    // D(h), h = H/|H|, read from the unnormalised H: with
+    // (h·x / ax)² + (h·y / ay)² + (h·n)² = (Hx²/ax² + Hy²/ay² + Hz²) / |H|²,
+    // D = norm (|H|² / (Hx²/ax² + Hy²/ay² + Hz²))². H is never normalised (no
+    // square root or division per component), and its squares keep full
+    // precision at narrow peaks, where 1 - (h·n)² would cancel.
     PB_MODEL_INLINE F d(const HalfVector<F>& h) const {
-        F stretched = mul_add(h.hx2, inv_alpha_x2, mul_add(h.hy2, inv_alpha_y2, h.hz2));
-        F root = h.h_len2 / stretched;
-        return norm * root * root;
+        F stretched_h_len2 = mul_add(h.hx2, inv_alpha_x2, mul_add(h.hy2, inv_alpha_y2, h.hz2));  // Hx²/ax² + Hy²/ay² + Hz²
+        F inv_stretched_unit = h.h_len2 / stretched_h_len2;  // 1 / ((h·x / ax)² + (h·y / ay)² + (h·n)²)
+        return norm * inv_stretched_unit * inv_stretched_unit;
     }
 
     // (w·x ax)² + (w·y ay)² + (n·w)²: the squared length of w stretched to alpha 1

@@ -64,6 +64,7 @@ struct DiffuseLobe {
     PB_MODEL_INLINE F value(const Geometry<F>& g, const Fresnel<F>& fresnel) const {
         F one(1.0);
         F cos2_theta_d = F(0.25) * g.h_len2;
+        // mix(1, F90, FL) as 1 + (F90 - 1) FL, one rounding
         F fd90_minus_1 = mul_add(F(2.0) * roughness, cos2_theta_d, F(-0.5));
         F fd = mul_add(fd90_minus_1, fresnel.fl, one) * mul_add(fd90_minus_1, fresnel.fv, one);
         // Skipped when 0 in every lane: for a uniform material the test has the
@@ -108,9 +109,13 @@ struct SheenLobe {
     Rgb<F> color;  // sheen Csheen (1 - metallic); the lobe is FH times it
 };
 
-// The primary specular Gs Fs Ds: anisotropic GGX, Fs = mix(Cspec0, 1, FH), and
-// Gs = S(wi) S(wo) with S(w) = G1(w) / (2 n·w): anisotropic Smith in the 2014
-// model, isotropic Smith with alpha_g = (0.5 + roughness / 2)² in the 2012 one.
+// The primary specular, the microfacet BRDF D F G / (4 cos θl cos θv) with
+//   D = Ds, anisotropic GGX,
+//   F = Fs = mix(Cspec0, 1, FH), per channel (applied by LobeValues),
+//   G = G1(wi) G1(wo), separable Smith: anisotropic in the 2014 model,
+//       isotropic with alpha_g = (0.5 + roughness / 2)² in the 2012 one.
+// value() is its scalar factor D G / (4 cos θl cos θv) = Ds Gs (docs/model.md's
+// Gs = S(wi) S(wo), S(w) = G1(w) / (2 n·w)).
 template <class F>
 struct SpecularLobe {
     Rgb<F> f0;        // Cspec0
@@ -118,16 +123,21 @@ struct SpecularLobe {
     Ggx<F> ggx;
     F alpha_g2;       // alpha_g² of the 2012 model's Smith term
 
-    // Gs Ds, the scalar factor of Fs, given the Smith denominator of wo
+    // D G / (4 cos θl cos θv), the scalar factor of Fs, given the Smith denominator of wo.
+    // G / (4 cos θl cos θv) is taken as 1 / (smith_denominator(wi) smith_denominator(wo)):
+    // each G1(w) = 2 n·w / smith_denominator(w) brings the 2 n·w that the
+    // 1/(4 cos θl cos θv) divides out, so neither G1 nor the cosines' product is
+    // formed (no 0/0 at grazing angles), and D over the product is one rounded quotient.
     template <Model model>
     PB_MODEL_INLINE F value(const Geometry<F>& g, F smith_wo) const {
-        F denominator;
+        F four_cos_cos_over_g;  // 4 cos θl cos θv / G
         if constexpr (model == Model::kDisney2012) {
-            denominator = smith_denominator_iso(g.wi, alpha_g2) * smith_wo;
+            four_cos_cos_over_g = smith_denominator_iso(g.wi, alpha_g2) * smith_wo;
         } else {
-            denominator = ggx.smith_denominator(g.wi) * smith_wo;
+            four_cos_cos_over_g = ggx.smith_denominator(g.wi) * smith_wo;
         }
-        return ggx.d(g) / denominator;
+        F d = ggx.d(g);
+        return d / four_cos_cos_over_g;
     }
 
     // w1 = max(lum(mix(Cspec0, 1, FV)), 0.02)
@@ -157,37 +167,42 @@ struct SpecularLobe {
     }
 };
 
-// Clearcoat 0.25 clearcoat Gr Fr Dr: GTR1 with ac = mix(0.1, 0.001, clearcoat_gloss),
-// Fr = mix(0.04, 1, FH), Gr = Siso(wi, 0.25) Siso(wo, 0.25).
+// Clearcoat, 0.25 clearcoat times the microfacet BRDF D F G / (4 cos θl cos θv) with
+//   D = Dr, GTR1 with ac = mix(0.1, 0.001, clearcoat_gloss),
+//   F = Fr = mix(0.04, 1, FH),
+//   G = Gr, separable isotropic Smith GGX at alpha 0.25,
+// G / (4 cos θl cos θv) taken from the Smith denominators as the specular's.
 template <class F>
 struct ClearcoatLobe {
     Gtr1<F> gtr1;
-    F scale;        // 0.25 clearcoat (ac² - 1) / (π ln ac²)
+    F scale;        // 0.25 clearcoat (ac² - 1) / (π ln ac²): the lobe's strength times D's normaliser
     F lobe_weight;  // 0.25 clearcoat
 
     static constexpr double kSmithAlpha2 = 0.0625;  // Gr's alpha 0.25, squared
 
     PB_MODEL_INLINE bool absent() const { return !any(scale != F(0.0)); }
 
-    // the Smith denominator of wo at alpha 0.25 (1 when no lane has a clearcoat)
+    // the Smith denominator n·w + sqrt(...) = 2 n·w / G1(w) of wo at alpha 0.25 (1 when no lane has a clearcoat)
     PB_MODEL_INLINE F smith_wo(const Vec3<F>& wo) const {
         return absent() ? F(1.0) : smith_denominator_iso_small(wo.z, F(kSmithAlpha2));
     }
 
-    // the grey value (0 in every lane without a clearcoat)
+    // 0.25 clearcoat D F G / (4 cos θl cos θv), grey (0 in every lane without a clearcoat):
+    // with D = norm |H|² / gtr1.denominator (Gtr1::d), one quotient
+    // (0.25 clearcoat norm) F |H|² / (gtr1.denominator (4 cos θl cos θv / G))
     PB_MODEL_INLINE F value(const Geometry<F>& g, F fh, F smith_wo) const {
         if (absent()) return F(0.0);
-        F fr = mul_add(F(0.96), fh, F(0.04));
-        F denominator = smith_denominator_iso_small(g.wi.z, F(kSmithAlpha2)) * smith_wo;
-        return scale * fr * g.h_len2 / (gtr1.denominator(g) * denominator);
+        F f = mul_add(F(0.96), fh, F(0.04));  // F = mix(0.04, 1, FH)
+        F four_cos_cos_over_g = smith_denominator_iso_small(g.wi.z, F(kSmithAlpha2)) * smith_wo;  // 4 cos θl cos θv / G
+        return scale * f * g.h_len2 / (gtr1.denominator(g) * four_cos_cos_over_g);
     }
 
-    // the value per unit clearcoat, 0.25 Gr Fr Dr, computed whether or not the lobe is present
+    // the value per unit clearcoat, 0.25 D F G / (4 cos θl cos θv), computed whether or not the lobe is present
     PB_MODEL_INLINE F unit_value(const Geometry<F>& g, F fh) const {
-        F fr = mul_add(F(0.96), fh, F(0.04));
+        F f = mul_add(F(0.96), fh, F(0.04));  // F = mix(0.04, 1, FH)
         F alpha2 = F(kSmithAlpha2);
-        F denominator = smith_denominator_iso_small(g.wi.z, alpha2) * smith_denominator_iso_small(g.wo.z, alpha2);
-        return F(0.25) * gtr1.norm * fr * g.h_len2 / (gtr1.denominator(g) * denominator);
+        F four_cos_cos_over_g = smith_denominator_iso_small(g.wi.z, alpha2) * smith_denominator_iso_small(g.wo.z, alpha2);
+        return F(0.25) * gtr1.norm * f * g.h_len2 / (gtr1.denominator(g) * four_cos_cos_over_g);
     }
 
     // w2 = 0.25 clearcoat mix(0.04, 1, FV)

@@ -95,33 +95,39 @@ PB_MODEL_INLINE View<F> view_of(const Vec3<F>& wo, const Shading<F>& s) {
 }
 
 // The lobes as scalar factors of the material's colors:
-//   diffuse   = D  base_color (1 - metallic) / π     (s.diffuse.color)
-//   sheen     = FH sheen Csheen (1 - metallic)       (s.sheen.color)
-//   specular  = S  mix(Cspec0, 1, FH),  S = Gs Ds
-//   clearcoat = C  (grey)
+//   diffuse   = diffuse  base_color (1 - metallic) / π   (s.diffuse.color)
+//   sheen     = FH  sheen Csheen (1 - metallic)         (s.sheen.color)
+//   specular  = specular  Fs,  specular = Ds Gs = D G / (4 cos θl cos θv),  Fs = mix(Cspec0, 1, FH)
+//   clearcoat = clearcoat  (grey)
 template <class F>
 struct LobeValues {
     F diffuse, fh, specular, clearcoat;
 
     Rgb<F> diffuse_rgb(const Shading<F>& s) const { return diffuse * s.diffuse.color; }
     Rgb<F> sheen_rgb(const Shading<F>& s) const { return fh * s.sheen.color; }
-    Rgb<F> specular_rgb(const Shading<F>& s) const { return specular * mix(s.specular.f0, Rgb<F>{F(1.0), F(1.0), F(1.0)}, fh); }
+    Rgb<F> specular_rgb(const Shading<F>& s) const { return specular * mix(s.specular.f0, Rgb<F>{F(1.0), F(1.0), F(1.0)}, fh); }  // Ds Gs Fs
     Rgb<F> clearcoat_rgb() const { return {clearcoat, clearcoat, clearcoat}; }
 
-    // f per channel: D dc + FH sc + S (1 - FH) Cspec0 + (S FH + C), three FMAs a channel
-    // (fewer for a LobeSet without the diffuse or the sheen: their terms are 0)
+    // f = diffuse + sheen + specular + clearcoat per channel, summed from the
+    // clearcoat up with each lobe's product fused into the sum: three FMAs a
+    // channel (fewer for a LobeSet without the diffuse or the sheen: their
+    // terms are 0). The specular's Fresnel mix(Cspec0, 1, FH) is expanded as
+    // (1 - FH) Cspec0 + FH, so that its grey half, specular FH, joins the
+    // clearcoat once for the three channels and the tinted half is one FMA a
+    // channel: specular + clearcoat = (specular (1 - FH)) Cspec0 + (specular FH + clearcoat).
     template <LobeSet lobes = LobeSet::kAll>
     Rgb<F> total(const Shading<F>& s) const {
-        F specular_tinted = specular * (F(1.0) - fh);
-        F grey = lobes == LobeSet::kAll ? mul_add(specular, fh, clearcoat) : specular * fh;
-        auto channel = [&](F dc, F sc, F f0) {
-            F specular_part = mul_add(specular_tinted, f0, grey);
+        F specular_of_cspec0 = specular * (F(1.0) - fh);  // specular (1 - FH), Cspec0's factor
+        F specular_grey_and_clearcoat = lobes == LobeSet::kAll ? mul_add(specular, fh, clearcoat) : specular * fh;
+        auto channel = [&](F diffuse_color, F sheen_color, F cspec0) {
+            F specular_and_clearcoat = mul_add(specular_of_cspec0, cspec0, specular_grey_and_clearcoat);
             if constexpr (lobes == LobeSet::kSpecular) {
-                return specular_part;
+                return specular_and_clearcoat;
             } else if constexpr (lobes == LobeSet::kPlain) {
-                return mul_add(diffuse, dc, specular_part);
+                return mul_add(diffuse, diffuse_color, specular_and_clearcoat);
             } else {
-                return mul_add(diffuse, dc, mul_add(fh, sc, specular_part));
+                F sheen_specular_and_clearcoat = mul_add(fh, sheen_color, specular_and_clearcoat);
+                return mul_add(diffuse, diffuse_color, sheen_specular_and_clearcoat);
             }
         };
         return {channel(s.diffuse.color.r, s.sheen.color.r, s.specular.f0.r),
