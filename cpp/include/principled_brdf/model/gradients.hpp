@@ -20,7 +20,7 @@
 #pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 template <class F>
-PB_MODEL_INLINE F channel_of(const Rgb<F>& colour, int c) { return c == 0 ? colour.r : c == 1 ? colour.g : colour.b; }
+PB_MODEL_INLINE F channel_of(const Rgb<F>& color, int c) { return c == 0 ? color.r : c == 1 ? color.g : color.b; }
 
 // The material's constants of the Jacobian: its colors' non-zero partials and
 // the partials of the roughnesses the lobes read.
