@@ -219,22 +219,28 @@ def assert_matches_reference(actual, expected, wi, wo):
     assert error.max(initial=0.0) <= 1e-3, error.max()
 
 
+def draw_pair_call(data, leading, seed, option_names):
+    """(options, layout, wi, wo, material) of a call on pairs, or None when the material was refused."""
+    rng = rng_from(seed)
+    opts = data.draw(options(option_names))
+    layout = opts.get("layout", "aos")
+    wi = soa(data.draw(direction_argument(leading, rng)), layout)
+    wo = soa(data.draw(direction_argument(leading, rng)), layout)
+    material = outcome(lambda: pb.Material(**data.draw(material_argument(int(np.prod(leading)), rng))))
+    return None if material is None else (opts, layout, wi, wo, material)
+
+
 # ------------------------------------------------------------------ the batched calls
 
 @FUZZ
 @given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1),
        entry=st.sampled_from(("eval", "eval_out", "eval_lobes", "pdf", "eval_grad")))
 def test_fuzz_evaluation(data, leading, seed, entry):
-    rng = rng_from(seed)
-    n = int(np.prod(leading))
-    opts = data.draw(options(["model", "threads", "check", "cosine", "isa", "layout"] if entry != "pdf"
-                             else ["threads", "check", "isa", "layout", "specular_sampler"]))
-    layout = opts.get("layout", "aos")
-    wi = soa(data.draw(direction_argument(leading, rng)), layout)
-    wo = soa(data.draw(direction_argument(leading, rng)), layout)
-    material = outcome(lambda: pb.Material(**data.draw(material_argument(n, rng))))
-    if material is None:
+    drawn = draw_pair_call(data, leading, seed, ["model", "threads", "check", "cosine", "isa", "layout"]
+                           if entry != "pdf" else ["threads", "check", "isa", "layout", "specular_sampler"])
+    if drawn is None:
         return
+    opts, layout, wi, wo, material = drawn
     out = None
     if entry == "eval_out":
         out_kind = data.draw(st.sampled_from(("fresh", "fresh", "alias_wi", "shifted", "misaligned", "float64",
@@ -473,15 +479,10 @@ def test_fuzz_sees_every_isa(isa):
        entry=st.sampled_from(("eval_pdf", "eval_pdf_out", "eval_grad_wrt", "eval_grad_out", "sample_n",
                               "compensated_eval", "compensated_sample")))
 def test_fuzz_paired_outputs_counts_and_compensation(data, leading, seed, entry):
-    rng = rng_from(seed)
-    n = int(np.prod(leading))
-    opts = data.draw(options(["model", "threads", "check", "isa", "layout"]))
-    layout = opts.get("layout", "aos")
-    wi = soa(data.draw(direction_argument(leading, rng)), layout)
-    wo = soa(data.draw(direction_argument(leading, rng)), layout)
-    material = outcome(lambda: pb.Material(**data.draw(material_argument(n, rng))))
-    if material is None:
+    drawn = draw_pair_call(data, leading, seed, ["model", "threads", "check", "isa", "layout"])
+    if drawn is None:
         return
+    opts, layout, wi, wo, material = drawn
     value_shape = tuple(leading) + (3,) if layout == "aos" else (3,) + tuple(leading)
     wrt = data.draw(st.sampled_from((None, "roughness", ["base_color", "sheen"], [], "albedo", ["metallic", 3])))
     width = len(pb._gradient.columns(wrt)) if outcome(lambda: pb._gradient.columns(wrt)) is not None else 13
