@@ -272,13 +272,15 @@ class _Distribution:
 
 
 class _Anisotropic(_Distribution):
-    """The families of roughness ``alpha_x``, ``alpha_y``: checks, properties and calls of the bindings."""
+    """The families of roughness ``alpha_x``, ``alpha_y``: checks, properties and the methods they
+    share, each calling the binding ``_core.microfacet.<_FAMILY>_<quantity>``."""
 
     __slots__ = ("_alpha_x", "_alpha_y", "_isotropic")
     _alpha_x: Float64Array
     _alpha_y: Float64Array
     _isotropic: bool
     _UPPER: typing.ClassVar[float] = np.inf  # the alphas' domain is (0, _UPPER]
+    _FAMILY: typing.ClassVar[str]  # the prefix of the family's bindings in _core.microfacet
 
     def __init__(self, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None) -> None:
         ax = _positive("alpha_x", alpha_x, self._UPPER)
@@ -311,6 +313,16 @@ class _Anisotropic(_Distribution):
         """The shape argument of the family's bindings (none for GGX and Beckmann)."""
         return {}
 
+    def _binding(self, quantity: str) -> _Core:
+        """The family's binding of ``quantity``."""
+        core_function: _Core = getattr(_core_mf, f"{self._FAMILY}_{quantity}")
+        return core_function
+
+    def _smith(self, quantity: str) -> tuple[_Core, dict[str, Float64Array] | None]:
+        """The binding of a quantity of the Smith Λ in use, and its shape argument (``None``:
+        the family's own)."""
+        return self._binding(quantity), None
+
     def _call(self, core_function: _Core, directions: dict[str, RealArrayLike],
               uniforms: dict[str, RealArrayLike] | None = None, *, shape: dict[str, Float64Array] | None = None,
               flags: tuple[int, ...] = (), returns_vector: bool = False) -> Float64Array:
@@ -324,22 +336,153 @@ class _Anisotropic(_Distribution):
         arguments.update(self._shape_argument() if shape is None else shape)
         return _run(core_function, *flags, returns_vector=returns_vector, **arguments)
 
-    def _sample(self, core_function: _Core, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
-        return self._call(core_function, {}, {"u1": u1, "u2": u2}, returns_vector=True)
+    def _sample_visible(self, wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
+        return self._call(self._binding("sample_visible"), {"wo": wo}, {"u1": u1, "u2": u2}, returns_vector=True)
 
-    def _sample_visible(self, core_function: _Core, wo: RealArrayLike, u1: RealArrayLike,
-                        u2: RealArrayLike) -> Float64Array:
-        return self._call(core_function, {"wo": wo}, {"u1": u1, "u2": u2}, returns_vector=True)
+    def d(self, h: RealArrayLike) -> Float64Array:
+        """The distribution of normals ``D(h)`` (its formula is in the class's description),
+        0 for ``h·n <= 0``.
 
-    def _g2(self, separable: _Core, correlated_form: _Core, wi: RealArrayLike, wo: RealArrayLike,
-            correlated: bool, shape: dict[str, Float64Array] | None = None) -> Float64Array:
-        core_function = correlated_form if _validate.flag("correlated", correlated) else separable
+        Parameters
+        ----------
+        h : array_like, shape (..., 3)
+            Half vectors (unit, local frame).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``D(h)``, float64, shape ``(...)``.
+        """
+        return self._call(self._binding("d"), {"h": h})
+
+    def pdf(self, h: RealArrayLike) -> Float64Array:
+        """Density in solid angle of :meth:`sample`: ``D(h) (h·n)``.
+
+        Parameters
+        ----------
+        h : array_like, shape (..., 3)
+            Half vectors (unit, local frame).
+
+        Returns
+        -------
+        numpy.ndarray
+            The density, float64, shape ``(...)``.
+        """
+        return self._call(self._binding("pdf"), {"h": h})
+
+    def sample(self, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
+        """Half vectors with density :meth:`pdf` (the class's description gives the warp).
+
+        Parameters
+        ----------
+        u1, u2 : float or array_like
+            Uniforms in [0, 1].
+
+        Returns
+        -------
+        numpy.ndarray
+            Unit half vectors, float64, shape ``(..., 3)``.
+        """
+        return self._call(self._binding("sample"), {}, {"u1": u1, "u2": u2}, returns_vector=True)
+
+    def lambda_(self, w: RealArrayLike) -> Float64Array:
+        """Smith Λ of the family (its form and accuracy are in the class's description).
+
+        0 at the normal, +inf at exactly grazing.
+
+        Parameters
+        ----------
+        w : array_like, shape (..., 3)
+            Directions (unit, local frame); two-sided (reads ``|w·n|``).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``Λ(w)``, float64, shape ``(...)``.
+        """
+        core_function, shape = self._smith("lambda")
+        return self._call(core_function, {"w": w}, shape=shape)
+
+    def g1(self, w: RealArrayLike) -> Float64Array:
+        """Smith masking ``G1 = 1 / (1 + Λ(w))`` with the Λ of :meth:`lambda_`.
+
+        Parameters
+        ----------
+        w : array_like, shape (..., 3)
+            Directions (unit, local frame).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``G1(w)``, float64, shape ``(...)``.
+        """
+        core_function, shape = self._smith("g1")
+        return self._call(core_function, {"w": w}, shape=shape)
+
+    def g2(self, wi: RealArrayLike, wo: RealArrayLike, *, correlated: bool = True) -> Float64Array:
+        """Smith masking-shadowing of the pair ``wi``, ``wo``, with the Λ of :meth:`lambda_`.
+
+        Height-correlated by default, ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99);
+        ``correlated=False``: the separable ``G2 = G1(wi) G1(wo)``.
+
+        Parameters
+        ----------
+        wi, wo : array_like, shape (..., 3)
+            Directions (unit, local frame).
+        correlated : bool, optional
+            ``True`` (default): height-correlated; ``False``: separable.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``G2(wi, wo)``, float64, shape ``(...)``.
+        """
+        form = "g2_height_correlated" if _validate.flag("correlated", correlated) else "g2_separable"
+        core_function, shape = self._smith(form)
         return self._call(core_function, {"wi": wi, "wo": wo}, shape=shape)
+
+    def pdf_visible(self, h: RealArrayLike, wo: RealArrayLike) -> Float64Array:
+        """Density of visible normals, ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38).
+
+        The density :meth:`sample_visible` draws, where the family has one. ``wo`` below the
+        horizon is mirrored to ``-wo``.
+
+        Parameters
+        ----------
+        h : array_like, shape (..., 3)
+            Half vectors (unit, local frame).
+        wo : array_like, shape (..., 3)
+            The viewing direction (unit, local frame).
+
+        Returns
+        -------
+        numpy.ndarray
+            The density, float64, shape ``(...)``.
+        """
+        return self._call(self._binding("pdf_visible"), {"h": h, "wo": wo})
 
 
 _NO_VISIBLE_SAMPLER = ("no visible-normal sampler is known in closed form for this family; sample() draws "
                        "D(h) (h·n) and pdf_visible() gives the density of visible normals")
 _NO_VISIBILITY = "the combined G2 / (4 cos θi cos θo) and its approximations are GGX's (GGX.g2_over_4cos)"
+
+_SAMPLE_VISIBLE_DOC = """Visible normals seen from ``wo``, with density :meth:`pdf_visible`.
+
+        The class's description gives the method. A ``wo`` below the horizon is mirrored to
+        ``-wo`` (two-sided use).
+
+        Parameters
+        ----------
+        wo : array_like, shape (..., 3)
+            The viewing direction (unit, local frame).
+        u1, u2 : float or array_like
+            Uniforms in [0, 1].
+
+        Returns
+        -------
+        numpy.ndarray
+            Unit half vectors, float64, shape ``(..., 3)``.
+        """
 
 
 # --------------------------------------------------------------------------
@@ -349,9 +492,30 @@ _NO_VISIBILITY = "the combined G2 / (4 cos θi cos θo) and its approximations a
 class GGX(_Anisotropic):
     """Anisotropic GGX (Trowbridge-Reitz, GTR2; Burley 2012 appendix B eq. 13) with Smith masking.
 
-    The distribution the model's specular lobe uses. Its normal distribution is
+    The distribution the model's specular lobe uses. Its normal distribution (appendix B
+    eq. 13) is::
 
-    ``D(h) = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²)``, 0 for ``h·n <= 0``.
+        D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²),  0 for h·n <= 0.
+
+    :meth:`sample` draws it by the projected half vector, eq. (14)-(15)::
+
+        h' = sqrt(u2/(1-u2)) (αx cos 2πu1 x + αy sin 2πu1 y) + n,   h = h'/|h'|
+
+    Its Smith Λ (:meth:`lambda_`)::
+
+        Λ(w) = (-1 + sqrt(1 + (αx² wx² + αy² wy²) / wz²)) / 2
+
+    is evaluated as ``p² / (2|wz| (sqrt(wz² + p²) + |wz|))``, ``p² = αx² wx² + αy² wy²``: no
+    cancellation and no overflow as ``wz -> 0``; +inf at exactly ``wz = 0``. So
+    ``G1 = 2|wz| / (|wz| + sqrt(wz² + αx² wx² + αy² wy²))``, and the height-correlated
+    :meth:`g2` is evaluated as ``2|zi||zo| / (|zi| ro + |zo| ri)``, ``r = sqrt(z² + αx² x² + αy² y²)``,
+    0 when either direction is grazing (the model uses the separable one). In
+    :meth:`pdf_visible`, ``G1 / |wo·n|`` is written
+    ``2 / (|wo·n| + sqrt((wo·n)² + αx² wox² + αy² woy²))``, finite at grazing ``wo``.
+
+    :meth:`sample_visible` follows Heitz 2018: ``wo`` is stretched to the α = 1
+    configuration, a point is drawn on the projected visible hemisphere (disk radius
+    ``sqrt(u2)``, angle ``2π u1``, warped towards the visible half), lifted and unstretched.
 
     Parameters
     ----------
@@ -370,167 +534,15 @@ class GGX(_Anisotropic):
     """
 
     __slots__ = ()
+    _FAMILY = "ggx"
 
     def __init__(self, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> None:
         super().__init__(alpha_x, alpha_y)
 
-    def d(self, h: RealArrayLike) -> Float64Array:
-        """The distribution of normals, appendix B eq. (13).
-
-        The formula::
-
-            D = 1 / (π αx αy ((h·x/αx)² + (h·y/αy)² + (h·n)²)²),  0 for h·n <= 0.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``D(h)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.ggx_d, {"h": h})
-
-    def pdf(self, h: RealArrayLike) -> Float64Array:
-        """Density in solid angle of :meth:`sample`: ``D(h) (h·n)``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.ggx_pdf, {"h": h})
-
-    def sample(self, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
-        """Half vectors with density :meth:`pdf`, by the projected half vector, eq. (14)-(15).
-
-        The warp::
-
-            h' = sqrt(u2/(1-u2)) (αx cos 2πu1 x + αy sin 2πu1 y) + n,   h = h'/|h'|
-
-        Parameters
-        ----------
-        u1, u2 : float or array_like
-            Uniforms in [0, 1].
-
-        Returns
-        -------
-        numpy.ndarray
-            Unit half vectors, float64, shape ``(..., 3)``.
-        """
-        return self._sample(_core_mf.ggx_sample, u1, u2)
-
-    def lambda_(self, w: RealArrayLike) -> Float64Array:
-        """Smith Λ of anisotropic GGX.
-
-        The formula::
-
-            Λ(w) = (-1 + sqrt(1 + (αx² wx² + αy² wy²) / wz²)) / 2
-
-        evaluated as ``p² / (2|wz| (sqrt(wz² + p²) + |wz|))``, ``p² = αx² wx² + αy² wy²``:
-        no cancellation and no overflow as ``wz -> 0``; +inf at exactly ``wz = 0``.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame); two-sided (reads ``|w·n|``).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``Λ(w)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.ggx_lambda, {"w": w})
-
-    def g1(self, w: RealArrayLike) -> Float64Array:
-        """Smith masking ``G1 = 1 / (1 + Λ(w)) = 2|wz| / (|wz| + sqrt(wz² + αx² wx² + αy² wy²))``.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G1(w)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.ggx_g1, {"w": w})
-
-    def g2(self, wi: RealArrayLike, wo: RealArrayLike, *, correlated: bool = True) -> Float64Array:
-        """Smith masking-shadowing of the pair ``wi``, ``wo``.
-
-        Height-correlated by default, ``G2 = 1 / (1 + Λ(wi) + Λ(wo))``, evaluated as
-        ``2|zi||zo| / (|zi| ro + |zo| ri)``, ``r = sqrt(z² + αx² x² + αy² y²)``; 0 when either
-        direction is grazing. ``correlated=False``: the separable ``G2 = G1(wi) G1(wo)``
-        (what the model uses).
-
-        Parameters
-        ----------
-        wi, wo : array_like, shape (..., 3)
-            Directions (unit, local frame).
-        correlated : bool, optional
-            ``True`` (default): height-correlated; ``False``: separable.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G2(wi, wo)``, float64, shape ``(...)``.
-        """
-        return self._g2(_core_mf.ggx_g2_separable, _core_mf.ggx_g2_height_correlated, wi, wo, correlated)
-
-    def pdf_visible(self, h: RealArrayLike, wo: RealArrayLike) -> Float64Array:
-        """Density of visible normals in solid angle, of :meth:`sample_visible`.
-
-        The formula::
-
-            D_wo(h) = G1(wo) max(0, wo·h) D(h) / |wo·n|
-
-        with ``G1 / |wo·n|`` written ``2 / (|wo·n| + sqrt((wo·n)² + αx² wox² + αy² woy²))``,
-        finite at grazing ``wo``; ``wo`` below the horizon is mirrored to ``-wo`` as in the sampler.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-        wo : array_like, shape (..., 3)
-            The viewing direction (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.ggx_pdf_visible, {"h": h, "wo": wo})
-
     def sample_visible(self, wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
-        """Visible normals seen from ``wo`` (Heitz 2018), with density :meth:`pdf_visible`.
+        return self._sample_visible(wo, u1, u2)
 
-        ``wo`` is stretched to the α = 1 configuration, a point is drawn on the projected
-        visible hemisphere (disk radius ``sqrt(u2)``, angle ``2π u1``, warped towards the
-        visible half), lifted and unstretched. A ``wo`` below the horizon is mirrored to
-        ``-wo`` (two-sided use).
-
-        Parameters
-        ----------
-        wo : array_like, shape (..., 3)
-            The viewing direction (unit, local frame).
-        u1, u2 : float or array_like
-            Uniforms in [0, 1].
-
-        Returns
-        -------
-        numpy.ndarray
-            Unit half vectors, float64, shape ``(..., 3)``.
-        """
-        return self._sample_visible(_core_mf.ggx_sample_visible, wo, u1, u2)
+    sample_visible.__doc__ = _SAMPLE_VISIBLE_DOC
 
     def g2_over_4cos(self, wi: RealArrayLike, wo: RealArrayLike, *,
                      approximation: str | None = None) -> Float64Array:
@@ -578,9 +590,29 @@ class GGX(_Anisotropic):
 class Beckmann(_Anisotropic):
     """Anisotropic Beckmann (Walter et al. 2007), stretched as in Heitz 2014, with Smith masking.
 
-    Its normal distribution is
+    Its normal distribution is::
 
-    ``D(h) = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴)``, 0 for ``h·n <= 0``.
+        D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴),  0 for h·n <= 0.
+
+    :meth:`sample` draws it with Gaussian stretched slopes, ``u2 = 1`` giving the horizon::
+
+        h ∝ sqrt(-ln(1 - u2)) (αx cos 2πu1 x + αy sin 2πu1 y) + n
+
+    Its exact Smith Λ (Heitz 2014), the default::
+
+        Λ = (erf(a) - 1) / 2 + exp(-a²) / (2 a sqrt(π)),   a = |wz| / sqrt(αx² wx² + αy² wy²)
+
+    (``a = 1 / (α_o tan θ)``). ``approximation="walter"``: Walter et al. 2007 eq. 27's
+    rational fit, as Λ, ``(1 - 1.259 a + 0.396 a²) / (3.535 a + 2.181 a²)`` for ``a < 1.6``,
+    else 0: within 3.2e-3 of the exact G1 relatively (at most 3.13e-3, at a = 1.33), so within
+    3.2e-3 (1 + Λ) of the exact Λ, and 1.8e-3 absolutely beyond the cut at a = 1.6.
+
+    :meth:`sample_visible` follows Heitz & d'Eon 2014: ``wo`` is stretched to unit
+    roughness; the visible slope along its azimuth is drawn by inverting its CDF
+    ``(1 + erf(x) + tan θ exp(-x²)/√π) / (1 + erf(cot θ) + tan θ exp(-cot²θ)/√π)``
+    numerically (Newton's iteration inside a bisection bracket, to 1e-15 in the CDF), the
+    other slope is Gaussian; the slope is rotated to the azimuth and unstretched.
+    :meth:`pdf_visible` is its density, with the exact Λ, 0 for a grazing ``wo``.
 
     Parameters
     ----------
@@ -603,6 +635,7 @@ class Beckmann(_Anisotropic):
 
     __slots__ = ("_walter",)
     _walter: bool
+    _FAMILY = "beckmann"
     _ABSENT: typing.ClassVar[dict[str, str]] = {"g2_over_4cos": _NO_VISIBILITY}
 
     def __init__(self, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
@@ -621,173 +654,16 @@ class Beckmann(_Anisotropic):
             parameters["approximation"] = "walter"
         return parameters
 
-    def _smith(self, exact: _Core, walter: _Core) -> tuple[_Core, dict[str, Float64Array] | None]:
-        """The binding of the Λ in use, and its shape argument (Walter's bindings take one)."""
-        return (walter, {"shape": _NO_SHAPE}) if self._walter else (exact, None)
-
-    def d(self, h: RealArrayLike) -> Float64Array:
-        """The distribution of normals.
-
-        The formula::
-
-            D = exp(-((h·x/αx)² + (h·y/αy)²) / (h·n)²) / (π αx αy (h·n)⁴),  0 for h·n <= 0.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``D(h)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.beckmann_d, {"h": h})
-
-    def pdf(self, h: RealArrayLike) -> Float64Array:
-        """Density in solid angle of :meth:`sample`: ``D(h) (h·n)``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.beckmann_pdf, {"h": h})
-
-    def sample(self, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
-        """Half vectors with density :meth:`pdf`: the stretched slopes are Gaussian.
-
-        The warp::
-
-            h ∝ sqrt(-ln(1 - u2)) (αx cos 2πu1 x + αy sin 2πu1 y) + n
-
-        (``u2 = 1`` gives the horizon).
-
-        Parameters
-        ----------
-        u1, u2 : float or array_like
-            Uniforms in [0, 1].
-
-        Returns
-        -------
-        numpy.ndarray
-            Unit half vectors, float64, shape ``(..., 3)``.
-        """
-        return self._sample(_core_mf.beckmann_sample, u1, u2)
-
-    def lambda_(self, w: RealArrayLike) -> Float64Array:
-        """Smith Λ for Beckmann (Heitz 2014), exact unless built with ``approximation="walter"``.
-
-        The exact form::
-
-            Λ = (erf(a) - 1) / 2 + exp(-a²) / (2 a sqrt(π)),   a = |wz| / sqrt(αx² wx² + αy² wy²)
-
-        (``a = 1 / (α_o tan θ)``); 0 at the normal, +inf at exactly grazing.
-        ``approximation="walter"``: Walter et al. 2007 eq. 27's rational fit, as Λ,
-        ``(1 - 1.259 a + 0.396 a²) / (3.535 a + 2.181 a²)`` for ``a < 1.6``, else 0: within
-        3.2e-3 of the exact G1 relatively (at most 3.13e-3, at a = 1.33), so within
-        3.2e-3 (1 + Λ) of the exact Λ, and 1.8e-3 absolutely beyond the cut at a = 1.6.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame); two-sided (reads ``|w·n|``).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``Λ(w)``, float64, shape ``(...)``.
-        """
-        core_function, shape = self._smith(_core_mf.beckmann_lambda, _core_mf.beckmann_walter_lambda)
-        return self._call(core_function, {"w": w}, shape=shape)
-
-    def g1(self, w: RealArrayLike) -> Float64Array:
-        """Smith masking ``G1 = 1 / (1 + Λ(w))`` with the Λ of :meth:`lambda_`.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G1(w)``, float64, shape ``(...)``.
-        """
-        core_function, shape = self._smith(_core_mf.beckmann_g1, _core_mf.beckmann_walter_g1)
-        return self._call(core_function, {"w": w}, shape=shape)
-
-    def g2(self, wi: RealArrayLike, wo: RealArrayLike, *, correlated: bool = True) -> Float64Array:
-        """Smith masking-shadowing of the pair ``wi``, ``wo``, with the Λ of :meth:`lambda_`.
-
-        Height-correlated by default, ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99);
-        ``correlated=False``: the separable ``G2 = G1(wi) G1(wo)``.
-
-        Parameters
-        ----------
-        wi, wo : array_like, shape (..., 3)
-            Directions (unit, local frame).
-        correlated : bool, optional
-            ``True`` (default): height-correlated; ``False``: separable.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G2(wi, wo)``, float64, shape ``(...)``.
-        """
+    def _smith(self, quantity: str) -> tuple[_Core, dict[str, Float64Array] | None]:
+        # Walter's bindings take a shape argument
         if self._walter:
-            return self._g2(_core_mf.beckmann_walter_g2_separable, _core_mf.beckmann_walter_g2_height_correlated,
-                            wi, wo, correlated, {"shape": _NO_SHAPE})
-        return self._g2(_core_mf.beckmann_g2_separable, _core_mf.beckmann_g2_height_correlated, wi, wo, correlated)
-
-    def pdf_visible(self, h: RealArrayLike, wo: RealArrayLike) -> Float64Array:
-        """Density of visible normals, of :meth:`sample_visible`, with the exact Λ.
-
-        ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38); ``wo`` below the horizon is
-        mirrored, 0 for a grazing ``wo``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-        wo : array_like, shape (..., 3)
-            The viewing direction (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.beckmann_pdf_visible, {"h": h, "wo": wo})
+            return self._binding(f"walter_{quantity}"), {"shape": _NO_SHAPE}
+        return super()._smith(quantity)
 
     def sample_visible(self, wo: RealArrayLike, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
-        """Visible normals seen from ``wo`` (Heitz & d'Eon 2014), with density :meth:`pdf_visible`.
+        return self._sample_visible(wo, u1, u2)
 
-        ``wo`` is stretched to unit roughness; the visible slope along its azimuth is drawn by
-        inverting its CDF
-        ``(1 + erf(x) + tan θ exp(-x²)/√π) / (1 + erf(cot θ) + tan θ exp(-cot²θ)/√π)``
-        numerically (Newton's iteration inside a bisection bracket, to 1e-15 in the CDF), the
-        other slope is Gaussian; the slope is rotated to the azimuth and unstretched. ``wo``
-        below the horizon is mirrored to ``-wo``.
-
-        Parameters
-        ----------
-        wo : array_like, shape (..., 3)
-            The viewing direction (unit, local frame).
-        u1, u2 : float or array_like
-            Uniforms in [0, 1].
-
-        Returns
-        -------
-        numpy.ndarray
-            Unit half vectors, float64, shape ``(..., 3)``.
-        """
-        return self._sample_visible(_core_mf.beckmann_sample_visible, wo, u1, u2)
+    sample_visible.__doc__ = _SAMPLE_VISIBLE_DOC
 
 
 # --------------------------------------------------------------------------
@@ -797,12 +673,23 @@ class Beckmann(_Anisotropic):
 class BlinnPhong(_Anisotropic):
     """Blinn-Phong with Walter et al. 2007's exponent ``α_p = 2/α² - 2``, anisotropic as Ashikhmin & Shirley 2000.
 
-    ``alpha`` means what it means for Beckmann; its normal distribution is
+    ``alpha`` means what it means for Beckmann; its normal distribution is::
 
-    ``D(h) = cos^e θh / (π αx αy)``, ``e = (2/αx² - 2) cos²φh + (2/αy² - 2) sin²φh``
-    (isotropically ``(α_p + 2) / (2π) cos^α_p θh``), 0 for ``h·n <= 0``. Blinn-Phong is not
-    shape-invariant and has no exact Smith Λ: :meth:`lambda_` is Beckmann's (an approximation,
-    good for smooth surfaces only). No visible-normal sampler (none is known in closed form).
+        D = cos^e θh / (π αx αy),   e = (2/αx² - 2) cos²φh + (2/αy² - 2) sin²φh
+
+    (isotropically ``(α_p + 2) / (2π) cos^α_p θh``), 0 for ``h·n <= 0``. :meth:`sample` draws
+    it as Ashikhmin & Shirley 2000, ``u2 = 1`` giving the horizon::
+
+        φh = azimuth of (αx cos 2πu1, αy sin 2πu1),   cos θh = u2^(1/(e(φh) + 2))
+
+    Blinn-Phong is not shape-invariant and has no exact Smith Λ: :meth:`lambda_` is
+    Beckmann's exact Λ at the same alphas (Walter et al. 2007 §5.2), an approximation, good
+    for smooth surfaces only: against the Smith G1 of Blinn-Phong's own D, G1 is off by 2e-5
+    at α = 0.05, 2e-2 at 0.3, 0.13 at 0.6 and 0.64 at 1 (85° views), and the weak white
+    furnace misses 1 by 3e-4, 3e-2, 0.15 and 0.73 (88° views; checked in
+    ``tests/microfacet/test_distribution_family.py``). With it :meth:`pdf_visible` integrates
+    to 1 only approximately (3e-2 at α = 0.4). No visible-normal sampler (none is known in
+    closed form): no ``sample_visible``.
 
     Parameters
     ----------
@@ -820,6 +707,7 @@ class BlinnPhong(_Anisotropic):
 
     __slots__ = ()
     _UPPER = 1.0
+    _FAMILY = "blinn_phong"
     _ABSENT: typing.ClassVar[dict[str, str]] = {"sample_visible": _NO_VISIBLE_SAMPLER, "g2_over_4cos": _NO_VISIBILITY}
 
     def __init__(self, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None) -> None:
@@ -827,139 +715,6 @@ class BlinnPhong(_Anisotropic):
 
     def _shape_argument(self) -> dict[str, Float64Array]:
         return {"shape": _NO_SHAPE}
-
-    def d(self, h: RealArrayLike) -> Float64Array:
-        """The distribution of normals.
-
-        The formula::
-
-            D = cos^e θh / (π αx αy),   e = (2/αx² - 2) cos²φh + (2/αy² - 2) sin²φh
-
-        0 for ``h·n <= 0``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``D(h)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.blinn_phong_d, {"h": h})
-
-    def pdf(self, h: RealArrayLike) -> Float64Array:
-        """Density in solid angle of :meth:`sample`: ``D(h) (h·n)``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.blinn_phong_pdf, {"h": h})
-
-    def sample(self, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
-        """Half vectors with density :meth:`pdf` (Ashikhmin & Shirley 2000).
-
-        The warp::
-
-            φh = azimuth of (αx cos 2πu1, αy sin 2πu1),   cos θh = u2^(1/(e(φh) + 2))
-
-        ``u2 = 1`` gives the horizon.
-
-        Parameters
-        ----------
-        u1, u2 : float or array_like
-            Uniforms in [0, 1].
-
-        Returns
-        -------
-        numpy.ndarray
-            Unit half vectors, float64, shape ``(..., 3)``.
-        """
-        return self._sample(_core_mf.blinn_phong_sample, u1, u2)
-
-    def lambda_(self, w: RealArrayLike) -> Float64Array:
-        """Λ of Blinn-Phong: Beckmann's exact Λ at the same alphas (Walter et al. 2007 §5.2).
-
-        An approximation, good for smooth surfaces only: against the Smith G1 of Blinn-Phong's
-        own D, G1 is off by 2e-5 at α = 0.05, 2e-2 at 0.3, 0.13 at 0.6 and 0.64 at 1 (85°
-        views), and the weak white furnace misses 1 by 3e-4, 3e-2, 0.15 and 0.73 (88° views;
-        checked in ``tests/microfacet/test_distribution_family.py``). 0 at the normal, +inf at exactly grazing.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame); two-sided (reads ``|w·n|``).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``Λ(w)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.blinn_phong_lambda, {"w": w})
-
-    def g1(self, w: RealArrayLike) -> Float64Array:
-        """Smith masking ``G1 = 1 / (1 + Λ(w))`` with :meth:`lambda_`.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G1(w)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.blinn_phong_g1, {"w": w})
-
-    def g2(self, wi: RealArrayLike, wo: RealArrayLike, *, correlated: bool = True) -> Float64Array:
-        """Smith masking-shadowing of the pair ``wi``, ``wo``, with :meth:`lambda_`.
-
-        Height-correlated by default, ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99);
-        ``correlated=False``: the separable ``G2 = G1(wi) G1(wo)``.
-
-        Parameters
-        ----------
-        wi, wo : array_like, shape (..., 3)
-            Directions (unit, local frame).
-        correlated : bool, optional
-            ``True`` (default): height-correlated; ``False``: separable.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G2(wi, wo)``, float64, shape ``(...)``.
-        """
-        return self._g2(_core_mf.blinn_phong_g2_separable, _core_mf.blinn_phong_g2_height_correlated, wi, wo,
-                        correlated)
-
-    def pdf_visible(self, h: RealArrayLike, wo: RealArrayLike) -> Float64Array:
-        """Density of visible normals, ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38).
-
-        ``wo`` below the horizon is mirrored, 0 for a grazing ``wo``. With Beckmann's Λ it
-        integrates to 1 only approximately (3e-2 at α = 0.4).
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-        wo : array_like, shape (..., 3)
-            The viewing direction (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.blinn_phong_pdf_visible, {"h": h, "wo": wo})
 
 
 # --------------------------------------------------------------------------
@@ -969,8 +724,24 @@ class BlinnPhong(_Anisotropic):
 class StudentT(_Anisotropic):
     """The Student-t distribution of slopes (Ribardière et al. 2017), shape ``gamma`` = γ > 3/2.
 
-    γ = 2 is GGX; γ -> ∞ is Beckmann (the difference falls as 1/γ). No visible-normal
-    sampler (none is known in closed form).
+    γ = 2 is GGX; γ -> ∞ is Beckmann (the difference falls as 1/γ). Its normal distribution is::
+
+        D = (γ-1)^γ / (π αx αy cos⁴θh ((γ-1) + r²)^γ),   r² = ((h·x/αx)² + (h·y/αy)²) / (h·n)²
+
+    0 for ``h·n <= 0``. :meth:`sample` draws the stretched slope radius in closed form,
+    ``ρ² = (γ-1) ((1-u2)^(-1/(γ-1)) - 1)`` (the inverse of its CDF
+    ``1 - (1 + ρ²/(γ-1))^(1-γ)``), azimuth ``2π u1``; ``u2 = 1`` gives the horizon.
+
+    Its Smith Λ, with ``a = |wz| / sqrt(αx² wx² + αy² wy²)``::
+
+        Λ = Γ(γ-1/2) / (Γ(γ) sqrt(π)) ((γ-1)^γ / (2γ-3) S1 + sqrt(γ-1) S2) - 1/2,
+        S1 = ((γ-1) + a²)^(3/2-γ) / a,   S2 = a 2F1(1/2, γ-1/2; 3/2; -a²/(γ-1))
+
+    with 2F1 by :func:`hyp2f1` and ``1/2 - ... S2`` taken as the incomplete-beta tail where
+    it would cancel: against the closed form in 30-digit mpmath, below 1e-12 relative for
+    γ <= 20; at large γ the two terms cancel where Λ is small, leaving ~1e-15 absolutely
+    (3e-6 relative at γ = 300, Λ = 4e-10). :meth:`pdf_visible` is 0 for a grazing ``wo``.
+    No visible-normal sampler (none is known in closed form): no ``sample_visible``.
 
     Parameters
     ----------
@@ -990,6 +761,7 @@ class StudentT(_Anisotropic):
 
     __slots__ = ("_gamma",)
     _gamma: Float64Array
+    _FAMILY = "student_t"
     _ABSENT: typing.ClassVar[dict[str, str]] = {"sample_visible": _NO_VISIBLE_SAMPLER, "g2_over_4cos": _NO_VISIBILITY}
 
     def __init__(self, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *,
@@ -1008,140 +780,6 @@ class StudentT(_Anisotropic):
     def _shape_argument(self) -> dict[str, Float64Array]:
         return {"gamma": self._gamma}
 
-    def d(self, h: RealArrayLike) -> Float64Array:
-        """The distribution of normals.
-
-        The formula::
-
-            D = (γ-1)^γ / (π αx αy cos⁴θh ((γ-1) + r²)^γ),   r² = ((h·x/αx)² + (h·y/αy)²) / (h·n)²
-
-        0 for ``h·n <= 0``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``D(h)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.student_t_d, {"h": h})
-
-    def pdf(self, h: RealArrayLike) -> Float64Array:
-        """Density in solid angle of :meth:`sample`: ``D(h) (h·n)``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.student_t_pdf, {"h": h})
-
-    def sample(self, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
-        """Half vectors with density :meth:`pdf`: the stretched slope radius in closed form.
-
-        ``ρ² = (γ-1) ((1-u2)^(-1/(γ-1)) - 1)`` (the inverse of its CDF
-        ``1 - (1 + ρ²/(γ-1))^(1-γ)``), azimuth ``2π u1``; ``u2 = 1`` gives the horizon.
-
-        Parameters
-        ----------
-        u1, u2 : float or array_like
-            Uniforms in [0, 1].
-
-        Returns
-        -------
-        numpy.ndarray
-            Unit half vectors, float64, shape ``(..., 3)``.
-        """
-        return self._sample(_core_mf.student_t_sample, u1, u2)
-
-    def lambda_(self, w: RealArrayLike) -> Float64Array:
-        """Smith Λ of the Student-t slopes (Ribardière et al. 2017).
-
-        With ``a = |wz| / sqrt(αx² wx² + αy² wy²)``::
-
-            Λ = Γ(γ-1/2) / (Γ(γ) sqrt(π)) ((γ-1)^γ / (2γ-3) S1 + sqrt(γ-1) S2) - 1/2,
-            S1 = ((γ-1) + a²)^(3/2-γ) / a,   S2 = a 2F1(1/2, γ-1/2; 3/2; -a²/(γ-1))
-
-        with 2F1 by :func:`hyp2f1` and ``1/2 - ... S2`` taken as the incomplete-beta tail where
-        it would cancel: against the closed form in 30-digit mpmath, below 1e-12 relative for
-        γ <= 20; at large γ the two terms cancel where Λ is small, leaving ~1e-15 absolutely
-        (3e-6 relative at γ = 300, Λ = 4e-10). 0 at the normal, +inf at exactly grazing.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame); two-sided (reads ``|w·n|``).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``Λ(w)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.student_t_lambda, {"w": w})
-
-    def g1(self, w: RealArrayLike) -> Float64Array:
-        """Smith masking ``G1 = 1 / (1 + Λ(w))`` with :meth:`lambda_`.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G1(w)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.student_t_g1, {"w": w})
-
-    def g2(self, wi: RealArrayLike, wo: RealArrayLike, *, correlated: bool = True) -> Float64Array:
-        """Smith masking-shadowing of the pair ``wi``, ``wo``, with :meth:`lambda_`.
-
-        Height-correlated by default, ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99);
-        ``correlated=False``: the separable ``G2 = G1(wi) G1(wo)``.
-
-        Parameters
-        ----------
-        wi, wo : array_like, shape (..., 3)
-            Directions (unit, local frame).
-        correlated : bool, optional
-            ``True`` (default): height-correlated; ``False``: separable.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G2(wi, wo)``, float64, shape ``(...)``.
-        """
-        return self._g2(_core_mf.student_t_g2_separable, _core_mf.student_t_g2_height_correlated, wi, wo,
-                        correlated)
-
-    def pdf_visible(self, h: RealArrayLike, wo: RealArrayLike) -> Float64Array:
-        """Density of visible normals, ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38).
-
-        ``wo`` below the horizon is mirrored, 0 for a grazing ``wo``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-        wo : array_like, shape (..., 3)
-            The viewing direction (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.student_t_pdf_visible, {"h": h, "wo": wo})
-
 
 # --------------------------------------------------------------------------
 # exponential-power slopes (Holzschuch & Pacanowski 2017)
@@ -1150,8 +788,26 @@ class StudentT(_Anisotropic):
 class ExponentialPower(_Anisotropic):
     """The exponential-power (generalised Gaussian) distribution of slopes (Holzschuch & Pacanowski 2017).
 
-    Shape ``p`` in [0.1, 10]; ``p = 1`` is Beckmann. No visible-normal sampler (none is known
-    in closed form).
+    Shape ``p`` in [0.1, 10]; ``p = 1`` is Beckmann. Its normal distribution is::
+
+        D = p exp(-r^(2p)) / (π Γ(1/p) αx αy cos⁴θh),   r² = ((h·x/αx)² + (h·y/αy)²) / (h·n)²
+
+    0 for ``h·n <= 0``. :meth:`sample` draws it by numerical inversion: the stretched slope
+    radius ρ has ``ρ^(2p)`` Gamma(1/p)-distributed; it is drawn by inverting the regularised
+    incomplete gamma function (Halley's iteration to 1e-15 relative), azimuth ``2π u1``;
+    ``u2 = 1`` gives the horizon.
+
+    Its Smith Λ is computed by quadrature of Smith's definition: with
+    ``a = |wz| / sqrt(αx² wx² + αy² wy²)``, the one-dimensional integral (Heitz 2014 eq. 72 in
+    polar slope coordinates)::
+
+        Λ(a) = (2/a) ∫_0^∞ f(sqrt(a² + t²)) (t - a atan(t/a)) t dt,   f(r) = p exp(-r^(2p)) / (π Γ(1/p))
+
+    by 20-point Gauss-Legendre panels doubling in width out to where the integrand is
+    below e^-60 of its start: within 3.4e-10 relative of a fine two-dimensional quadrature
+    of Smith's definition (p in [0.3, 4], 5° to 89.9°), and at p = 1 within 2e-14 of
+    Beckmann's erf form (6e-11 where Λ ~ 1e-250). :meth:`pdf_visible` is 0 for a grazing
+    ``wo``. No visible-normal sampler (none is known in closed form): no ``sample_visible``.
 
     Parameters
     ----------
@@ -1171,6 +827,7 @@ class ExponentialPower(_Anisotropic):
 
     __slots__ = ("_p",)
     _p: Float64Array
+    _FAMILY = "exponential_power"
     _ABSENT: typing.ClassVar[dict[str, str]] = {"sample_visible": _NO_VISIBLE_SAMPLER, "g2_over_4cos": _NO_VISIBILITY}
 
     def __init__(self, alpha_x: RealArrayLike, alpha_y: RealArrayLike | None = None, *, p: RealArrayLike) -> None:
@@ -1187,141 +844,6 @@ class ExponentialPower(_Anisotropic):
 
     def _shape_argument(self) -> dict[str, Float64Array]:
         return {"p": self._p}
-
-    def d(self, h: RealArrayLike) -> Float64Array:
-        """The distribution of normals.
-
-        The formula::
-
-            D = p exp(-r^(2p)) / (π Γ(1/p) αx αy cos⁴θh),   r² = ((h·x/αx)² + (h·y/αy)²) / (h·n)²
-
-        0 for ``h·n <= 0``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``D(h)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.exponential_power_d, {"h": h})
-
-    def pdf(self, h: RealArrayLike) -> Float64Array:
-        """Density in solid angle of :meth:`sample`: ``D(h) (h·n)``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.exponential_power_pdf, {"h": h})
-
-    def sample(self, u1: RealArrayLike, u2: RealArrayLike) -> Float64Array:
-        """Half vectors with density :meth:`pdf`, by numerical inversion.
-
-        The stretched slope radius ρ has ``ρ^(2p)`` Gamma(1/p)-distributed; it is drawn by
-        inverting the regularised incomplete gamma function (Halley's iteration to 1e-15
-        relative), azimuth ``2π u1``; ``u2 = 1`` gives the horizon.
-
-        Parameters
-        ----------
-        u1, u2 : float or array_like
-            Uniforms in [0, 1].
-
-        Returns
-        -------
-        numpy.ndarray
-            Unit half vectors, float64, shape ``(..., 3)``.
-        """
-        return self._sample(_core_mf.exponential_power_sample, u1, u2)
-
-    def lambda_(self, w: RealArrayLike) -> Float64Array:
-        """Smith Λ of the exponential-power slopes, by quadrature of Smith's definition.
-
-        With ``a = |wz| / sqrt(αx² wx² + αy² wy²)``, the one-dimensional integral of Smith's
-        definition (Heitz 2014 eq. 72 in polar slope coordinates)::
-
-            Λ(a) = (2/a) ∫_0^∞ f(sqrt(a² + t²)) (t - a atan(t/a)) t dt,   f(r) = p exp(-r^(2p)) / (π Γ(1/p))
-
-        by 20-point Gauss-Legendre panels doubling in width out to where the integrand is
-        below e^-60 of its start: within 3.4e-10 relative of a fine two-dimensional quadrature
-        of Smith's definition (p in [0.3, 4], 5° to 89.9°), and at p = 1 within 2e-14 of
-        Beckmann's erf form (6e-11 where Λ ~ 1e-250). 0 at the normal, +inf at exactly grazing.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame); two-sided (reads ``|w·n|``).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``Λ(w)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.exponential_power_lambda, {"w": w})
-
-    def g1(self, w: RealArrayLike) -> Float64Array:
-        """Smith masking ``G1 = 1 / (1 + Λ(w))`` with :meth:`lambda_`.
-
-        Parameters
-        ----------
-        w : array_like, shape (..., 3)
-            Directions (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G1(w)``, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.exponential_power_g1, {"w": w})
-
-    def g2(self, wi: RealArrayLike, wo: RealArrayLike, *, correlated: bool = True) -> Float64Array:
-        """Smith masking-shadowing of the pair ``wi``, ``wo``, with :meth:`lambda_`.
-
-        Height-correlated by default, ``G2 = 1 / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014 eq. 99);
-        ``correlated=False``: the separable ``G2 = G1(wi) G1(wo)``.
-
-        Parameters
-        ----------
-        wi, wo : array_like, shape (..., 3)
-            Directions (unit, local frame).
-        correlated : bool, optional
-            ``True`` (default): height-correlated; ``False``: separable.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``G2(wi, wo)``, float64, shape ``(...)``.
-        """
-        return self._g2(_core_mf.exponential_power_g2_separable, _core_mf.exponential_power_g2_height_correlated,
-                        wi, wo, correlated)
-
-    def pdf_visible(self, h: RealArrayLike, wo: RealArrayLike) -> Float64Array:
-        """Density of visible normals, ``G1(wo) max(0, wo·h) D(h) / |wo·n|`` (Heitz 2014 eq. 38).
-
-        ``wo`` below the horizon is mirrored, 0 for a grazing ``wo``.
-
-        Parameters
-        ----------
-        h : array_like, shape (..., 3)
-            Half vectors (unit, local frame).
-        wo : array_like, shape (..., 3)
-            The viewing direction (unit, local frame).
-
-        Returns
-        -------
-        numpy.ndarray
-            The density, float64, shape ``(...)``.
-        """
-        return self._call(_core_mf.exponential_power_pdf_visible, {"h": h, "wo": wo})
 
 
 # --------------------------------------------------------------------------
