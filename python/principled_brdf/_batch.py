@@ -355,15 +355,24 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     # direction the call raises, and an out= buffer may hold partial results.
     tolerance = DIRECTION_LENGTH_TOLERANCE if check else 0.0
     out_layout = _INTERLEAVED if layout == "aos" else _ROWS
-    options = _core.EvalOptions(model=model_id, cosine=cosine, energy_compensation=energy_compensation and not gradient,
-                                check_tolerance=tolerance, threads=thread_count, isa=isa_name)
-    pdf_options = _core.PdfOptions(model=model_id, sampler=pdf_sampler or 0, cosine=cosine,
+    # one options object a call, made once for all its segments
+    options: _core.EvalOptions | _core.PdfOptions
+    if pdf_sampler is None:
+        options = _core.EvalOptions(model=model_id, cosine=cosine, energy_compensation=energy_compensation,
+                                    check_tolerance=tolerance, threads=thread_count, isa=isa_name)
+    else:
+        options = _core.PdfOptions(model=model_id, sampler=pdf_sampler, cosine=cosine,
                                    energy_compensation=energy_compensation, check_tolerance=tolerance,
                                    threads=thread_count, isa=isa_name)
 
     def run(wi_flat: Float32Array, wi_code: int, wo_flat: Float32Array, wo_code: int,
             params: list[float | tuple[float, ...] | Float32Array], segment: list[Float32Array], n: int) -> int:
         """One kernel call over ``n`` elements; the first element it rejects, or -1."""
+        if isinstance(options, _core.PdfOptions):
+            f = _flat_vec3(segment[1], layout)[0] if len(segment) == 2 else None  # eval_pdf: f in the same pass
+            return int(_core.batch_pdf(
+                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+                pdf=segment[0].reshape(n), out=f, out_layout=out_layout, n=n, options=options))
         if gradient:
             value, jacobian = segment
             width = len(GRADIENT_NAMES)
@@ -372,11 +381,6 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
                 out=_flat_vec3(value, layout)[0],
                 jacobian=jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)),
                 out_layout=out_layout, n=n, options=options))
-        if pdf_sampler is not None:
-            f = _flat_vec3(segment[1], layout)[0] if len(segment) == 2 else None  # eval_pdf: f in the same pass
-            return int(_core.batch_pdf(
-                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-                pdf=segment[0].reshape(n), out=f, out_layout=out_layout, n=n, options=pdf_options))
         return int(_core.batch_eval(
             wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
             outputs=[_flat_vec3(o, layout)[0] for o in segment], lobes=len(segment) == len(LOBE_NAMES),
