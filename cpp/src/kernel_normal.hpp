@@ -2,17 +2,22 @@
 // equations of least-squares fits (NormalEquationsJob in batch.hpp;
 // docs/fitting.md). Each problem's material is prepared once; its pairs go
 // through eval_gradient a batch of lanes at a time, and a sink keeps the
-// wanted columns of the batch on the stack, where they are scaled by the
-// loss's derivative and summed into per-lane sums (JᵀJ, Jᵀr and the cost).
-// The lanes are added up in float64, in lane order, when the problem is done.
+// wanted columns of a tile of batches on the stack, where they are scaled by
+// the loss's derivative; JᵀJ's per-lane sums take a tile at a time, a few
+// entries held in registers over the tile's batches (the sums are the same
+// as batch by batch: each entry adds its batches in order). The lanes are
+// added up in float64, in lane order, when the problem is done.
 #pragma once  // (per translation unit)
 
-// eval_gradient's sink: the batch's wanted columns, by channel and column.
+// Batches whose columns are kept before JᵀJ's sums take them.
+constexpr int kNormalTile = 4;
+
+// A batch's wanted columns, by channel and column (eval_gradient's sink writes them).
+using BatchColumns = float[3][kParamSlots][kLanes];
+
 struct NormalSink {
     const Columns& columns;
-    alignas(64) float column[3][kParamSlots][kLanes];
-
-    explicit NormalSink(const Columns& c) : columns(c) {}
+    BatchColumns& column;
 
     bool wants(int p) const { return columns.wants(p); }
 
@@ -42,12 +47,13 @@ PB_KERNEL_INLINE ChannelResidual channel_residual(Loss loss, Floats f, Floats ta
     return {(f - target) * scale, scale};
 }
 
-// One batch of kLanes pairs of a problem into its sums: wi, wo, target and
-// scale point at the batch's first pair ((kLanes, 3) each).
+// One batch of kLanes pairs of a problem: its cost and Jᵀr into the sums, its
+// scaled columns ∂r_c/∂p_k into `column` for JᵀJ (add_normal_tile). wi, wo,
+// target and scale point at the batch's first pair ((kLanes, 3) each).
 template <Model model>
 PB_KERNEL_INLINE void add_normal_batch(const NormalEquationsJob& job, const Prepared<Output::kGradient>& material,
                                        const float* wi_data, const float* wo_data, const float* target_data,
-                                       const float* scale_data, NormalSums& sums) {
+                                       const float* scale_data, BatchColumns& column, NormalSums& sums) {
     Vec3<Floats> wi, wo;
     load_interleaved(wi_data, wi.x, wi.y, wi.z);
     load_interleaved(wo_data, wo.x, wo.y, wo.z);
@@ -58,7 +64,7 @@ PB_KERNEL_INLINE void add_normal_batch(const NormalEquationsJob& job, const Prep
     // as eval_grad's: x cos θl or x times 1, then 0 below the surface
     Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
     auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
-    NormalSink sink{job.columns};
+    NormalSink sink{job.columns, column};
     Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked, sink);
     Rgb<Floats> target, scale;
     load_interleaved(target_data, target.r, target.g, target.b);
@@ -73,24 +79,52 @@ PB_KERNEL_INLINE void add_normal_batch(const NormalEquationsJob& job, const Prep
             .store_aligned(squares);
     for (std::int64_t lane = 0; lane < kLanes; ++lane) sums.cost[lane] += squares[lane];
 
-    // ∂r_c/∂p_k = u'(f_c) s_c ∂f_c/∂p_k, in place
+    // ∂r_c/∂p_k = u'(f_c) s_c ∂f_c/∂p_k, in place, and Jᵀr
     const int width = job.columns.count;
-    for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < width; ++k)
-            (channel[c].slope * Floats::load_aligned(sink.column[c][k])).store_aligned(sink.column[c][k]);
-    int entry = 0;
     for (int k = 0; k < width; ++k) {
-        Floats a0 = Floats::load_aligned(sink.column[0][k]), a1 = Floats::load_aligned(sink.column[1][k]),
-               a2 = Floats::load_aligned(sink.column[2][k]);
+        Floats a0 = channel[0].slope * Floats::load_aligned(column[0][k]);
+        Floats a1 = channel[1].slope * Floats::load_aligned(column[1][k]);
+        Floats a2 = channel[2].slope * Floats::load_aligned(column[2][k]);
+        a0.store_aligned(column[0][k]);
+        a1.store_aligned(column[1][k]);
+        a2.store_aligned(column[2][k]);
         Floats gradient = Floats::load_aligned(sums.gradient[k]);
         gradient = mul_add(a0, channel[0].residual, mul_add(a1, channel[1].residual, mul_add(a2, channel[2].residual, gradient)));
         gradient.store_aligned(sums.gradient[k]);
-        for (int l = k; l < width; ++l, ++entry) {
-            Floats sum = Floats::load_aligned(sums.normal[entry]);
-            sum = mul_add(a0, Floats::load_aligned(sink.column[0][l]),
-                          mul_add(a1, Floats::load_aligned(sink.column[1][l]),
-                                  mul_add(a2, Floats::load_aligned(sink.column[2][l]), sum)));
-            sum.store_aligned(sums.normal[entry]);
+    }
+}
+
+// Σ over channels of column k times column l of one batch, added to sum.
+PB_KERNEL_INLINE Floats add_product(const BatchColumns& column, int k, int l, Floats sum) {
+    return mul_add(Floats::load_aligned(column[0][k]), Floats::load_aligned(column[0][l]),
+                   mul_add(Floats::load_aligned(column[1][k]), Floats::load_aligned(column[1][l]),
+                           mul_add(Floats::load_aligned(column[2][k]), Floats::load_aligned(column[2][l]), sum)));
+}
+
+// JᵀJ's per-lane sums (upper triangle by rows) over the first `batches` of a
+// tile, four entries of a row at a time kept in registers over the batches.
+PB_KERNEL_INLINE void add_normal_tile(const BatchColumns* tile, int batches, int width, NormalSums& sums) {
+    for (int k = 0; k < width; ++k) {
+        float(*row)[kLanes] = sums.normal + (k * width - k * (k - 1) / 2) - k;  // row[l] is entry (k, l)
+        int l = k;
+        for (; l + 4 <= width; l += 4) {
+            Floats s0 = Floats::load_aligned(row[l]), s1 = Floats::load_aligned(row[l + 1]);
+            Floats s2 = Floats::load_aligned(row[l + 2]), s3 = Floats::load_aligned(row[l + 3]);
+            for (int t = 0; t < batches; ++t) {
+                s0 = add_product(tile[t], k, l, s0);
+                s1 = add_product(tile[t], k, l + 1, s1);
+                s2 = add_product(tile[t], k, l + 2, s2);
+                s3 = add_product(tile[t], k, l + 3, s3);
+            }
+            s0.store_aligned(row[l]);
+            s1.store_aligned(row[l + 1]);
+            s2.store_aligned(row[l + 2]);
+            s3.store_aligned(row[l + 3]);
+        }
+        for (; l < width; ++l) {
+            Floats sum = Floats::load_aligned(row[l]);
+            for (int t = 0; t < batches; ++t) sum = add_product(tile[t], k, l, sum);
+            sum.store_aligned(row[l]);
         }
     }
 }
@@ -110,9 +144,16 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
     const float* scale = job.scale + 3 * n * b;
     const int width = job.columns.count;
     NormalSums sums(width);
+    alignas(64) BatchColumns tile[kNormalTile];
+    int batches = 0;  // in the tile
     std::int64_t i = 0;
-    for (; i + kLanes <= n; i += kLanes)
-        add_normal_batch<model>(job, material, wi + 3 * i, wo + 3 * i, target + 3 * i, scale + 3 * i, sums);
+    for (; i + kLanes <= n; i += kLanes) {
+        add_normal_batch<model>(job, material, wi + 3 * i, wo + 3 * i, target + 3 * i, scale + 3 * i, tile[batches], sums);
+        if (++batches == kNormalTile) {
+            add_normal_tile(tile, batches, width, sums);
+            batches = 0;
+        }
+    }
     if (i < n) {  // the last pairs, padded by the last one with scale 0 (no residual, no derivative)
         alignas(64) PadBuffer wi_pad, wo_pad, target_pad, scale_pad;
         for (std::int64_t lane = 0; lane < kLanes; ++lane) {
@@ -124,8 +165,10 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
                 scale_pad[3 * lane + c] = i + lane < n ? scale[3 * e + c] : 0.0f;
             }
         }
-        add_normal_batch<model>(job, material, wi_pad, wo_pad, target_pad, scale_pad, sums);
+        add_normal_batch<model>(job, material, wi_pad, wo_pad, target_pad, scale_pad, tile[batches], sums);
+        ++batches;
     }
+    if (batches > 0) add_normal_tile(tile, batches, width, sums);
     auto lane_sum = [](const float* lanes) {
         double total = 0.0;
         for (std::int64_t lane = 0; lane < kLanes; ++lane) total += lanes[lane];

@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import math
 import threading
+import time
 
 from collections.abc import Mapping as _Mapping
 from dataclasses import dataclass
@@ -178,6 +179,8 @@ def _residual_and_jacobian(value: Float64Array, jacobian: Float64Array, measured
 _blas_lock = threading.Lock()
 _blas_users = 0
 _blas_limiter: Any = None
+_blas_original: dict[str, int] = {}
+_BLAS_RESTORE_TRIES = 5
 
 
 @contextlib.contextmanager
@@ -186,7 +189,7 @@ def _one_blas_thread() -> Iterator[None]:
     the SVD of the tall (N, P) Jacobian, which threads slow down (a 20,000-pair fit on
     two cores: 12.6 s with OpenBLAS's threads, 4.1 s with one). Calls that overlap (from
     several threads) share the limit, and the last one out restores the previous limits."""
-    global _blas_users, _blas_limiter
+    global _blas_users, _blas_limiter, _blas_original
     try:
         from threadpoolctl import threadpool_limits  # type: ignore[import-untyped]  # it ships no type hints
     except ImportError:  # pragma: no cover - in the fit and test extras
@@ -194,6 +197,7 @@ def _one_blas_thread() -> Iterator[None]:
         return
     with _blas_lock:
         if _blas_users == 0:
+            _blas_original = _blas_thread_counts()
             _blas_limiter = threadpool_limits(1, user_api="blas")
         _blas_users += 1
     try:
@@ -203,7 +207,28 @@ def _one_blas_thread() -> Iterator[None]:
             _blas_users -= 1
             if _blas_users == 0:
                 limiter, _blas_limiter = _blas_limiter, None
-                limiter.restore_original_limits()
+                _restore_blas_threads(limiter, _blas_original)
+
+
+def _blas_thread_counts() -> dict[str, int]:
+    from threadpoolctl import threadpool_info
+
+    return {info["filepath"]: info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas"}
+
+
+def _restore_blas_threads(limiter: Any, original: dict[str, int]) -> None:
+    """Undo a threadpoolctl limit, checked against the counts before it: OpenBLAS
+    (0.3.30 and 0.3.31 seen) now and then keeps its count of 1 when it is set back
+    right after BLAS calls of two threads, then takes the same setting a few
+    milliseconds later. Left unchecked, BLAS stayed on one thread for the rest of
+    the process."""
+    for attempt in range(_BLAS_RESTORE_TRIES):
+        if attempt:
+            time.sleep(1e-3 * 2**attempt)
+        limiter.restore_original_limits()
+        now = _blas_thread_counts()
+        if all(now.get(path) == count for path, count in original.items()):
+            return
 
 
 def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
