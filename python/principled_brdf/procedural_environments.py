@@ -30,13 +30,13 @@ from .environment import Environment, uv_to_directions
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from ._typing import Float64Array
+    from ._typing import Float64Array, FloatArray
 
 __all__ = ["BUILT_IN", "DEFAULT_HEIGHT", "SUPERSAMPLING", "built_in", "studio", "outdoor", "studio_radiance",
            "outdoor_radiance"]
 
 DEFAULT_HEIGHT = 512  # map rows (columns: twice as many); 0.35° a pixel
-SUPERSAMPLING = 3  # directions averaged per pixel along each axis
+SUPERSAMPLING = 2  # directions averaged per pixel along each axis
 
 
 def _unit(vector: tuple[float, float, float]) -> Float64Array:
@@ -44,14 +44,16 @@ def _unit(vector: tuple[float, float, float]) -> Float64Array:
     return v / np.linalg.norm(v)
 
 
-def _smoothstep(edge0: float, edge1: float, x: Float64Array) -> Float64Array:
+def _smoothstep(edge0: float, edge1: float, x: FloatArray) -> Float64Array:
     t = np.clip((x - edge0) / (edge1 - edge0), 0.0, 1.0)
     return t * t * (3.0 - 2.0 * t)
 
 
-def _softbox(d: Float64Array, centre: tuple[float, float, float], half_width: float, half_height: float,
+def _softbox(d: FloatArray, centre: tuple[float, float, float], half_width: float, half_height: float,
              softness: float = 0.04, right: tuple[float, float, float] | None = None) -> Float64Array:
-    """1 inside a planar rectangle seen from the origin, 0 outside, over a soft edge.
+    """The relative radiance of a planar softbox seen from the origin: 1 at its centre, falling
+    to 0.45 at its sides (the diffuser is brightest in front of the lamp), 0 outside over a
+    soft edge.
 
     The rectangle is perpendicular to ``centre`` at unit distance; ``half_width`` and
     ``half_height`` are its half-extents there, along ``right`` (default: horizontal) and
@@ -65,10 +67,11 @@ def _softbox(d: Float64Array, centre: tuple[float, float, float], half_width: fl
     x, y = (d @ r) * scale, (d @ up) * scale
     inside = (_smoothstep(half_width + softness, half_width - softness, np.abs(x))
               * _smoothstep(half_height + softness, half_height - softness, np.abs(y)))
-    return np.where(ahead, inside, 0.0)
+    falloff = 1.0 - 0.55 * np.minimum((x / half_width) ** 2 + (y / half_height) ** 2, 1.0)
+    return np.where(ahead, inside * falloff, 0.0)
 
 
-def studio_radiance(d: Float64Array) -> Float64Array:
+def studio_radiance(d: FloatArray) -> Float64Array:
     """The studio's RGB radiance ``(..., 3)`` of unit directions ``(..., 3)`` (module docstring)."""
     y = d[..., 1]
     # the surround: a dark cyclorama, a little lighter towards the top
@@ -76,23 +79,23 @@ def studio_radiance(d: Float64Array) -> Float64Array:
     # the floor: a plane one unit below, lit in a pool under the subject that fades into the dark
     below = y < -1e-3
     distance = np.hypot(d[..., 0], d[..., 2]) / np.where(below, -y, 1.0)
-    floor = 0.012 + 0.11 * np.exp(-((distance / 2.5) ** 2))
+    floor = 0.01 + 0.07 * np.exp(-((distance / 1.5) ** 2))
     ground = _smoothstep(0.0, -0.04, y)  # the floor's far edge meets the cyclorama softly
     background = (surround + ground * (floor - surround))[..., None] * np.array([1.0, 0.98, 0.95])
-    lights = (
-        6.0 * _softbox(d, (-1.0, 0.75, 0.85), 0.42, 0.6)  # key: a tall softbox up and to the left of the camera
-        + 1.6 * _softbox(d, (1.0, 0.1, 0.35), 0.3, 0.55)  # fill on the right
-        + 4.0 * _softbox(d, (0.0, 1.0, -0.15), 0.75, 0.09, right=(1.0, 0.0, 0.0))  # strip overhead
-        + 5.0 * _softbox(d, (0.75, 0.3, -1.0), 0.12, 0.55, softness=0.02)  # rim: a narrow strip behind
-    )
-    return background + lights[..., None] * np.array([1.0, 0.97, 0.92])  # lights a touch warm of white
+    # a warm key (a tungsten-balanced lamp of about 4000 K) against cool-white fill and strips
+    warm, neutral = np.array([1.0, 0.84, 0.66]), np.array([0.92, 0.96, 1.0])
+    key = 9.0 * _softbox(d, (-1.0, 0.75, 0.85), 0.38, 0.55)  # a tall softbox up and to the left of the camera
+    others = (2.5 * _softbox(d, (1.0, 0.1, 0.35), 0.25, 0.5)  # fill on the right
+              + 5.0 * _softbox(d, (0.0, 1.0, -0.15), 0.75, 0.08, right=(1.0, 0.0, 0.0))  # strip overhead
+              + 7.0 * _softbox(d, (0.75, 0.3, -1.0), 0.1, 0.55, softness=0.02))  # rim: a narrow strip behind
+    return background + key[..., None] * warm + others[..., None] * neutral
 
 
 SUN_DIRECTION = (-0.55, 0.6, 0.45)  # towards the sun: up and to the left of the camera
 SUN_RADIUS = np.radians(1.5)
 
 
-def outdoor_radiance(d: Float64Array) -> Float64Array:
+def outdoor_radiance(d: FloatArray) -> Float64Array:
     """The outdoor scene's RGB radiance ``(..., 3)`` of unit directions ``(..., 3)`` (module docstring)."""
     y = d[..., 1]
     elevation = np.clip(y, 0.0, 1.0)
@@ -122,7 +125,7 @@ def outdoor_radiance(d: Float64Array) -> Float64Array:
     return np.where(below[..., None], ground, sky)
 
 
-def _map(radiance: Callable[[Float64Array], Float64Array], height: int) -> Float64Array:
+def _map(radiance: Callable[[FloatArray], Float64Array], height: int) -> Float64Array:
     """The ``(height, 2 height, 3)`` map of ``radiance``, each pixel the mean over its
     ``SUPERSAMPLING²`` sub-pixel centres (built a band of rows at a time)."""
     width, n = 2 * height, SUPERSAMPLING
