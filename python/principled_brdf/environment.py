@@ -117,6 +117,8 @@ class Environment:
         sin_theta = np.sin(np.pi * (np.arange(rows) + 0.5) / rows)
         luminance = pixels @ np.array(_color.LUMINANCE_WEIGHTS)
         self.distribution = PiecewiseConstant2D(luminance * sin_theta[:, None])
+        self._radiance = self.image.reshape(-1, 3)
+        self._density = self.distribution.density.ravel()
 
     @classmethod
     def read(cls, path: str | os.PathLike[str]) -> Environment:
@@ -126,15 +128,9 @@ class Environment:
     def __repr__(self) -> str:
         return f"Environment({self.name!r}, {self.image.shape[0]}x{self.image.shape[1]})"
 
-    def _pixel(self, uv: FloatArray) -> tuple[Float64Array, Float64Array]:
-        rows, columns = self.image.shape[:2]
-        column = np.clip((uv[..., 0] * columns).astype(np.int64), 0, columns - 1)
-        row = np.clip((uv[..., 1] * rows).astype(np.int64), 0, rows - 1)
-        return row, column
-
     def __call__(self, directions: RealArrayLike) -> Float32Array:
         uv, _ = directions_to_uv(directions)
-        return self.image[self._pixel(uv)]
+        return self._radiance[self.distribution.cell(uv)]
 
     def pdf(self, directions: RealArrayLike) -> Float64Array:
         """The density per steradian with which :meth:`sample` draws ``directions`` (0 at the poles)."""
@@ -143,15 +139,19 @@ class Environment:
     def lookup(self, directions: RealArrayLike) -> tuple[Float32Array, Float64Array]:
         """``(radiance (..., 3), pdf (...))`` of ``directions``: the call and :meth:`pdf` at once."""
         uv, sin_theta = directions_to_uv(directions)
-        density = self.distribution.pdf(uv)
-        pdf = np.divide(density, 2.0 * np.pi**2 * sin_theta, out=np.zeros_like(density), where=sin_theta > 0.0)
-        return self.image[self._pixel(uv)], pdf
+        pixel = self.distribution.cell(uv)  # the map's pixels are the distribution's cells
+        return self._radiance[pixel], self._per_steradian(self._density[pixel], sin_theta)
 
     def sample(self, u: RealArrayLike) -> tuple[Float32Array, Float64Array, Float32Array]:
         """``(directions (..., 3), pdf per steradian (...), radiance (..., 3))`` for uniforms
         ``u`` of shape ``(..., 2)`` in [0, 1)."""
-        uv, density = self.distribution.sample(u)
+        uv, pixel = self.distribution.sample_cells(u)
         directions = uv_to_directions(uv)
-        sin_theta = np.sin(np.pi * uv[..., 1])
-        pdf = np.divide(density, 2.0 * np.pi**2 * sin_theta, out=np.zeros_like(density), where=sin_theta > 0.0)
-        return directions, pdf, self.image[self._pixel(uv)]
+        sin_theta = np.hypot(directions[..., 0], directions[..., 2])
+        return directions, self._per_steradian(self._density[pixel], sin_theta), self._radiance[pixel]
+
+    @staticmethod
+    def _per_steradian(density: Float64Array, sin_theta: FloatArray) -> Float64Array:
+        """A density over (u, v) per steradian: ``dω = 2π² sin θ du dv``; 0 at the poles."""
+        return np.divide(density, np.float32(2.0 * np.pi**2) * sin_theta, out=np.zeros_like(density),
+                         where=sin_theta > 0.0)

@@ -53,29 +53,30 @@ class _RowInverse:
 
     def __init__(self, cdf: Float64Array) -> None:
         rows, cells = cdf.shape[0], cdf.shape[1] - 1
-        self.cdf, self.cells = cdf, cells
+        self.cells = cells
         self.buckets = GUIDE_BUCKETS_PER_CELL * cells
         edges = np.arange(self.buckets + 1) / self.buckets
-        first = np.empty((rows, self.buckets + 1), np.int32)
-        last = np.empty((rows, self.buckets + 1), np.int32)
+        guide = np.empty((rows, self.buckets), np.int32)
         for r in range(rows):
-            first[r] = np.searchsorted(cdf[r], edges, side="right") - 1  # the cell of the bucket's start
-            last[r] = np.searchsorted(cdf[r], edges, side="left") - 1  # the cell just below each edge
-        self.low = np.clip(first[:, :-1], 0, cells - 1)
-        self.high = np.clip(last[:, 1:], 0, cells - 1)
+            first = np.clip(np.searchsorted(cdf[r], edges[:-1], side="right") - 1, 0, cells - 1)  # a bucket's start
+            last = np.clip(np.searchsorted(cdf[r], edges[1:], side="left") - 1, 0, cells - 1)  # just below its end
+            guide[r] = np.where(first == last, first, -1)  # -1: the bucket holds a boundary, search
+        self.guide = guide.ravel()
+        self.lower = cdf[:, :-1].ravel()  # each cell's lower boundary, and its inverse width (0 if empty)
+        width = np.diff(cdf, axis=-1).ravel()
+        self.inverse_width = np.divide(1.0, width, out=np.zeros_like(width), where=width > 0.0)
         # each row offset by twice its index: one search of the flattened array serves every row
         self.flat = (cdf + 2.0 * np.arange(rows)[:, None]).ravel()
 
     def __call__(self, row: NDArray[np.int64], u: Float64Array) -> tuple[NDArray[np.int64], Float64Array]:
         """``(cell, position in [0, 1) within the cell)`` of uniforms ``u`` in rows ``row``."""
         bucket = np.minimum((u * self.buckets).astype(np.int64), self.buckets - 1)
-        cell = self.low[row, bucket].astype(np.int64)
-        search = np.flatnonzero(cell != self.high[row, bucket])
+        cell = self.guide[row * self.buckets + bucket].astype(np.int64)
+        search = np.flatnonzero(cell < 0)
         found = np.searchsorted(self.flat, 2.0 * row[search] + u[search], side="right") - 1
         cell[search] = np.clip(found - row[search] * (self.cells + 1), 0, self.cells - 1)
-        lower, upper = self.cdf[row, cell], self.cdf[row, cell + 1]
-        width = upper - lower
-        offset = np.divide(u - lower, width, out=np.full_like(u, 0.5), where=width > 0.0)
+        index = row * self.cells + cell
+        offset = (u - self.lower[index]) * self.inverse_width[index]
         return cell, np.clip(offset, 0.0, np.nextafter(1.0, 0.0))
 
 
@@ -103,6 +104,11 @@ class PiecewiseConstant2D:
         """``(points (..., 2) as (u, v), pdf (...))`` for uniforms ``u`` of shape ``(..., 2)``
         in [0, 1): the row from the marginal distribution by ``u[..., 1]``, the column from
         that row's conditional distribution by ``u[..., 0]``."""
+        points, cell = self.sample_cells(u)
+        return points, self.density.ravel()[cell]
+
+    def sample_cells(self, u: RealArrayLike) -> tuple[Float64Array, NDArray[np.int64]]:
+        """:meth:`sample`'s points and the flat index ``row * columns + column`` of their cells."""
         uniforms = np.asarray(u, dtype=np.float64)
         if uniforms.ndim == 0 or uniforms.shape[-1] != 2:
             raise ValueError(f"u: expected uniforms of shape (..., 2), got {uniforms.shape}")
@@ -111,12 +117,16 @@ class PiecewiseConstant2D:
         row, row_offset = self._marginal(np.zeros(len(flat), np.int64), flat[:, 1])
         column, column_offset = self._conditional(row, flat[:, 0])
         points = np.stack([(column + column_offset) / columns, (row + row_offset) / rows], axis=-1)
-        return points.reshape(uniforms.shape), self.density[row, column].reshape(uniforms.shape[:-1])
+        return points.reshape(uniforms.shape), (row * columns + column).reshape(uniforms.shape[:-1])
 
     def pdf(self, points: RealArrayLike) -> Float64Array:
         """The density at ``points`` ``(..., 2)`` as ``(u, v)`` in [0, 1] (1 counts as the last cell)."""
-        uv = np.asarray(points, dtype=np.float64)
+        return self.density.ravel()[self.cell(points)]
+
+    def cell(self, points: RealArrayLike) -> NDArray[np.int64]:
+        """The flat index ``row * columns + column`` of the cells of ``points`` ``(..., 2)``."""
+        uv = np.asarray(points)
         rows, columns = self.shape
-        column = np.clip((uv[..., 0] * columns).astype(np.int64), 0, columns - 1)
-        row = np.clip((uv[..., 1] * rows).astype(np.int64), 0, rows - 1)
-        return self.density[row, column]
+        column = np.minimum((uv[..., 0] * columns).astype(np.int64), columns - 1)
+        row = np.minimum((uv[..., 1] * rows).astype(np.int64), rows - 1)
+        return row * columns + column
