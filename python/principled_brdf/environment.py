@@ -20,14 +20,13 @@ poles), whose density over ``(u, v)`` becomes ``pdf_uv / (2π² sin θ)`` per st
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING
+import typing
 
 import numpy as np
 
-from . import _color, _validate
-from .piecewise import PiecewiseConstant2D
+from . import _color, _validate, piecewise
 
-if TYPE_CHECKING:
+if typing.TYPE_CHECKING:
     from ._typing import Float32Array, Float64Array, FloatArray, RealArrayLike
 
 __all__ = ["Environment", "MAP_FORMATS", "MAX_MAP_PIXELS", "directions_to_uv", "uv_to_directions", "read_map"]
@@ -116,7 +115,7 @@ class Environment:
         rows = pixels.shape[0]
         sin_theta = np.sin(np.pi * (np.arange(rows) + 0.5) / rows)
         luminance = pixels @ np.array(_color.LUMINANCE_WEIGHTS)
-        self.distribution = PiecewiseConstant2D(luminance * sin_theta[:, None])
+        self.distribution = piecewise.PiecewiseConstant2D(luminance * sin_theta[:, None])
         self._radiance = self.image.reshape(-1, 3)
         self._density = self.distribution.density.ravel()
 

@@ -12,13 +12,13 @@ builds one from a latitude-longitude map's luminance times ``sin θ``.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import typing
 
 import numpy as np
 
 from . import _validate
 
-if TYPE_CHECKING:
+if typing.TYPE_CHECKING:
     from numpy.typing import NDArray
 
     from ._typing import Float64Array, RealArrayLike
@@ -38,7 +38,7 @@ def _cumulative(weights: Float64Array) -> Float64Array:
     return np.minimum(cdf, 1.0)
 
 
-GUIDE_BUCKETS_PER_CELL = 4  # guide-table buckets per cell: at most 1 / 4 of the draws need a binary search
+_GUIDE_BUCKETS_PER_CELL = 4  # guide-table buckets per cell: at most 1 / 4 of the draws need a binary search
 
 
 class _RowInverse:
@@ -54,7 +54,7 @@ class _RowInverse:
     def __init__(self, cdf: Float64Array) -> None:
         rows, cells = cdf.shape[0], cdf.shape[1] - 1
         self.cells = cells
-        self.buckets = GUIDE_BUCKETS_PER_CELL * cells
+        self.buckets = _GUIDE_BUCKETS_PER_CELL * cells
         edges = np.arange(self.buckets + 1) / self.buckets
         guide = np.empty((rows, self.buckets), np.int32)
         for r in range(rows):

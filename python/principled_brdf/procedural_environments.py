@@ -1,5 +1,6 @@
 """The built-in environments, drawn by this code (no downloaded data): a photographic
-*studio* and an *outdoor* scene, as latitude-longitude maps (:class:`Environment`).
+*studio* and an *outdoor* scene, as latitude-longitude maps
+(:class:`~principled_brdf.environment.Environment`).
 
 Each is a radiance function of camera-space directions (x right, y up, z towards the
 viewer) averaged over ``SUPERSAMPLING²`` directions per pixel, so edges are smooth at the
@@ -13,27 +14,26 @@ gets a radiance of about 1, the tone curves' mid-upper range.
   a metal's colour reads against the dark surround.
 - ``outdoor``: a clear sky (a pale horizon to a deep blue zenith, a glow around the
   sun), a sun disk of 1.5° radius up and to the left of the camera, and a ground plane
-  of large checkered tiles (1 unit below the viewer, 1 unit tiles) that recede to the
+  of checkered tiles (1 unit below the viewer, tiles of 0.5) that recede to the
   horizon: what glass bends is easy to see.
 """
 
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING
+import typing
 
 import numpy as np
 
-from . import _validate
-from .environment import Environment, uv_to_directions
+from . import _validate, environment
 
-if TYPE_CHECKING:
+if typing.TYPE_CHECKING:
     from collections.abc import Callable
 
     from ._typing import Float64Array, FloatArray
 
-__all__ = ["BUILT_IN", "DEFAULT_HEIGHT", "SUPERSAMPLING", "built_in", "studio", "outdoor", "studio_radiance",
-           "outdoor_radiance"]
+__all__ = ["BUILT_IN", "DEFAULT_HEIGHT", "SUPERSAMPLING", "SUN_DIRECTION", "SUN_RADIUS", "built_in", "studio", "outdoor",
+           "studio_radiance", "outdoor_radiance"]
 
 DEFAULT_HEIGHT = 512  # map rows (columns: twice as many); 0.35° a pixel
 SUPERSAMPLING = 2  # directions averaged per pixel along each axis
@@ -59,7 +59,7 @@ def _softbox(d: FloatArray, centre: tuple[float, float, float], half_width: floa
     ``half_height`` are its half-extents there, along ``right`` (default: horizontal) and
     the axis perpendicular to both; ``softness`` the edge's width, the same units."""
     c = _unit(centre)
-    r = _unit(right) if right is not None else _unit(tuple(np.cross((0.0, 1.0, 0.0), c)))  # type: ignore[arg-type]
+    r = _unit(right) if right is not None else _unit(tuple(np.cross((0.0, 1.0, 0.0), c)))
     up = np.cross(c, r)
     facing = d @ c
     ahead = facing > 1e-3
@@ -99,25 +99,25 @@ def outdoor_radiance(d: FloatArray) -> Float64Array:
     """The outdoor scene's RGB radiance ``(..., 3)`` of unit directions ``(..., 3)`` (module docstring)."""
     y = d[..., 1]
     elevation = np.clip(y, 0.0, 1.0)
-    zenith, horizon = np.array([0.10, 0.22, 0.62]), np.array([0.75, 0.84, 1.0])
+    zenith, horizon = np.array([0.05, 0.11, 0.32]), np.array([0.42, 0.48, 0.58])
     blend = (1.0 - elevation) ** 4
     sky = zenith + blend[..., None] * (horizon - zenith)
     sun = _unit(SUN_DIRECTION)
     angle = np.arccos(np.clip(d @ sun, -1.0, 1.0))
-    glow = 0.6 * np.exp(-angle / 0.12) + 0.15 * np.exp(-angle / 0.6)
+    glow = 0.5 * np.exp(-angle / 0.12) + 0.1 * np.exp(-angle / 0.6)
     sky = sky + glow[..., None] * np.array([1.0, 0.9, 0.75])
     disk = _smoothstep(SUN_RADIUS * 1.05, SUN_RADIUS * 0.95, angle)
     # a sun of irradiance ~4 on a surface facing it: radiance x solid angle (π radius²)
     sun_radiance = 4.0 / (np.pi * SUN_RADIUS**2)
     sky = sky + (sun_radiance * disk)[..., None] * np.array([1.0, 0.95, 0.85])
-    # the ground: 1-unit tiles one unit below, their contrast fading where they shrink below a pixel
+    # the ground: tiles of 0.5 one unit below, their contrast fading where they shrink below a pixel
     below = y < -1e-4
     scale = np.divide(1.0, -y, out=np.zeros_like(y), where=below)
     x, z = d[..., 0] * scale, d[..., 2] * scale
-    checker = ((np.floor(x) + np.floor(z)) % 2.0)[..., None]
-    light, dark = np.array([0.55, 0.5, 0.42]), np.array([0.12, 0.14, 0.16])
+    checker = ((np.floor(2.0 * x) + np.floor(2.0 * z)) % 2.0)[..., None]
+    light, dark = np.array([0.45, 0.41, 0.35]), np.array([0.08, 0.09, 0.11])
     distance = np.hypot(x, z)
-    contrast = _smoothstep(14.0, 5.0, distance)[..., None]
+    contrast = _smoothstep(7.0, 2.5, distance)[..., None]
     mean = 0.5 * (light + dark)
     tiles = mean + contrast * (np.where(checker > 0.5, light, dark) - mean)
     haze = _smoothstep(0.0, 0.25, -y)[..., None]  # towards the horizon the ground fades into the haze
@@ -137,32 +137,32 @@ def _map(radiance: Callable[[FloatArray], Float64Array], height: int) -> Float64
         v = (rows[:, None] + offsets[None, :]).ravel() / height
         u = (np.arange(width)[:, None] + offsets[None, :]).ravel() / width
         uv = np.stack(np.broadcast_arrays(u[None, :], v[:, None]), axis=-1)
-        values = radiance(uv_to_directions(uv))  # (rows n, width n, 3)
+        values = radiance(environment.uv_to_directions(uv))  # (rows n, width n, 3)
         image[rows] = values.reshape(len(rows), n, width, n, 3).mean(axis=(1, 3))
     return image
 
 
 @functools.lru_cache(maxsize=8)
-def _cached(name: str, height: int) -> Environment:
-    return Environment(_map(_RADIANCE[name], height), name=name)
+def _cached(name: str, height: int) -> environment.Environment:
+    return environment.Environment(_map(_RADIANCE[name], height), name=name)
 
 
-def studio(height: int = DEFAULT_HEIGHT) -> Environment:
+def studio(height: int = DEFAULT_HEIGHT) -> environment.Environment:
     """The studio (module docstring) as a ``(height, 2 height)`` map (made once per height)."""
     return _cached("studio", _validate.integer_in("height", height, 2, 8192, " rows"))
 
 
-def outdoor(height: int = DEFAULT_HEIGHT) -> Environment:
+def outdoor(height: int = DEFAULT_HEIGHT) -> environment.Environment:
     """The outdoor scene (module docstring) as a ``(height, 2 height)`` map (made once per height)."""
     return _cached("outdoor", _validate.integer_in("height", height, 2, 8192, " rows"))
 
 
 _RADIANCE = {"studio": studio_radiance, "outdoor": outdoor_radiance}
 #: The built-in environments by name.
-BUILT_IN: dict[str, Callable[..., Environment]] = {"studio": studio, "outdoor": outdoor}
+BUILT_IN: dict[str, Callable[..., environment.Environment]] = {"studio": studio, "outdoor": outdoor}
 
 
-def built_in(name: str) -> Environment:
+def built_in(name: str) -> environment.Environment:
     """The built-in environment ``name`` (:data:`BUILT_IN`) at its default size."""
     if name not in BUILT_IN:
         raise ValueError(f"environment: expected one of {', '.join(BUILT_IN)}, got {name!r}")

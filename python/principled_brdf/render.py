@@ -30,9 +30,11 @@ from ._batch import eval as _eval
 from ._batch import eval_pdf as _eval_pdf
 from ._batch import random_uniforms as _random_uniforms
 from ._batch import sample as _sample
-from .environment import MAP_FORMATS, Environment
+from .environment import MAP_FORMATS as _MAP_FORMATS
+from .environment import Environment
 from .material import Material
-from .procedural_environments import BUILT_IN, built_in
+from .procedural_environments import BUILT_IN as _BUILT_IN
+from .procedural_environments import built_in as _built_in
 
 if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
     from collections.abc import Callable
@@ -49,7 +51,7 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
     _EnvironmentArg = Union[str, "os.PathLike[str]", bool, None, Environment, NDArray[Any], _Environment]
     _ToneCurve = Literal["filmic", "reinhard", "clip"]
 
-__all__ = ["render_sphere", "render_environment", "sky_environment", "environment_of", "ENVIRONMENT_NAMES",
+__all__ = ["render_sphere", "render_environment", "sky_environment", "environment_of", "Environment", "ENVIRONMENT_NAMES",
            "DEFAULT_LIGHT_INTENSITY", "sphere_frames", "lattice_uniforms", "tone_map",
            "to_srgb8", "png_bytes", "write_png", "save_image", "IMAGE_FORMATS", "DEFAULT_LIGHT", "DEFAULT_SAMPLES", "DEFAULT_MAP_SAMPLES", "MAX_RESOLUTION",
            "MAX_SAMPLES", "MAX_SAMPLE_WORK",
@@ -58,7 +60,7 @@ __all__ = ["render_sphere", "render_environment", "sky_environment", "environmen
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
 DEFAULT_LIGHT_INTENSITY = 3.0  # the key light's irradiance with the sky or no environment (a map brings its own lights)
 #: The environments named by a string: the simple gradient and the built-in maps.
-ENVIRONMENT_NAMES = ("sky",) + tuple(BUILT_IN)
+ENVIRONMENT_NAMES = ("sky",) + tuple(_BUILT_IN)
 
 
 MAX_RESOLUTION = _validate.MAX_RESOLUTION  # pixels along a side (16384)
@@ -145,10 +147,10 @@ def environment_of(value: _EnvironmentArg) -> Environment | _Environment | None:
     if isinstance(value, Environment):
         return value
     if isinstance(value, str) and value in ENVIRONMENT_NAMES:
-        return sky_environment if value == "sky" else built_in(value)
+        return sky_environment if value == "sky" else _built_in(value)
     if isinstance(value, (str, os.PathLike)):
         path = os.fspath(value)
-        if isinstance(path, str) and os.path.splitext(path)[1].lower() in MAP_FORMATS:
+        if isinstance(path, str) and os.path.splitext(path)[1].lower() in _MAP_FORMATS:
             return Environment.read(path)
         raise ValueError(f"environment: {expected}, got {value!r}")
     if value is None or value is False:
@@ -159,7 +161,7 @@ def environment_of(value: _EnvironmentArg) -> Environment | _Environment | None:
         return Environment(value)
     if not callable(value):
         raise TypeError(f"environment: {expected}, got {type(value).__name__}")
-    return typing.cast("_Environment", value)
+    return value
 
 
 def render_sphere(material: Material, resolution: int = 256, light: RealArrayLike = DEFAULT_LIGHT,
@@ -256,8 +258,8 @@ def lattice_uniforms(count: int, shape: tuple[int, ...], seed: int = 0, first: i
 def _power_heuristic(pdf: FloatArray, other: FloatArray) -> Float64Array:
     """Veach's power heuristic (β = 2) for one sample of each of two strategies:
     ``pdf² / (pdf² + other²)``, 0 where both densities are 0."""
-    p, q = np.asarray(pdf, dtype=np.float64) ** 2, np.asarray(other, dtype=np.float64) ** 2
-    return np.divide(p, p + q, out=np.zeros_like(p), where=p > 0.0)
+    p, q = np.broadcast_arrays(np.asarray(pdf, dtype=np.float64) ** 2, np.asarray(other, dtype=np.float64) ** 2)
+    return np.divide(p, p + q, out=np.zeros(p.shape), where=p > 0.0)
 
 
 def render_environment(material: Material, resolution: int = 256, environment: _EnvironmentArg = None,
@@ -323,8 +325,8 @@ def render_environment(material: Material, resolution: int = 256, environment: _
         value, bsdf_pdf = _eval_pdf(material, local, wo, cosine=True, **options)
         light_pdf = light_pdf.reshape((count,) + spheres + inside.shape)
         # f |cos| L / pdf_light x pdf_light² / (pdf_light² + pdf_bsdf²)
-        weight = np.divide(_power_heuristic(light_pdf, bsdf_pdf), light_pdf, out=np.zeros_like(light_pdf),
-                           where=light_pdf > 0.0)
+        heuristic = _power_heuristic(light_pdf, bsdf_pdf)
+        weight = np.divide(heuristic, light_pdf, out=np.zeros_like(heuristic), where=light_pdf > 0.0)
         total += (value * weight[..., None] * radiance.reshape(local.shape)).sum(axis=0, dtype=np.float64)
     total /= samples
     total[..., ~inside, :] = 0.0

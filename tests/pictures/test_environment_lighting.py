@@ -173,3 +173,14 @@ def test_studio_chrome_reflects_the_lights_crisply(studio_metals):
     step = np.maximum(np.abs(np.diff(y, axis=0, append=0.0)), np.abs(np.diff(y, axis=1, append=0.0)))[interior]
     assert np.median(y[inside]) < 0.3 and np.mean(y[inside] > 0.8) > 0.02  # dark surround, bright lights
     assert np.sum(step > 0.4) >= 8  # the softboxes' edges jump from dark to bright within a pixel
+
+
+def test_a_sphere_looks_the_same_alone_or_in_a_batch():
+    studio = procedural_environments.studio(32)
+    roughness = np.array([0.1, 0.5, 1.0])
+    batch = pb.render.render_sphere(GLOSSY.replace(roughness=roughness[:, None, None]), 16, environment=studio,
+                                    samples=8)
+    for k, r in enumerate(roughness):
+        np.testing.assert_allclose(batch[k], pb.render.render_sphere(GLOSSY.replace(roughness=r), 16,
+                                                                     environment=studio, samples=8),
+                                   rtol=1e-5, atol=1e-7)
