@@ -72,14 +72,17 @@ def read_map(path: str | os.PathLike[str]) -> Float32Array:
             import OpenEXR
         except ImportError:
             raise ImportError("reading .exr needs the OpenEXR package: pip install OpenEXR") from None
-        with OpenEXR.File(path) as exr:
-            channels = exr.channels()
-            if "RGB" in channels:
-                pixels = np.asarray(channels["RGB"].pixels)
-            elif all(name in channels for name in "RGB"):
-                pixels = np.stack([np.asarray(channels[name].pixels) for name in "RGB"], axis=-1)
-            else:
-                raise ValueError(f"environment: {path!r} has no R, G, B channels (it has {', '.join(channels)})")
+        try:
+            with OpenEXR.File(path) as exr:
+                channels = exr.channels()
+                if "RGB" in channels:
+                    pixels = np.asarray(channels["RGB"].pixels)
+                elif all(name in channels for name in "RGB"):
+                    pixels = np.stack([np.asarray(channels[name].pixels) for name in "RGB"], axis=-1)
+                else:
+                    raise ValueError(f"environment: {path!r} has no R, G, B channels (it has {', '.join(channels)})")
+        except RuntimeError as error:  # OpenEXR's way of saying the file is not one it can read
+            raise ValueError(f"environment: {path!r} is not a readable OpenEXR file ({error})") from None
         return np.asarray(pixels, dtype=np.float32)
     try:
         import cv2
