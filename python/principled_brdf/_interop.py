@@ -43,7 +43,8 @@ def leading_rank(names: list[str], values: list[np.ndarray], wi: np.ndarray, wo:
 
 
 def material_of(names: list[str], values: list[np.ndarray]) -> Material:
-    return Material(**dict(zip(names, values)))
+    parameters: dict[str, Any] = dict(zip(names, values))
+    return Material(**parameters)
 
 
 def evaluate(names: list[str], values: list[np.ndarray], wi: np.ndarray, wo: np.ndarray, double: bool,

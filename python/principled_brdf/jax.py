@@ -66,7 +66,7 @@ def _operation(names: tuple[str, ...], options: tuple[tuple[str, Any], ...]) -> 
     def value_shape(wi: jax.Array, wo: jax.Array, values: tuple[jax.Array, ...]) -> jax.ShapeDtypeStruct:
         leading = jnp.broadcast_shapes(wi.shape[:-1], wo.shape[:-1],
                                        *(v.shape[:-1] if n == "base_color" else v.shape for n, v in zip(names, values)))
-        return jax.ShapeDtypeStruct(leading + (3,), wi.dtype)
+        return jax.ShapeDtypeStruct(leading + (3,), wi.dtype)  # type: ignore[no-untyped-call]
 
     @jax.custom_vjp
     def operation(wi: jax.Array, wo: jax.Array, *values: jax.Array) -> jax.Array:
@@ -77,7 +77,7 @@ def _operation(names: tuple[str, ...], options: tuple[tuple[str, Any], ...]) -> 
 
     def backward(residuals: tuple[jax.Array, ...], cotangent: jax.Array) -> tuple[Any, ...]:
         wi, wo, *values = residuals
-        shapes = tuple(jax.ShapeDtypeStruct(v.shape, v.dtype) for v in values)
+        shapes = tuple(jax.ShapeDtypeStruct(v.shape, v.dtype) for v in values)  # type: ignore[no-untyped-call]
         gradients = jax.pure_callback(functools.partial(host_vjp, cotangent.ndim - 1), shapes, wi, wo, cotangent, *values,
                                       vmap_method="expand_dims")
         # the directions' derivatives are not available yet: NaN says so rather than a silent 0

@@ -29,7 +29,7 @@ from .material import Material
 if TYPE_CHECKING:
     from collections.abc import Mapping
 
-__all__ = ["eval", "pdf", "sample", "Sample"]
+__all__ = ["eval", "pdf", "sample", "TensorSample"]
 
 
 def _numpy(name: str, value: Any) -> np.ndarray:
@@ -58,7 +58,7 @@ class _Eval(torch.autograd.Function):
     """f(wi, wo) with the gradients of the material's parameters as the backward pass."""
 
     @staticmethod
-    def forward(ctx: Any, names: list[str], options: dict[str, Any], double: bool,  # type: ignore[override]
+    def forward(ctx: Any, names: list[str], options: dict[str, Any], double: bool,
                 wi: torch.Tensor, wo: torch.Tensor, *values: torch.Tensor) -> torch.Tensor:
         ctx.names, ctx.options, ctx.double = names, options, double
         ctx.save_for_backward(wi, wo, *values)
@@ -66,7 +66,7 @@ class _Eval(torch.autograd.Function):
         return torch.from_numpy(_interop.evaluate(names, arrays, _numpy("wi", wi), _numpy("wo", wo), double, options))
 
     @staticmethod
-    def backward(ctx: Any, grad_output: torch.Tensor) -> tuple[Any, ...]:  # type: ignore[override]
+    def backward(ctx: Any, grad_output: torch.Tensor) -> tuple[Any, ...]:
         wi, wo, *values = ctx.saved_tensors
         arrays = [_numpy(name, v) for name, v in zip(ctx.names, values)]
         wanted = list(ctx.needs_input_grad[5:])
@@ -107,7 +107,7 @@ def eval(material: Mapping[str, Any] | Material, wi: torch.Tensor, wo: torch.Ten
     double = _is_double(wi, wo, *values)
     dtype = torch.float64 if double else torch.float32
     wi, wo, *values = (_tensor(name, v, dtype) for name, v in zip(["wi", "wo", *names], [wi, wo, *values]))
-    return _Eval.apply(names, options, double, wi, wo, *values)
+    return _Eval.apply(names, options, double, wi, wo, *values)  # type: ignore[no-untyped-call]
 
 
 def pdf(material: Mapping[str, Any] | Material, wi: torch.Tensor, wo: torch.Tensor, **options: Any) -> torch.Tensor:
@@ -121,7 +121,7 @@ def pdf(material: Mapping[str, Any] | Material, wi: torch.Tensor, wo: torch.Tens
                                        _numpy("wo", wo).astype(np.float32, copy=False), **options))
 
 
-class Sample(NamedTuple):
+class TensorSample(NamedTuple):
     """:class:`principled_brdf.Sample` as tensors."""
 
     wi: torch.Tensor
@@ -130,7 +130,7 @@ class Sample(NamedTuple):
     lobe: torch.Tensor
 
 
-def sample(material: Mapping[str, Any] | Material, wo: torch.Tensor, **options: Any) -> Sample:
+def sample(material: Mapping[str, Any] | Material, wo: torch.Tensor, **options: Any) -> TensorSample:
     """:func:`principled_brdf.sample` on tensors (no gradient; float32 kernels, or
     the float64 reference for float64 inputs, which then needs ``u=``)."""
     names, values = _material_items(material)
@@ -142,4 +142,4 @@ def sample(material: Mapping[str, Any] | Material, wo: torch.Tensor, **options: 
         drawn = reference.sample(pb_material, _numpy("wo", wo), **options)
     else:
         drawn = _batch.sample(pb_material, _numpy("wo", wo).astype(np.float32, copy=False), **options)
-    return Sample(*(torch.from_numpy(np.asarray(a)) for a in drawn))
+    return TensorSample(*(torch.from_numpy(np.asarray(a)) for a in drawn))
