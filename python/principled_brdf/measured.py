@@ -115,17 +115,32 @@ def _centres() -> tuple[Float64Array, Float64Array, Float64Array]:
     return theta_h, i_d / MERL_SHAPE[1] * _HALF_PI, i_p / MERL_SHAPE[2] * np.pi
 
 
-def merl_pairs(phi_h: float = 0.0) -> tuple[Float64Array, Float64Array]:
+def _steps(step: int | tuple[int, int, int]) -> tuple[slice, slice, slice]:
+    """Every ``step``-th cell along (θh, θd, φd): one stride for all three axes or one per axis."""
+    values = step if isinstance(step, tuple) else (step,) * 3
+    if len(values) != 3 or any(isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer))
+                               for v in values):
+        raise TypeError(f"step: expected a positive integer or three (θh, θd, φd), got {step!r}")
+    if any(v < 1 for v in values):
+        raise ValueError(f"step: expected strides >= 1, got {step!r}")
+    return tuple(slice(None, None, int(v)) for v in values)  # type: ignore[return-value]
+
+
+def merl_pairs(phi_h: float = 0.0, *, step: int | tuple[int, int, int] = 1) -> tuple[Float64Array, Float64Array]:
     """(wi, wo), each ``(90 · 90 · 180, 3)``, at the cells' centres in the file's
     order, with the half vector at azimuth ``phi_h`` (radians; the table holds an
     isotropic BRDF, the same at every φh): the pairs to evaluate a model at, or to
     fit one to a table's :meth:`MerlBRDF.values`. Some lie below the horizon
-    (θh + θd > 90°)."""
+    (θh + θd > 90°). ``step``: every ``step``-th cell along each axis (an integer),
+    or along (θh, θd, φd) (three), in the same order as ``MerlBRDF.values(step=...)``:
+    a coarse subset of the table, e.g. ``step=(1, 3, 12)`` keeps every θh cell (the
+    specular peak's) and 1 in 36 of the others."""
     phi = _validate.as_real_array("phi_h", phi_h)
     if phi.ndim != 0:
         raise ValueError(f"phi_h: expected one angle in radians, got shape {phi.shape}")
     _validate.require_finite("phi_h", phi)
-    theta_h, theta_d, phi_d = _centres()
+    cells = _steps(step)
+    theta_h, theta_d, phi_d = (angle[cells] for angle in _centres())
     wi, wo = half_diff_to_wiwo(theta_h.reshape(-1), float(phi), theta_d.reshape(-1), phi_d.reshape(-1))
     return wi, wo
 
@@ -142,9 +157,10 @@ class MerlBRDF:
         _require_brdf_values("table", array)
         self.table = array
 
-    def values(self) -> Float64Array:
-        """f ``(90 · 90 · 180, 3)`` in :func:`merl_pairs`' order, NaN where missing."""
-        return self.table.reshape(3, -1).T.copy()
+    def values(self, *, step: int | tuple[int, int, int] = 1) -> Float64Array:
+        """f ``(90 · 90 · 180, 3)`` in :func:`merl_pairs`' order, NaN where missing; ``step``
+        as for :func:`merl_pairs` (every ``step``-th cell), in the same order."""
+        return self.table[(slice(None),) + _steps(step)].reshape(3, -1).T.copy()
 
     def eval(self, wi: RealArrayLike, wo: RealArrayLike,
              interpolation: Literal["nearest", "linear"] = "nearest") -> Float64Array:
