@@ -96,10 +96,12 @@ class MicrofacetSurface:
 
     def fresnel(self, cos_theta_d: RealArrayLike) -> Float64Array:
         """The unpolarised reflectance ``(..., 3)`` at ``cos θd = wi·h``."""
-        cos_theta_d = np.asarray(cos_theta_d, dtype=np.float64)[..., None]
-        if np.any(self.k > 0.0):
-            return _microfacet.fresnel_conductor(cos_theta_d, self.eta, self.k)
-        return _microfacet.fresnel_dielectric(cos_theta_d, self.eta)
+        cos_theta_d = np.asarray(cos_theta_d, dtype=np.float64)
+        if np.any(self.k > 0.0):  # a channel at a time: no (..., 3) copies of the broadcast arguments
+            channels = [_microfacet.fresnel_conductor(cos_theta_d, eta, k) for eta, k in zip(self.eta, self.k)]
+        else:
+            channels = [_microfacet.fresnel_dielectric(cos_theta_d, eta) for eta in self.eta]
+        return np.stack(channels, axis=-1)
 
     @property
     def f0(self) -> Float64Array:
