@@ -5,8 +5,12 @@ At ``metallic = 1`` the diffuse, subsurface and sheen lobes are weighted by
 at ``sheen = 0`` ``sheen_tint`` does nothing, at ``clearcoat = 0``
 ``clearcoat_gloss``. Whatever values such parameters took on the way are
 noise (a metal that ends with ``sheen = 1`` has no sheen), so they are set back
-to their start when that leaves f unchanged to the last bit at every sample:
-the fitted material, its cost and residuals are the same, only its reading is.
+to their start when that leaves f unchanged at every sample to float32's
+resolution (within 1e-6 of its largest value; a bound is reached only to
+the solver's tolerance, so ``1 - metallic`` may be 3e-8 rather than 0): the
+fitted f is the same, only its reading changes. The candidates are the
+parameters whose move back changes f by less than that to first order
+(``|∂f/∂p| |p - start| <= 1e-8 max |f|``).
 """
 
 from __future__ import annotations
@@ -17,6 +21,10 @@ import numpy as np
 
 from ._gradient import GRADIENT_NAMES
 from .material import PARAMETERS
+
+_FIRST_ORDER_CHANGE = 1e-8  # of max |f|: below float32's resolution (6e-8)
+_SAME_F = 1e-6  # of max |f|: f unchanged to float32's resolution
+_SHOWN_CHANGE = 1e-6  # a parameter set back from closer than this to its start is not named in the note
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -39,26 +47,31 @@ def _whole_parameters(slots: Sequence[int]) -> list[list[int]]:
 
 
 def reset(values: Float64Array, start: Float64Array, slots: Sequence[int], evaluate: Evaluate,
-          value: Value) -> list[str]:
+          value: Value) -> list[str] | None:
     """Sets back to ``start``, in ``values`` (13,) in place, the fitted parameters (``slots``)
-    whose derivative is zero at every sample, when f (``value``) is then unchanged bit for bit;
-    returns their names."""
+    whose derivative is (next to) zero at every sample, when f (``value``) is then unchanged
+    to 1e-6 of its largest value; returns the names of those that moved visibly (by more than
+    1e-6), or None when nothing was set back."""
     f, jacobian = evaluate(values)
+    resolution = _FIRST_ORDER_CHANGE * float(np.max(np.abs(f), initial=0.0))
     inert = [group for group in _whole_parameters(slots)
-             if not np.any(jacobian[..., group]) and np.any(values[group] != start[group])]
+             if np.any(values[group] != start[group])
+             and float(np.max(np.abs(jacobian[..., group] @ (values[group] - start[group])))) <= resolution]
     if not inert:
-        return []
+        return None
     moved = values.copy()
     for group in inert:
         moved[group] = start[group]
-    if not np.array_equal(value(moved), f):
-        return []
+    if not np.max(np.abs(value(moved) - f), initial=0.0) <= _SAME_F * float(np.max(np.abs(f), initial=0.0)):
+        return None
+    shown = [GRADIENT_NAMES[group[0]].removesuffix("_r") for group in inert
+             if np.max(np.abs(values[group] - start[group])) > _SHOWN_CHANGE]
     values[:] = moved
-    return [GRADIENT_NAMES[group[0]].removesuffix("_r") for group in inert]
+    return shown
 
 
-def note(reset_names: Sequence[Sequence[str]]) -> str | None:
-    """The result's note: which parameters went back to their start, in how many problems."""
+def note(reset_names: Sequence[Sequence[str]], problems: int) -> str | None:
+    """The result's note: which parameters went back to their start, in how many of the problems."""
     counted: dict[str, int] = {}
     for names in reset_names:
         for name in names:
@@ -66,6 +79,6 @@ def note(reset_names: Sequence[Sequence[str]]) -> str | None:
     if not counted:
         return None
     names = [name for name in PARAMETERS if name in counted]
-    where = "" if len(reset_names) == 1 else f" (in {max(counted.values())} of {len(reset_names)} problems)"
+    where = "" if problems == 1 else f" (in {max(counted.values())} of {problems} problems)"
     return (f"{', '.join(names)} set back to the start{where}: no effect on f at the fitted material "
-            "(e.g. the diffuse and sheen lobes of a metal, metallic = 1); f, cost and residuals unchanged")
+            "(e.g. the diffuse and sheen lobes of a metal, metallic = 1); f unchanged to float32's resolution")

@@ -299,6 +299,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     fitted = np.empty((count, len(GRADIENT_NAMES)))
     costs, iterations, success, messages = np.empty(count), np.empty(count, np.int64), np.empty(count, bool), []
     residuals_out = np.full(problems.shape, np.nan)
+    reset_names: list[list[str]] = []  # per problem, the parameters set back to their start
     dtype = np.float32 if precision == "float32" else np.float64
     with _one_blas_thread():
         for row in range(count):
@@ -345,18 +346,17 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
                                      bounds=(lower[slots], upper[slots]), method="trf", x_scale="jac",
                                      max_nfev=max_iterations)
             values[slots] = solution.x
+            moved = _inert.reset(values, start, slots, *_evaluators(wi_p, wo_p, model, precision))
+            reset_names.append(moved or [])
             fitted[row] = values
-            costs[row] = solution.cost
+            costs[row] = solution.cost if moved is None else \
+                0.5 * float(np.sum((evaluate(values[slots].copy())[0] * root_weight) ** 2))
             iterations[row] = solution.njev if solution.njev is not None else solution.nfev
             success[row] = solution.success
             messages.append(solution.message)
-            residuals_out[row][present] = evaluate(solution.x)[0]
+            residuals_out[row][present] = evaluate(values[slots].copy())[0]
 
-    reset_names = [_inert.reset(fitted[row], start, slots, *_evaluators(wi_rows[row][present], wo_rows[row][present],
-                                                                         model, precision))
-                   if slots and success[row] and (present := ~np.isnan(problems[row]).any(axis=-1)).any() else []
-                   for row in range(count)]
-    if (note := _inert.note(reset_names)) is not None:
+    if (note := _inert.note(reset_names, count)) is not None:
         notes.append(note)
     take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
     return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
@@ -369,10 +369,8 @@ def _evaluators(wi: Float64Array, wo: Float64Array, model: Model, precision: str
         Callable[[Float64Array], tuple[Float64Array, Float64Array]], Callable[[Float64Array], Float64Array]]:
     """f and ∂f/∂slot (13 columns), and f alone, at slot values (13,) over the pairs, in the fit's precision."""
     if precision == "float32":
-        wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
-
         def gradient(values: Float64Array) -> Any:
-            return eval_grad(_material_of(values), wi32, wo32, model=model, check=False)
+            return eval_grad(_material_of(values), wi, wo, model=model, check=False)
     else:
         def gradient(values: Float64Array) -> Any:
             return reference.eval_grad(_material_of(values), wi, wo, model=model)
