@@ -346,7 +346,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
                                      bounds=(lower[slots], upper[slots]), method="trf", x_scale="jac",
                                      max_nfev=max_iterations)
             values[slots] = solution.x
-            moved = _inert.reset(values, start, slots, *_evaluators(wi_p, wo_p, model, precision))
+            moved = _inert.reset(values, start, slots, *_evaluators(wi_rows[row][present], wo_rows[row][present], model, precision))
             reset_names.append(moved or [])
             fitted[row] = values
             costs[row] = solution.cost if moved is None else \

@@ -97,10 +97,11 @@ class MicrofacetSurface:
     def fresnel(self, cos_theta_d: RealArrayLike) -> Float64Array:
         """The unpolarised reflectance ``(..., 3)`` at ``cos θd = wi·h``."""
         cos_theta_d = np.asarray(cos_theta_d, dtype=np.float64)
-        if np.any(self.k > 0.0):  # a channel at a time: no (..., 3) copies of the broadcast arguments
-            channels = [_microfacet.fresnel_conductor(cos_theta_d, eta, k) for eta, k in zip(self.eta, self.k)]
+        eta_rgb, k_rgb = np.asarray(self.eta, dtype=np.float64), np.asarray(self.k, dtype=np.float64)
+        if np.any(k_rgb > 0.0):  # a channel at a time: no (..., 3) copies of the broadcast arguments
+            channels = [_microfacet.fresnel_conductor(cos_theta_d, eta, k) for eta, k in zip(eta_rgb, k_rgb)]
         else:
-            channels = [_microfacet.fresnel_dielectric(cos_theta_d, eta) for eta in self.eta]
+            channels = [_microfacet.fresnel_dielectric(cos_theta_d, eta) for eta in eta_rgb]
         return np.stack(channels, axis=-1)
 
     @property
@@ -109,19 +110,18 @@ class MicrofacetSurface:
         return self.fresnel(1.0)
 
     def __call__(self, wi: RealArrayLike, wo: RealArrayLike) -> Float64Array:
-        wi = np.asarray(_validate.directions("wi", wi), dtype=np.float64)
-        wo = np.asarray(_validate.directions("wo", wo), dtype=np.float64)
-        wi, wo = np.broadcast_arrays(wi, wo)
-        f = np.full(wi.shape, np.nan)
-        above = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0)
-        wi, wo = wi[above], wo[above]
-        wi = wi / np.linalg.norm(wi, axis=-1, keepdims=True)
-        wo = wo / np.linalg.norm(wo, axis=-1, keepdims=True)
-        h = wi + wo
+        light, view = np.broadcast_arrays(np.asarray(_validate.directions("wi", wi), dtype=np.float64),
+                                          np.asarray(_validate.directions("wo", wo), dtype=np.float64))
+        f = np.full(light.shape, np.nan)
+        above = (light[..., 2] > 0.0) & (view[..., 2] > 0.0)
+        l, v = light[above], view[above]
+        l = l / np.linalg.norm(l, axis=-1, keepdims=True)
+        v = v / np.linalg.norm(v, axis=-1, keepdims=True)
+        h = l + v
         h /= np.linalg.norm(h, axis=-1, keepdims=True)
-        dg = self.distribution.d(h) * self.distribution.g2(wi, wo)
-        specular = (dg / (4.0 * wi[:, 2] * wo[:, 2]))[:, None] * self.fresnel(np.sum(wi * h, axis=-1))
-        f[above] = self.specular_weight * specular + self.diffuse / np.pi
+        dg = self.distribution.d(h) * self.distribution.g2(l, v)
+        specular = (dg / (4.0 * l[:, 2] * v[:, 2]))[:, None] * self.fresnel(np.sum(l * h, axis=-1))
+        f[above] = self.specular_weight * specular + np.asarray(self.diffuse, dtype=np.float64) / np.pi
         return f
 
 
@@ -138,9 +138,8 @@ def conductor(metal: str | tuple[RealArrayLike, RealArrayLike], alpha: float, *,
     if isinstance(metal, str):
         if metal not in CONDUCTORS:
             raise ValueError(f"metal: expected one of {', '.join(CONDUCTORS)} or an (eta, k) pair, got {metal!r}")
-        eta, k = CONDUCTORS[metal]
-    else:
-        eta, k = metal
+        return MicrofacetSurface(_distribution(distribution, alpha), *CONDUCTORS[metal])
+    eta, k = metal
     return MicrofacetSurface(_distribution(distribution, alpha), eta, k)
 
 
