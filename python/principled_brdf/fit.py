@@ -19,7 +19,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _gradient, _validate
+from . import _gradient, _inert, _validate
+from ._loss_scale import log_scale
 from ._batch import eval_grad
 from ._gradient import GRADIENT_NAMES
 from .material import PARAMETERS, Material
@@ -38,7 +39,7 @@ __all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES"]
 # Default bounds for fitting: the domains, with the unbounded parameters held
 # to [0, 1] as the BRDF Explorer's sliders are (pass bounds= to widen them).
 FIT_BOUNDS = {name: (max(info.lower, 0.0), min(info.upper, 1.0)) for name, info in PARAMETERS.items()}
-LOSSES = ("log", "relative", "linear")
+LOSSES = ("scaled_log", "log", "relative", "linear")
 # The "relative" loss divides by max(m, _RELATIVE_FLOOR_FRACTION * max m, _RELATIVE_FLOOR) (1/sr):
 # the absolute floor keeps a black problem (every m = 0) finite; it then fits f towards 0.
 _RELATIVE_FLOOR_FRACTION = 1e-3
@@ -147,13 +148,14 @@ def _material_of(slot_values: Float64Array) -> Material:
 
 
 def _residual_and_jacobian(value: Float64Array, jacobian: Float64Array, measured: Float64Array,
-                           cos_theta: Float64Array, loss: str,
-                           scale: Float64Array) -> tuple[Float64Array, Float64Array]:
-    """Residuals r (n, 3) and dr/dslot (n, 3, 13) for one problem."""
-    if loss == "log":
-        model = value * cos_theta[:, None]
-        residual = np.log1p(model) - np.log1p(measured * cos_theta[:, None])
-        derivative = (cos_theta[:, None] / (1.0 + model))[..., None] * jacobian
+                           cos_theta: Float64Array, loss: str, scale: Float64Array,
+                           level: float) -> tuple[Float64Array, Float64Array]:
+    """Residuals r (n, 3) and dr/dslot (n, 3, 13) for one problem; ``scale`` the relative
+    loss's divisors (n, 3), ``level`` the log losses' s (1/sr)."""
+    if loss in ("log", "scaled_log"):
+        model = value * cos_theta[:, None] / level
+        residual = np.log1p(model) - np.log1p(measured * cos_theta[:, None] / level)
+        derivative = (cos_theta[:, None] / (level * (1.0 + model)))[..., None] * jacobian
     elif loss == "relative":
         residual = (value - measured) / scale
         derivative = jacobian / scale[..., None]
@@ -198,7 +200,7 @@ def _one_blas_thread() -> Iterator[None]:
 
 def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
         init: Material | dict[str, Any] | None = None, fit: str | list[str] | tuple[str, ...] | None = None,
-        loss: Literal["log", "relative", "linear"] = "log", weights: RealArrayLike | None = None,
+        loss: Literal["scaled_log", "log", "relative", "linear"] = "scaled_log", weights: RealArrayLike | None = None,
         bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None = None, model: Model = "disney2014",
         cosine: bool = True, precision: Literal["float32", "float64"] = "float32",
         max_iterations: SupportsIndex = 200) -> FitResult:
@@ -214,8 +216,11 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     ``anisotropic`` is held at its start when the pairs cannot determine it:
     every half vector in one plane through the normal, as a MERL table's
     pairs; the result's ``notes`` and ``summary()`` say so).
-    ``loss``: ``"log"`` (``log(1 + f c) - log(1 + m c)``, c = cos θl if
-    ``cosine`` else 1: robust over the dynamic range of specular peaks),
+    ``loss``: ``"scaled_log"`` (the default: ``log(1 + f c / s) - log(1 + m c / s)``,
+    c = cos θl if ``cosine`` else 1, s the median of the problem's m c but at
+    least a tenth of their mean: logarithmic over the specular peak's decades,
+    the same for a bright and a dim material), ``"log"`` (the same with
+    s = 1/sr),
     ``"relative"`` (``(f - m) / max(m, 1e-3 max m, 1e-9)``, max m over the
     problem's samples: the floors keep zero measurements finite, and a black
     problem, every m = 0, fits f towards 0) or ``"linear"`` (``(f - m) c``).
@@ -294,6 +299,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     fitted = np.empty((count, len(GRADIENT_NAMES)))
     costs, iterations, success, messages = np.empty(count), np.empty(count, np.int64), np.empty(count, bool), []
     residuals_out = np.full(problems.shape, np.nan)
+    reset_names: list[list[str]] = []  # per problem, the parameters set back to their start
     dtype = np.float32 if precision == "float32" else np.float64
     with _one_blas_thread():
         for row in range(count):
@@ -308,6 +314,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
             m = target[present]
             cos_theta = np.maximum(wi_rows[row][present][:, 2], 0.0) if cosine else np.ones(len(m))
             scale = np.maximum(m, max(_RELATIVE_FLOOR_FRACTION * float(m.max()), _RELATIVE_FLOOR))
+            level = log_scale(m, cos_theta) if loss == "scaled_log" else 1.0
             root_weight = np.sqrt(weights[row][present])[:, None] if weights is not None else np.ones((len(m), 1))
             values = start.copy()
             last: dict[str, Float64Array] = {}
@@ -322,7 +329,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
                     else:
                         g = reference.eval_grad(material, wi_p, wo_p, model=model)
                     r, d = _residual_and_jacobian(g.value.astype(np.float64), g.jacobian.astype(np.float64), m,
-                                                  cos_theta, loss, scale)
+                                                  cos_theta, loss, scale, level)
                     last.update(x=x.copy(), r=r, d=d[..., slots])
                 return last["r"], last["d"]
 
@@ -339,18 +346,39 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
                                      bounds=(lower[slots], upper[slots]), method="trf", x_scale="jac",
                                      max_nfev=max_iterations)
             values[slots] = solution.x
+            moved = _inert.reset(values, start, slots, *_evaluators(wi_rows[row][present], wo_rows[row][present], model, precision))
+            reset_names.append(moved or [])
             fitted[row] = values
-            costs[row] = solution.cost
+            costs[row] = solution.cost if moved is None else \
+                0.5 * float(np.sum((evaluate(values[slots].copy())[0] * root_weight) ** 2))
             iterations[row] = solution.njev if solution.njev is not None else solution.nfev
             success[row] = solution.success
             messages.append(solution.message)
-            residuals_out[row][present] = evaluate(solution.x)[0]
+            residuals_out[row][present] = evaluate(values[slots].copy())[0]
 
+    if (note := _inert.note(reset_names, count)) is not None:
+        notes.append(note)
     take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
     return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
                      residuals=take(residuals_out), iterations=take(iterations), success=take(success),
                      message=tuple(messages) if batched else messages[0], names=tuple(GRADIENT_NAMES[k] for k in slots),
                      notes=tuple(notes))
+
+
+def _evaluators(wi: Float64Array, wo: Float64Array, model: Model, precision: str) -> tuple[
+        Callable[[Float64Array], tuple[Float64Array, Float64Array]], Callable[[Float64Array], Float64Array]]:
+    """f and ∂f/∂slot (13 columns), and f alone, at slot values (13,) over the pairs, in the fit's precision."""
+    if precision == "float32":
+        def gradient(values: Float64Array) -> Any:
+            return eval_grad(_material_of(values), wi, wo, model=model, check=False)
+    else:
+        def gradient(values: Float64Array) -> Any:
+            return reference.eval_grad(_material_of(values), wi, wo, model=model)
+
+    def both(values: Float64Array) -> tuple[Float64Array, Float64Array]:
+        g = gradient(values)
+        return g.value, g.jacobian
+    return both, lambda values: gradient(values).value
 
 
 def _determines_anisotropy(wi: NDArray[Any], wo: NDArray[Any]) -> bool:
