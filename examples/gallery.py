@@ -1,6 +1,6 @@
 """Writes the README's gallery (docs/gallery/*.png) with the library's own plots.
 
-    python examples/gallery.py [output directory]
+    python examples/gallery.py [output directory [picture names...]]
 
 Every picture comes from a public function (pb.plot, pb.render, the demo's
 picture), at its default settings unless a caption says otherwise, so the
@@ -26,15 +26,41 @@ DPI = 80
 
 def presets(path: str) -> None:
     names = pb.presets.names()
-    spheres = [pb.render.render_sphere(pb.presets.get(name), 128, samples=256) for name in names]
+    spheres = [pb.render.render_sphere(pb.presets.get(name), 128, environment="studio") for name in names]
     demo.write_picture(path, spheres, list(names), columns=5)
 
 
 def metals(path: str) -> None:
     roughness = np.linspace(0.05, 1.0, 6)
-    materials = [pb.presets.get(name).replace(roughness=r) for name in ("gold", "chrome") for r in roughness]
-    labels = [f"{name}, r = {r:.2f}" for name in ("gold", "chrome") for r in roughness]
-    demo.write_picture(path, [pb.render.render_sphere(m, 128, samples=256) for m in materials], labels, columns=6)
+    names = ("gold", "copper", "chrome")
+    materials = [pb.presets.get(name).replace(roughness=r) for name in names for r in roughness]
+    labels = [f"{name}, r = {r:.2f}" for name in names for r in roughness]
+    demo.write_picture(path, [pb.render.render_sphere(m, 128, environment="studio") for m in materials], labels,
+                       columns=6)
+
+
+ENVIRONMENT_PRESETS = ("chrome", "gold", "copper", "car_paint", "white_plastic", "blue_rubber")
+
+
+def environments(path: str) -> None:
+    """The built-in maps as panoramas, then presets under the sky, the studio and outdoors."""
+    spheres, titles = [], []
+    for environment in ("sky", "studio", "outdoor"):
+        spheres += [pb.render.render_sphere(pb.presets.get(name), 128, environment=environment)
+                    for name in ENVIRONMENT_PRESETS]
+        titles.append(environment)
+    labels = list(ENVIRONMENT_PRESETS) + [""] * (len(spheres) - len(ENVIRONMENT_PRESETS))
+    demo.write_picture(path, spheres, labels, columns=len(ENVIRONMENT_PRESETS), row_titles=titles)
+
+
+def environment_maps(path: str) -> None:
+    """The studio and outdoor maps side by side, tone mapped (each 256 x 512, a 2 x 2 mean of the map)."""
+    panoramas = []
+    for name in ("studio", "outdoor"):
+        image = pb.render.environment_of(name).image
+        panoramas.append(image.reshape(256, 2, 512, 2, 3).mean(axis=(1, 3)))
+    gap = np.zeros((256, 8, 3))
+    pb.render.save_image(path, np.concatenate([panoramas[0], gap, panoramas[1]], axis=1))
 
 
 def plots(path: str) -> None:
@@ -75,12 +101,16 @@ def shrink(path: str) -> None:
     rgb.quantize(palette=palette, dither=Image.Dither.FLOYDSTEINBERG).save(path, optimize=True)
 
 
-def main(directory: str) -> None:
+def main(directory: str, only: list[str] | None = None) -> None:
+    """Write every picture, or those named in ``only``."""
     os.makedirs(directory, exist_ok=True)
     pictures = [("demo", lambda path: demo.run(pairs=1 << 16, output=path, repeats=1, report=lambda message: None)),
-                ("presets", presets), ("metals", metals), ("plots", plots), ("parameter_sweep", sweep),
+                ("presets", presets), ("metals", metals), ("environments", environments),
+                ("environment_maps", environment_maps), ("plots", plots), ("parameter_sweep", sweep),
                 ("microfacet_family", family)]
     for name, draw in pictures:
+        if only and name not in only:
+            continue
         path = os.path.join(directory, f"{name}.png")
         draw(path)
         shrink(path)
@@ -88,4 +118,5 @@ def main(directory: str) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "docs", "gallery"))
+    main(sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "docs", "gallery"),
+         sys.argv[2:])

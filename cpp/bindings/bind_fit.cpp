@@ -33,7 +33,8 @@ void require_shape(const py::array& a, const std::vector<py::ssize_t>& shape, co
 // (count, P (P + 1) / 2), (count, P) and (count,) float64 arrays.
 py::tuple normal_equations(const Float32Array& wi, const Float32Array& wo, const Float32Array& slots,
                            const Float32Array& target, const Float32Array& scale, const Int64Array& problems,
-                           const py::object& columns, int loss, bool cosine, int model, int threads, const std::string& isa) {
+                           const py::object& columns, int loss, bool cosine, int model, int threads, const std::string& isa,
+                           const py::object& gain) {
     if (target.ndim() != 3 || target.shape(2) != 3) throw std::invalid_argument("target: expected a (B, N, 3) array");
     const py::ssize_t count = target.shape(0), pairs = target.shape(1);
     require_shape(scale, {count, pairs, 3}, "scale");
@@ -47,6 +48,11 @@ py::tuple normal_equations(const Float32Array& wi, const Float32Array& wo, const
         }
     }
     if (wo.ndim() != wi.ndim()) throw std::invalid_argument("wi, wo: expected the same shape");
+    Float32Array gains;
+    if (!gain.is_none()) {
+        gains = py::cast<Float32Array>(gain);
+        require_shape(gains, {count}, "gain");
+    }
     if (problems.ndim() != 1) throw std::invalid_argument("problems: expected a 1-d array of problem indices");
     const py::ssize_t n = problems.shape(0);
     for (py::ssize_t j = 0; j < n; ++j)
@@ -62,6 +68,7 @@ py::tuple normal_equations(const Float32Array& wi, const Float32Array& wo, const
     job.slots = slots.data();
     job.target = target.data();
     job.scale = scale.data();
+    job.gain = gain.is_none() ? nullptr : gains.data();
     job.problems = problems.data();
     job.model = model_from(model);
     job.loss = static_cast<Loss>(loss);
@@ -153,8 +160,8 @@ Float64Array damped_steps(const Float64Array& normal, const Float64Array& gradie
 void bind_fit(py::module_& m) {
     m.def("normal_equations", &normal_equations, py::kw_only(), py::arg("wi"), py::arg("wo"), py::arg("slots"),
           py::arg("target"), py::arg("scale"), py::arg("problems"), py::arg("columns"), py::arg("loss"),
-          py::arg("cosine"), py::arg("model"), py::arg("threads") = 0, py::arg("isa") = "",
-          "(normal, gradient, cost) of the residuals (u(f) - target) scale of each listed problem, by the SIMD "
+          py::arg("cosine"), py::arg("model"), py::arg("threads") = 0, py::arg("isa") = "", py::arg("gain") = py::none(),
+          "(normal, gradient, cost) of the residuals (u(gain f) - target) scale of each listed problem, by the SIMD "
           "kernels: JᵀJ's upper triangle by rows, Jᵀr and Σ r² (float64).");
     m.def("damped_steps", &damped_steps, py::arg("normal"), py::arg("gradient"), py::arg("damping"), py::arg("free"),
           "Per problem, δ solving (A + diag(damping)) δ = -gradient over the free parameters (0 for the others; "

@@ -37,23 +37,24 @@ struct NormalSums {
     }
 };
 
-// r = (u(f) - t) s and ∂r/∂f = u'(f) s for one channel of a batch.
+// r = (u(x) - t) s and ∂r/∂x = u'(x) s for one channel of a batch.
 struct ChannelResidual {
     Floats residual, slope;
 };
 
-PB_KERNEL_INLINE ChannelResidual channel_residual(Loss loss, Floats f, Floats target, Floats scale) {
-    if (loss == Loss::kLog) return {(xsimd::log1p(f) - target) * scale, scale / (Floats(1.0f) + f)};
-    return {(f - target) * scale, scale};
+PB_KERNEL_INLINE ChannelResidual channel_residual(Loss loss, Floats x, Floats target, Floats scale) {
+    if (loss == Loss::kLog) return {(xsimd::log1p(x) - target) * scale, scale / (Floats(1.0f) + x)};
+    return {(x - target) * scale, scale};
 }
 
 // One batch of kLanes pairs of a problem: its cost and Jᵀr into the sums, its
 // scaled columns ∂r_c/∂p_k into `column` for JᵀJ (add_normal_tile). wi, wo,
-// target and scale point at the batch's first pair ((kLanes, 3) each).
+// target and scale point at the batch's first pair ((kLanes, 3) each), gain
+// is the problem's g.
 template <Model model>
 PB_KERNEL_INLINE void add_normal_batch(const NormalEquationsJob& job, const Prepared<Output::kGradient>& material,
                                        const float* wi_data, const float* wo_data, const float* target_data,
-                                       const float* scale_data, BatchColumns& column, NormalSums& sums) {
+                                       const float* scale_data, Floats gain, BatchColumns& column, NormalSums& sums) {
     Vec3<Floats> wi, wo;
     load_interleaved(wi_data, wi.x, wi.y, wi.z);
     load_interleaved(wo_data, wo.x, wo.y, wo.z);
@@ -70,8 +71,10 @@ PB_KERNEL_INLINE void add_normal_batch(const NormalEquationsJob& job, const Prep
     load_interleaved(target_data, target.r, target.g, target.b);
     load_interleaved(scale_data, scale.r, scale.g, scale.b);
     ChannelResidual channel[3];
-    for (int c = 0; c < 3; ++c)
-        channel[c] = channel_residual(job.loss, masked(channel_of(f, c)), channel_of(target, c), channel_of(scale, c));
+    for (int c = 0; c < 3; ++c) {
+        channel[c] = channel_residual(job.loss, gain * masked(channel_of(f, c)), channel_of(target, c), channel_of(scale, c));
+        channel[c].slope *= gain;  // ∂r/∂f = u'(g f) g s
+    }
 
     alignas(64) float squares[kLanes];
     mul_add(channel[0].residual, channel[0].residual,
@@ -137,6 +140,7 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
     RawMaterial m;
     for (int s = 0; s < kParamSlots; ++s) m.slot[s] = Floats(job.slots[b * kParamSlots + s]);
     const Prepared<Output::kGradient> material = prepare<Output::kGradient>(m);
+    const Floats gain(job.gain != nullptr ? job.gain[b] : 1.0f);
     const std::int64_t directions = job.per_problem_directions ? 3 * n * b : 0;
     const float* wi = job.wi + directions;
     const float* wo = job.wo + directions;
@@ -148,7 +152,7 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
     int batches = 0;  // in the tile
     std::int64_t i = 0;
     for (; i + kLanes <= n; i += kLanes) {
-        add_normal_batch<model>(job, material, wi + 3 * i, wo + 3 * i, target + 3 * i, scale + 3 * i, tile[batches], sums);
+        add_normal_batch<model>(job, material, wi + 3 * i, wo + 3 * i, target + 3 * i, scale + 3 * i, gain, tile[batches], sums);
         if (++batches == kNormalTile) {
             add_normal_tile(tile, batches, width, sums);
             batches = 0;
@@ -165,7 +169,7 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
                 scale_pad[3 * lane + c] = i + lane < n ? scale[3 * e + c] : 0.0f;
             }
         }
-        add_normal_batch<model>(job, material, wi_pad, wo_pad, target_pad, scale_pad, tile[batches], sums);
+        add_normal_batch<model>(job, material, wi_pad, wo_pad, target_pad, scale_pad, gain, tile[batches], sums);
         ++batches;
     }
     if (batches > 0) add_normal_tile(tile, batches, width, sums);

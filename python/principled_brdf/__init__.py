@@ -3,7 +3,8 @@
 See the README for the model and the API tour.
 """
 
-from . import frames, measured, microfacet, plot, presets, reference, render
+from . import (environment, frames, measured, microfacet, piecewise, plot, presets, procedural_environments, reference,
+               render, synthetic)
 from .fit import FitResult, fit
 from ._batch import Lobes, Sample, ValuePdf, cpu_info, eval, eval_grad, eval_lobes, eval_vjp, eval_pdf, pdf, random_uniforms, sample
 from ._gradient import GRADIENT_NAMES, Gradient
@@ -15,7 +16,8 @@ __all__ = [
     "eval", "eval_lobes", "eval_pdf", "pdf", "sample", "random_uniforms", "cpu_info",
     "Lobes", "Sample", "ValuePdf", "Albedo", "albedo",
     "eval_grad", "eval_vjp", "Gradient", "GRADIENT_NAMES", "fit", "FitResult",
-    "reference", "microfacet", "measured", "frames", "presets", "render", "plot",
+    "reference", "microfacet", "measured", "synthetic", "frames", "presets", "render", "plot",
+    "environment", "procedural_environments", "piecewise",
 ]
 from .explorer import explorer  # noqa: E402 - ipywidgets and matplotlib are imported by the call
 __all__.append("explorer")

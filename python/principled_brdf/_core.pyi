@@ -198,8 +198,9 @@ def normal_equations(
     model: _Int,
     threads: _Int = 0,
     isa: str = "",
+    gain: _Float32In | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """(normal, gradient, cost) of the residuals (u(f) - target) scale of each listed problem, by the SIMD kernels: JᵀJ's upper triangle by rows, Jᵀr and Σ r² (float64)."""
+    """(normal, gradient, cost) of the residuals (u(gain f) - target) scale of each listed problem, by the SIMD kernels: JᵀJ's upper triangle by rows, Jᵀr and Σ r² (float64)."""
 
 def damped_steps(
     normal: NDArray[np.float64],

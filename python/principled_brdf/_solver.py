@@ -185,26 +185,29 @@ def levenberg_marquardt(equations: NormalEquations, start: Float64Array, lower: 
 
 
 def float32_equations(wi: NDArray[Any], wo: NDArray[Any], target: NDArray[np.float32], scale: NDArray[np.float32],
-                      full_start: Float64Array, fitted: list[int], problems: NDArray[np.int64], loss: int,
-                      cosine: bool, model: int, threads: int = 0, isa: str = "") -> NormalEquations:
-    """The normal equations by the SIMD kernels: wi, wo (N, 3) or (B, N, 3)
-    float32, target and scale (B, N, 3), the start's slots (B, 13) holding the
-    parameters not fitted, ``fitted`` the slots fitted (increasing); the
-    solver's problem j is row ``problems[j]`` of these arrays."""
+                      gain: NDArray[np.float32], full_start: Float64Array, fitted: list[int],
+                      problems: NDArray[np.int64], loss: int, cosine: bool, model: int, threads: int = 0,
+                      isa: str = "") -> NormalEquations:
+    """The normal equations by the SIMD kernels of r = (u(g f) - t) s: wi, wo
+    (N, 3) or (B, N, 3) float32, target t and scale s (B, N, 3), gain g (B,),
+    the start's slots (B, P) holding the parameters not fitted, ``fitted`` the
+    slots fitted (increasing); the solver's problem j is row ``problems[j]`` of
+    these arrays."""
     slots = np.ascontiguousarray(full_start, dtype=np.float32)
     fitted_index = np.asarray(fitted, dtype=np.int64)
 
     def evaluate(rows: NDArray[np.int64], x: Float64Array) -> tuple[Float64Array, Float64Array, Float64Array]:
         rows = problems[rows]
         slots[np.ix_(rows, fitted_index)] = x
-        return _core.normal_equations(wi=wi, wo=wo, slots=slots, target=target, scale=scale, problems=rows,
+        return _core.normal_equations(wi=wi, wo=wo, slots=slots, target=target, scale=scale, gain=gain, problems=rows,
                                       columns=fitted, loss=loss, cosine=cosine, model=model, threads=threads, isa=isa)
 
     return NormalEquations(evaluate)
 
 
 def float64_equations(material_of: Callable[[Float64Array], Any], wi: NDArray[Any], wo: NDArray[Any],
-                      target: Float64Array, scale: Float64Array, full_start: Float64Array, fitted: list[int],
+                      target: Float64Array, scale: Float64Array, gain: Float64Array, full_start: Float64Array,
+                      fitted: list[int],
                       problems: NDArray[np.int64], loss: int, cosine: bool, model: Model,
                       chunk_bytes: int = 1 << 26) -> NormalEquations:
     """The normal equations from the float64 reference's Jacobian, reduced by
@@ -230,7 +233,7 @@ def float64_equations(material_of: Callable[[Float64Array], Any], wi: NDArray[An
             material = material_of(slots[part]).reshape(len(part), 1)
             g = reference.eval_grad(material, wi[part] if per_problem else wi, wo[part] if per_problem else wo,
                                     model=model, cosine=cosine)
-            f, jacobian = g.value, g.jacobian[..., fitted]
+            f, jacobian = g.value * gain[part][:, None, None], g.jacobian[..., fitted] * gain[part][:, None, None, None]
             t, s = target[part], scale[part]
             if loss == 1:
                 r, slope = (np.log1p(f) - t) * s, s / (1.0 + f)

@@ -4,10 +4,12 @@ Every subcommand has ``--help``; bad arguments print a one-line error and
 exit with status 2. The numeric options are bounded so that a job fits in
 memory and ends: ``--pairs`` at most 2^27, ``--repeats`` 1 to 100 with
 pairs x repeats at most 2^31, ``--resolution`` 2 to 16384, ``--samples`` 1 to
-65536 per pixel with resolution² x samples at most 2^34 (with the sky),
+65536 per pixel with resolution² x samples at most 2^34 (with an environment),
 ``--exposure`` finite, > 0 and at most 1e20, ``--light`` three finite numbers
-not all 0, ``--param`` values inside their domains and what the kernels take
-(``roughness`` up to 1e4, the others up to 1e20).
+not all 0, ``--light-intensity`` finite, >= 0 and at most 1e20, ``--param``
+values inside their domains and what the kernels take (``roughness`` up to
+1e4, the others up to 1e20), ``--environment`` a built-in name or an existing
+``.exr``/``.hdr`` file, ``--tone`` one of the tone curves.
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ import numpy as np
 
 from ._batch import FLOAT32_LIMITS
 from .material import PARAMETERS, Material
-from .render import MAX_RESOLUTION, MAX_SAMPLE_WORK, MAX_SAMPLES
+from .environment import MAP_FORMATS
+from .render import ENVIRONMENT_NAMES, MAX_RESOLUTION, MAX_SAMPLE_WORK, MAX_SAMPLES
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -80,6 +83,33 @@ def _exposure(text: str) -> float:
     return value
 
 
+def _intensity(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (np.isfinite(value) and 0.0 <= value <= MAX_EXPOSURE):
+        raise argparse.ArgumentTypeError(f"expected a finite number >= 0 and at most {MAX_EXPOSURE:g}, got {text!r}")
+    return value
+
+
+ENVIRONMENT_CHOICES = ENVIRONMENT_NAMES + ("none",)
+
+
+def _environment(text: str) -> str:
+    """A built-in environment's name, ``none``, or an existing ``.exr``/``.hdr`` map."""
+    import os
+
+    if text in ENVIRONMENT_CHOICES:
+        return text
+    if os.path.splitext(text)[1].lower() not in MAP_FORMATS:
+        raise argparse.ArgumentTypeError(f"expected {', '.join(ENVIRONMENT_CHOICES)} or a "
+                                         f"{'/'.join(MAP_FORMATS)} latitude-longitude map, got {text!r}")
+    if not os.path.isfile(text):
+        raise argparse.ArgumentTypeError(f"no such file: {text!r}")
+    return text
+
+
 def _vector(text: str) -> tuple[float, ...]:
     try:
         values = tuple(float(v) for v in text.split(","))
@@ -135,7 +165,7 @@ def _timing_limits(args: argparse.Namespace) -> str | None:
 def _render_limits(args: argparse.Namespace) -> str | None:
     """What is wrong with render's options together, or None."""
     pixels = args.resolution * args.resolution
-    if args.environment and pixels * args.samples > MAX_SAMPLE_WORK:
+    if args.environment != "none" and args.samples is not None and pixels * args.samples > MAX_SAMPLE_WORK:
         return (f"argument --samples: {args.samples} per pixel at {args.resolution}x{args.resolution} is "
                 f"{pixels * args.samples} samples, beyond {MAX_SAMPLE_WORK} (2^34); at most "
                 f"{max(MAX_SAMPLE_WORK // pixels, 1)} per pixel at this resolution")
@@ -155,11 +185,15 @@ def _render(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     params = presets.parameters(args.preset) if args.preset else {}
     params.update(dict(args.param or []))
     material = Material(**params)
-    lighting = f"a key light and a sky ({args.samples} samples per pixel)" if args.environment else "a key light"
+    environment = None if args.environment == "none" else args.environment
+    lighting = "a key light" if environment is None else f"the {environment} environment"
+    if environment is not None and args.samples is not None:
+        lighting += f" ({args.samples} samples per pixel)"
     report(f"rendering {material} at {args.resolution}x{args.resolution} under {lighting} ...")
-    image = render_sphere(material, resolution=args.resolution, light=args.light, model=args.model,
-                          environment="sky" if args.environment else None, samples=args.samples)
-    save_image(args.output, image, exposure=args.exposure)
+    image = render_sphere(material, resolution=args.resolution, light=args.light, light_intensity=args.light_intensity,
+                          model=args.model, environment=environment, samples=args.samples,
+                          energy_compensation=args.energy_compensation)
+    save_image(args.output, image, exposure=args.exposure, curve=args.tone)
     report(f"wrote {args.output}")
 
 
@@ -198,24 +232,36 @@ def build_parser() -> argparse.ArgumentParser:
     demo.set_defaults(run=_demo, limits=_timing_limits)
 
     render = commands.add_parser("render", help="render a preset or parameters on a lit sphere (PNG, EXR, NPY)",
-                                 description="Render a material on a sphere lit by a directional light and a sky.")
+                                 description="Render a material on a sphere lit by an environment (and a key light).")
     from . import presets
-    from .render import DEFAULT_SAMPLES, IMAGE_FORMATS
+    from .render import DEFAULT_MAP_SAMPLES, DEFAULT_SAMPLES, IMAGE_FORMATS, TONE_CURVES
 
     render.add_argument("--preset", choices=presets.names(), help="start from a named preset")
     render.add_argument("--param", action="append", type=_parameter, metavar="NAME=VALUE",
                         help="set a parameter (repeatable), e.g. roughness=0.3 or base_color=0.9,0.6,0.2")
     render.add_argument("--resolution", type=_at_most(MAX_RESOLUTION, "pixels", lower=2), default=512,
                         help="image size in pixels (default 512)")
+    render.add_argument("--environment", type=_environment, default="studio", metavar="ENVIRONMENT",
+                        help="the light all around: studio (default: softboxes in a dark studio), outdoor (sky, sun, "
+                             "a tiled ground), sky (a plain gradient), none, or a latitude-longitude map PATH.exr or "
+                             "PATH.hdr")
+    render.add_argument("--no-environment", dest="environment", action="store_const", const="none",
+                        help="the same as --environment none: the key light alone")
     render.add_argument("--light", type=_vector, default=(-0.5, 0.6, 0.75),
-                        help="direction towards the light, camera space x,y,z (default -0.5,0.6,0.75)")
-    render.add_argument("--environment", action=argparse.BooleanOptionalAction, default=True,
-                        help="light by the sky too (default; --no-environment: the key light alone)")
-    render.add_argument("--samples", type=_at_most(MAX_SAMPLES, "samples per pixel"), default=DEFAULT_SAMPLES,
-                        help=f"sky samples per pixel (default {DEFAULT_SAMPLES}, at most {MAX_SAMPLES}, and "
-                             "resolution² x samples at most 2^34)")
+                        help="direction towards the key light, camera space x,y,z (default -0.5,0.6,0.75)")
+    render.add_argument("--light-intensity", type=_intensity, default=None,
+                        help="the key light's irradiance (default 3 with sky or none, 0 with a map: it brings its "
+                             "own lights)")
+    render.add_argument("--samples", type=_at_most(MAX_SAMPLES, "samples per pixel"), default=None,
+                        help=f"environment samples per pixel (default {DEFAULT_SAMPLES} with sky, "
+                             f"{DEFAULT_MAP_SAMPLES} with a map; at most {MAX_SAMPLES}, and resolution² x samples "
+                             "at most 2^34)")
     render.add_argument("--exposure", type=_exposure, default=1.0,
                         help="scale before tone mapping, or of the linear values in EXR/NPY (default 1)")
+    render.add_argument("--tone", choices=TONE_CURVES, default="filmic",
+                        help="the tone curve of a PNG (default filmic; EXR and NPY stay linear)")
+    render.add_argument("--energy-compensation", action=argparse.BooleanOptionalAction, default=False,
+                        help="add the multiple-scattering lobe of rough metals (default off)")
     render.add_argument("--model", choices=("disney2014", "disney2012"), default="disney2014")
     render.add_argument("--output", required=True, type=_image_path(tuple(IMAGE_FORMATS)),
                         help="file to write: .png (tone mapped, sRGB), .exr or .npy (linear float32)")

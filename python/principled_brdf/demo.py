@@ -87,7 +87,7 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
     write_picture(output, images, labels, columns=len(PICTURE_PRESETS), row_titles=titles)
     report(f"wrote {output}: presets {', '.join(PICTURE_PRESETS)} (top); below, a white and a gold metal from "
            f"roughness {SWEEP_ROUGHNESS[0]:g} to {SWEEP_ROUGHNESS[-1]:g}, each without and with energy_compensation "
-           "(Kulla & Conty 2017), under a sky and a key light")
+           "(Kulla & Conty 2017), in the studio environment (softboxes, a dark surround)")
     return {"rates": rates, "max_relative_error": error, "white_furnace": furnace, "output": output}
 
 
@@ -108,13 +108,17 @@ def picture_spheres(resolution: int = PICTURE_RESOLUTION) -> tuple[list[Float32A
     return images, labels, titles
 
 
+PICTURE_ENVIRONMENT = "studio"  # softboxes in a dark studio: metals read as the metal they are
+PICTURE_SAMPLES = 256  # map samples per pixel: no visible grain on a glossy metal under the softboxes
+
+
 def lit_sphere(material: Material, resolution: int = PICTURE_RESOLUTION, *,
                energy_compensation: bool = False) -> Float32Array:
-    """A sphere under render_sphere's key light and default sky (linear RGB), with 256
-    sky samples per pixel: no grain where a rough metal reflects the dark ground.
-    ``material`` of leading shape ``S + (1, 1)`` gives ``S`` spheres (``render_sphere``);
-    ``energy_compensation`` as in ``pb.eval``."""
-    return render_sphere(material, resolution, samples=256, energy_compensation=energy_compensation)
+    """A sphere in :data:`PICTURE_ENVIRONMENT` (render_sphere, linear RGB) with
+    :data:`PICTURE_SAMPLES` per pixel. ``material`` of leading shape ``S + (1, 1)``
+    gives ``S`` spheres (``render_sphere``); ``energy_compensation`` as in ``pb.eval``."""
+    return render_sphere(material, resolution, environment=PICTURE_ENVIRONMENT, samples=PICTURE_SAMPLES,
+                         energy_compensation=energy_compensation)
 
 
 def write_picture(output: str, images: Sequence[FloatArray], labels: Sequence[str], columns: int,

@@ -23,7 +23,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _gradient, _solver, _validate
+from . import _gradient, _inert, _solver, _validate
+from ._loss_scale import log_scale
 from ._batch import eval, eval_grad
 from ._gradient import GRADIENT_NAMES
 from .material import PARAMETERS, Material
@@ -38,14 +39,16 @@ if TYPE_CHECKING:
     from ._typing import Float64Array, Model, RealArrayLike
 
     # fitted slots, costs, iterations, success, messages, residuals: per problem
-    _FitArrays = tuple[Float64Array, Float64Array, NDArray[np.int64], NDArray[np.bool_], list[str], Float64Array]
+    # and per problem the parameters set back to their start (module _inert)
+    _FitArrays = tuple[Float64Array, Float64Array, NDArray[np.int64], NDArray[np.bool_], list[str], Float64Array,
+                       list[list[str]]]
 
 __all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES", "METHODS"]
 
 # Default bounds for fitting: the domains, with the unbounded parameters held
 # to [0, 1] as the BRDF Explorer's sliders are (pass bounds= to widen them).
 FIT_BOUNDS = {name: (max(info.lower, 0.0), min(info.upper, 1.0)) for name, info in PARAMETERS.items()}
-LOSSES = ("log", "relative", "linear")
+LOSSES = ("scaled_log", "log", "relative", "linear")
 METHODS = ("batched", "scipy")
 # The batched solver stops when a taken step lowers the cost by less than this
 # fraction: the float32 kernels' cost is exact to about 1e-7 of itself.
@@ -158,13 +161,14 @@ def _material_of(slot_values: Float64Array) -> Material:
 
 
 def _residual_and_jacobian(value: Float64Array, jacobian: Float64Array, measured: Float64Array,
-                           cos_theta: Float64Array, loss: str,
-                           scale: Float64Array) -> tuple[Float64Array, Float64Array]:
-    """Residuals r (n, 3) and dr/dslot (n, 3, 13) for one problem."""
-    if loss == "log":
-        model = value * cos_theta[:, None]
-        residual = np.log1p(model) - np.log1p(measured * cos_theta[:, None])
-        derivative = (cos_theta[:, None] / (1.0 + model))[..., None] * jacobian
+                           cos_theta: Float64Array, loss: str, scale: Float64Array,
+                           level: float) -> tuple[Float64Array, Float64Array]:
+    """Residuals r (n, 3) and dr/dslot (n, 3, 13) for one problem; ``scale`` the relative
+    loss's divisors (n, 3), ``level`` the log losses' s (1/sr)."""
+    if loss in ("log", "scaled_log"):
+        model = value * cos_theta[:, None] / level
+        residual = np.log1p(model) - np.log1p(measured * cos_theta[:, None] / level)
+        derivative = (cos_theta[:, None] / (level * (1.0 + model)))[..., None] * jacobian
     elif loss == "relative":
         residual = (value - measured) / scale
         derivative = jacobian / scale[..., None]
@@ -233,7 +237,7 @@ def _restore_blas_threads(limiter: Any, original: dict[str, int]) -> None:
 
 def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
         init: Material | dict[str, Any] | None = None, fit: str | list[str] | tuple[str, ...] | None = None,
-        loss: Literal["log", "relative", "linear"] = "log", weights: RealArrayLike | None = None,
+        loss: Literal["scaled_log", "log", "relative", "linear"] = "scaled_log", weights: RealArrayLike | None = None,
         bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None = None, model: Model = "disney2014",
         cosine: bool = True, precision: Literal["float32", "float64"] = "float32",
         max_iterations: SupportsIndex = 200, method: Literal["batched", "scipy"] = "batched",
@@ -250,8 +254,11 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     ``anisotropic`` is held at its start when the pairs cannot determine it:
     every half vector in one plane through the normal, as a MERL table's
     pairs; the result's ``notes`` and ``summary()`` say so).
-    ``loss``: ``"log"`` (``log(1 + f c) - log(1 + m c)``, c = cos θl if
-    ``cosine`` else 1: robust over the dynamic range of specular peaks),
+    ``loss``: ``"scaled_log"`` (the default: ``log(1 + f c / s) - log(1 + m c / s)``,
+    c = cos θl if ``cosine`` else 1, s the median of the problem's m c but at
+    least a tenth of their mean: logarithmic over the specular peak's decades,
+    the same for a bright and a dim material), ``"log"`` (the same with
+    s = 1/sr),
     ``"relative"`` (``(f - m) / max(m, 1e-3 max m, 1e-9)``, max m over the
     problem's samples: the floors keep zero measurements finite, and a black
     problem, every m = 0, fits f towards 0) or ``"linear"`` (``(f - m) c``).
@@ -339,13 +346,15 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     _validate.model_index(model)  # checked before any work; eval_grad takes the name
 
     if method == "batched":
-        fitted, costs, iterations, success, messages, residuals_out = _fit_batched(
+        fitted, costs, iterations, success, messages, residuals_out, reset_names = _fit_batched(
             wi, wo, problems, weights, start, lower, upper, slots, loss, cosine, model, precision, max_iterations,
             thread_count)
     else:
-        fitted, costs, iterations, success, messages, residuals_out = _fit_scipy(
+        fitted, costs, iterations, success, messages, residuals_out, reset_names = _fit_scipy(
             wi_rows, wo_rows, problems, weights, start, lower, upper, slots, loss, cosine, model, precision,
             max_iterations)
+    if (note := _inert.note(reset_names, count)) is not None:
+        notes.append(note)
 
     take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
     return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
@@ -366,6 +375,7 @@ def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[A
     fitted = np.empty((count, len(GRADIENT_NAMES)))
     costs, iterations, success, messages = np.empty(count), np.empty(count, np.int64), np.empty(count, bool), []
     residuals_out = np.full(problems.shape, np.nan)
+    reset_names: list[list[str]] = []  # per problem, the parameters set back to their start
     dtype = np.float32 if precision == "float32" else np.float64
     with _one_blas_thread():
         for row in range(count):
@@ -380,6 +390,7 @@ def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[A
             m = target[present]
             cos_theta = np.maximum(wi_rows[row][present][:, 2], 0.0) if cosine else np.ones(len(m))
             scale = np.maximum(m, max(_RELATIVE_FLOOR_FRACTION * float(m.max()), _RELATIVE_FLOOR))
+            level = log_scale(m, cos_theta) if loss == "scaled_log" else 1.0
             root_weight = np.sqrt(weights[row][present])[:, None] if weights is not None else np.ones((len(m), 1))
             values = start.copy()
             last: dict[str, Float64Array] = {}
@@ -394,7 +405,7 @@ def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[A
                     else:
                         g = reference.eval_grad(material, wi_p, wo_p, model=model)
                     r, d = _residual_and_jacobian(g.value.astype(np.float64), g.jacobian.astype(np.float64), m,
-                                                  cos_theta, loss, scale)
+                                                  cos_theta, loss, scale, level)
                     last.update(x=x.copy(), r=r, d=d[..., slots])
                 return last["r"], last["d"]
 
@@ -411,13 +422,16 @@ def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[A
                                      bounds=(lower[slots], upper[slots]), method="trf", x_scale="jac",
                                      max_nfev=max_iterations)
             values[slots] = solution.x
+            moved = _inert.reset(values, start, slots, *_evaluators(wi_rows[row][present], wo_rows[row][present], model, precision))
+            reset_names.append(moved or [])
             fitted[row] = values
-            costs[row] = solution.cost
+            costs[row] = solution.cost if moved is None else \
+                0.5 * float(np.sum((evaluate(values[slots].copy())[0] * root_weight) ** 2))
             iterations[row] = solution.njev if solution.njev is not None else solution.nfev
             success[row] = solution.success
             messages.append(solution.message)
-            residuals_out[row][present] = evaluate(solution.x)[0]
-    return fitted, costs, iterations, success, messages, residuals_out
+            residuals_out[row][present] = evaluate(values[slots].copy())[0]
+    return fitted, costs, iterations, success, messages, residuals_out, reset_names
 
 
 def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], weights: Float64Array | None,
@@ -432,11 +446,19 @@ def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], wei
     cos_theta = np.broadcast_to(cos_theta, (count, n))[..., None]
     root_weight = (np.sqrt(weights) if weights is not None else np.ones((count, n)))[..., None]
     floor = np.maximum(_RELATIVE_FLOOR_FRACTION * m.max(axis=(1, 2)), _RELATIVE_FLOOR)[:, None, None]
-    # r = (u(f) - target) scale: the loss folded into target and scale (docs/fitting.md)
+    # the log losses' s per problem (1/sr for "log")
+    level = np.ones(count)
+    if loss == "scaled_log":
+        for row in np.flatnonzero(has_data):
+            here = present[row]
+            level[row] = log_scale(m[row][here], cos_theta[row, :, 0][here])
+    # r = (u(g f) - target) scale: the loss folded into the gain g, target and scale (docs/fitting.md)
+    gain = np.ones(count)
     if loss == "relative":
         target, scale, kernel_cosine, loss_code = m, root_weight / np.maximum(m, floor), False, 0
-    elif loss == "log":
-        target, scale, kernel_cosine, loss_code = np.log1p(m * cos_theta), root_weight, cosine, 1
+    elif loss in ("log", "scaled_log"):
+        target, scale, kernel_cosine, loss_code = np.log1p(m * cos_theta / level[:, None, None]), root_weight, cosine, 1
+        gain = 1.0 / level
     else:
         target, scale, kernel_cosine, loss_code = m * cos_theta, root_weight, cosine, 0
     scale = np.where(present[..., None], np.broadcast_to(scale, problems.shape), 0.0)
@@ -450,15 +472,18 @@ def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], wei
     iterations = np.zeros(count, np.int64)
     success = np.zeros(count, bool)
     messages = [_NO_DATA] * count
+    reset_names: list[list[str]] = []
     if slots and len(solved):
         if precision == "float32":
             equations = _solver.float32_equations(
                 np.ascontiguousarray(wi, dtype=np.float32), np.ascontiguousarray(wo, dtype=np.float32),
                 np.ascontiguousarray(target, dtype=np.float32), np.ascontiguousarray(scale, dtype=np.float32),
-                full_start, slots, solved, loss_code, kernel_cosine, _validate.model_index(model), threads)
+                np.ascontiguousarray(gain, dtype=np.float32), full_start, slots, solved, loss_code, kernel_cosine,
+                _validate.model_index(model), threads)
         else:
             equations = _solver.float64_equations(_material_of, wi, wo, np.broadcast_to(target, problems.shape),
-                                                  scale, full_start, slots, solved, loss_code, kernel_cosine, model)
+                                                  scale, gain, full_start, slots, solved, loss_code, kernel_cosine,
+                                                  model)
         solution = _solver.levenberg_marquardt(equations, full_start[np.ix_(solved, slot_index)], lower[slots],
                                                upper[slots], max_iterations, _FTOL[precision])
         fitted[np.ix_(solved, slot_index)] = solution.x
@@ -466,18 +491,46 @@ def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], wei
         success[solved] = solution.success
         for j, row in enumerate(solved):
             messages[row] = solution.message[j]
+        reset_names = _reset_inert(fitted, full_start, slots, solved, wi, wo, present, model, precision, threads)
     elif len(solved):
         success[solved] = True
         for row in solved:
             messages[row] = _NOTHING_FITTED
-    residuals_out, costs = _residuals_at(fitted, wi, wo, problems, present, m, cos_theta, root_weight, floor, loss,
-                                         model, precision, threads)
-    return fitted, costs, iterations, success, messages, residuals_out
+    residuals_out, costs = _residuals_at(fitted, wi, wo, problems, present, m, cos_theta, root_weight, floor, level,
+                                         loss, model, precision, threads)
+    return fitted, costs, iterations, success, messages, residuals_out, reset_names
 
 
-def _residuals_at(fitted: Float64Array, wi: Float64Array, wo: Float64Array, problems: Float64Array,
+def _reset_inert(fitted: Float64Array, start: Float64Array, slots: list[int], solved: NDArray[np.int64],
+                 wi: NDArray[Any], wo: NDArray[Any], present: NDArray[np.bool_], model: Model, precision: str,
+                 threads: int) -> list[list[str]]:
+    """_inert.reset for each solved problem, in place in ``fitted``: f and its Jacobian of a few
+    problems at a time in one call, then each problem's check on its present samples."""
+    n = present.shape[1]
+    chunk = max(1, (1 << 22) // max(1, n * 3 * len(GRADIENT_NAMES)))
+    names: list[list[str]] = []
+    for begin in range(0, len(solved), chunk):
+        rows = solved[begin:begin + chunk]
+        wi_part, wo_part = (wi[rows], wo[rows]) if wi.ndim == 3 else (wi, wo)
+        material = _material_of(fitted[rows]).reshape(-1, 1)
+        if precision == "float32":
+            g = eval_grad(material, wi_part.astype(np.float32), wo_part.astype(np.float32), model=model, check=False,
+                          threads=threads or None)
+        else:
+            g = reference.eval_grad(material, wi_part, wo_part, model=model)
+        for j, row in enumerate(rows):
+            here = present[row]
+            value, jacobian = g.value[j][here].astype(np.float64), g.jacobian[j][here].astype(np.float64)
+            _, evaluate_value = _evaluators(wi[row][here] if wi.ndim == 3 else wi[here],
+                                            wo[row][here] if wo.ndim == 3 else wo[here], model, precision)
+            moved = _inert.reset(fitted[row], start[row], slots, lambda values: (value, jacobian), evaluate_value)
+            names.append(moved or [])
+    return names
+
+
+def _residuals_at(fitted: Float64Array, wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any],
                   present: NDArray[np.bool_], m: Float64Array, cos_theta: Float64Array, root_weight: Float64Array,
-                  floor: Float64Array, loss: str, model: Model, precision: str,
+                  floor: Float64Array, level: Float64Array, loss: str, model: Model, precision: str,
                   threads: int) -> tuple[Float64Array, Float64Array]:
     """The unweighted residuals (NaN where a sample is missing) and ½ Σ (weighted residual)² of every
     problem at its fitted material, a few problems at a time."""
@@ -495,8 +548,9 @@ def _residuals_at(fitted: Float64Array, wi: Float64Array, wo: Float64Array, prob
         else:
             value = reference.eval(material, wi_part, wo_part, model=model)
         c, mm = cos_theta[rows], m[rows]
-        if loss == "log":
-            r = np.log1p(value * c) - np.log1p(mm * c)
+        if loss in ("log", "scaled_log"):
+            s = level[rows][:, None, None]
+            r = np.log1p(value * c / s) - np.log1p(mm * c / s)
         elif loss == "relative":
             r = (value - mm) / np.maximum(mm, floor[rows])
         else:
@@ -505,6 +559,22 @@ def _residuals_at(fitted: Float64Array, wi: Float64Array, wo: Float64Array, prob
         residuals[rows] = np.where(here, r, np.nan)
         costs[rows] = 0.5 * np.sum(np.where(here, r * root_weight[rows], 0.0) ** 2, axis=(1, 2))
     return residuals, costs
+
+
+def _evaluators(wi: Float64Array, wo: Float64Array, model: Model, precision: str) -> tuple[
+        Callable[[Float64Array], tuple[Float64Array, Float64Array]], Callable[[Float64Array], Float64Array]]:
+    """f and ∂f/∂slot (13 columns), and f alone, at slot values (13,) over the pairs, in the fit's precision."""
+    if precision == "float32":
+        def gradient(values: Float64Array) -> Any:
+            return eval_grad(_material_of(values), wi, wo, model=model, check=False)
+    else:
+        def gradient(values: Float64Array) -> Any:
+            return reference.eval_grad(_material_of(values), wi, wo, model=model)
+
+    def both(values: Float64Array) -> tuple[Float64Array, Float64Array]:
+        g = gradient(values)
+        return g.value, g.jacobian
+    return both, lambda values: gradient(values).value
 
 
 def _determines_anisotropy(wi: NDArray[Any], wo: NDArray[Any]) -> bool:

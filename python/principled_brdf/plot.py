@@ -417,33 +417,37 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
 
 
 def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealArrayLike = _render.DEFAULT_LIGHT,
-               light_intensity: float = 3.0, environment: _EnvironmentArg = "sky",
-               environment_samples: int = _render.DEFAULT_SAMPLES, seed: int = 0, exposure: float = 1.0,
+               light_intensity: float | None = None, environment: _EnvironmentArg = "sky",
+               environment_samples: int | None = None, seed: int = 0, exposure: float = 1.0,
                model: Model = "disney2014", ax: Axes | None = None, energy_compensation: bool = False) -> Axes:
     """The material on a sphere (``pb.render.render_sphere``), tone mapped to sRGB; returns the Axes.
 
     ``material`` is uniform or per pixel (leading shape ``(resolution,
     resolution)``). ``light``: direction towards the light in camera space
     (x right, y up, z to the viewer), ``light_intensity`` its irradiance
-    scale (0 turns it off). ``environment``: ``"sky"`` (default,
-    :func:`pb.render.sky_environment`), a callable ``L(w)`` (camera-space
+    scale (0 turns it off; by default 3 with the sky or no environment, 0 with
+    a map). ``environment``: ``"sky"`` (default,
+    :func:`pb.render.sky_environment`), ``"studio"``, ``"outdoor"``, a
+    ``.exr``/``.hdr`` map or an array, a callable ``L(w)`` (camera-space
     directions ``(..., 3)`` to RGB radiance), or None / False for the light
-    alone; its integral ``∫ f L cos θl dωi`` is estimated per pixel from
-    ``environment_samples`` importance samples at lattice points (deterministic
-    for a ``seed``). ``exposure`` scales the linear image before the tone
-    curve (``pb.render.tone_map``). Off the sphere is transparent.
+    alone (``pb.render.environment_of``); its integral ``∫ f L cos θl dωi`` is
+    estimated per pixel from ``environment_samples`` lattice points (by default
+    64 for the sky or a callable, 256 for a map; deterministic for a ``seed``;
+    :func:`pb.render.render_environment`). ``exposure`` scales the linear image
+    before the tone curve (``pb.render.tone_map``). Off the sphere is transparent.
     ``energy_compensation`` as in ``pb.eval``.
     """
     material = _material("material", material)
     n = _validate.resolution("resolution", resolution)
     exposure = _validate.real_number("exposure", exposure, 0.0)
-    intensity = _validate.real_number("light_intensity", light_intensity, 0.0)
+    intensity = None if light_intensity is None else _validate.real_number("light_intensity", light_intensity, 0.0)
     if material.shape not in ((), (n, n)):
         raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
                          f"got {material.shape}")
-    count = _validate.integer_in("environment_samples", environment_samples, 1, _render.MAX_SAMPLES, " per pixel")
+    count = None if environment_samples is None else _validate.integer_in(
+        "environment_samples", environment_samples, 1, _render.MAX_SAMPLES, " per pixel")
     _validate.model_index(model)
-    environment = _render._environment(environment)
+    environment = _render.environment_of(environment)
     ax = _axes(ax)
 
     image = _render.render_sphere(material, n, light=light, light_intensity=intensity, model=model,

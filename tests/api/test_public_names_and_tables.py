@@ -10,7 +10,8 @@ import pytest
 import principled_brdf as pb
 from principled_brdf import _core
 
-PUBLIC_MODULES = [pb, pb.reference, pb.microfacet, pb.plot, pb.render, pb.presets,
+PUBLIC_MODULES = [pb, pb.reference, pb.microfacet, pb.plot, pb.render, pb.presets, pb.environment,
+                  pb.procedural_environments, pb.piecewise,
                   importlib.import_module("principled_brdf.distributed")]
 # names a module may use in its signatures without exporting them: the package's own
 TOP_LEVEL = set(pb.__all__)

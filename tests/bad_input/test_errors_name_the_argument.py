@@ -357,3 +357,44 @@ def test_the_checks_fast_path_accepts_exactly_what_the_elementwise_rule_accepts(
             with np.errstate(invalid="ignore"):
                 expected = bool(np.all(np.isfinite(values) & (values >= lower) & (values <= upper)))
             assert all_within(values, lower, upper) == expected, (values, lower, upper)
+
+
+# --------------------------------------------------------------------------
+# environments (docs/rendering-and-plots.md, "Environments")
+
+
+@pytest.mark.parametrize("environment, error, match", [
+    ("garden", ValueError, r"environment: expected 'sky', 'studio', 'outdoor', a .exr or .hdr file.*got 'garden'"),
+    ("map.png", ValueError, r"environment: expected 'sky'.*got 'map.png'"),
+    ("missing.exr", FileNotFoundError, r"environment: no such file: 'missing.exr'"),
+    (3.5, TypeError, r"environment: expected 'sky'.*got float"),
+    (np.zeros((4, 8)), ValueError, r"environment: expected a latitude-longitude map of shape \(H, W, 3\)"),
+    (np.zeros((1, 8, 3)), ValueError, r"H and W at least 2, got \(1, 8, 3\)"),
+    (np.full((4, 8, 3), -1.0), ValueError, r"environment\[0, 0, 0\]: -1.0 is outside its domain"),
+    (np.where(np.arange(96).reshape(4, 8, 3) == 50, np.nan, 1.0), ValueError,
+     r"environment\[2, 0, 2\]: nan is not a finite number"),
+    (np.full((4, 8, 3), 1e39), ValueError, r"environment\[0, 0, 0\]: 1e\+39 is outside its domain"),
+    (np.array([[["a"] * 3] * 4] * 2), TypeError, r"environment: expected real numbers"),
+])
+def test_bad_environments_are_refused_naming_the_argument(environment, error, match, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(error, match=match):
+        pb.render.render_sphere(pb.Material(), 8, environment=environment, samples=2)
+
+
+def test_unreadable_map_files_name_the_argument(tmp_path):
+    broken = tmp_path / "broken.hdr"
+    broken.write_bytes(b"not an image")
+    pytest.importorskip("cv2")
+    with pytest.raises(ValueError, match=r"environment: .*broken.hdr.* is not a readable Radiance RGBE"):
+        pb.render.render_sphere(pb.Material(), 8, environment=broken, samples=2)
+    corrupt = tmp_path / "corrupt.exr"
+    corrupt.write_bytes(b"not an exr")
+    with pytest.raises(ValueError, match=r"environment: .*corrupt.exr.* is not a readable OpenEXR file"):
+        pb.render.render_sphere(pb.Material(), 8, environment=corrupt, samples=2)
+    with pytest.raises(ValueError, match=r"environment: .*gray.exr.* has no R, G, B channels \(it has Y\)"):
+        import OpenEXR
+
+        with OpenEXR.File({"type": OpenEXR.scanlineimage}, {"Y": np.ones((4, 8), np.float32)}) as exr:
+            exr.write(str(tmp_path / "gray.exr"))
+        pb.render.render_sphere(pb.Material(), 8, environment=tmp_path / "gray.exr", samples=2)

@@ -866,7 +866,7 @@ def test_cli_light_of_extreme_magnitude_is_a_direction(capsys, tmp_path):
     for light in ("1e308,1e308,1e308", "5e-324,5e-324,5e-324"):
         output = tmp_path / "x.npy"
         status, err = exit_status(capsys, ["render", "--light", light, "--resolution", "8", "--samples", "2",
-                                           "--output", str(output)])
+                                           "--environment", "sky", "--output", str(output)])
         assert status == 0, err
         expected = pb.render.render_sphere(pb.Material(), 8, light=(1.0, 1.0, 1.0), samples=2)
         np.testing.assert_array_equal(np.load(output), expected)

@@ -1,5 +1,4 @@
-"""The examples run: the notebooks execute without a cell error and draw their figures, and
-the dask example gives pb.eval's bits and runs as a script.
+"""The examples run: the notebooks execute without a cell error and draw their figures.
 
 The notebooks are executed with nbclient in a scratch directory (nothing lands in the
 repository) by a kernel running *this* interpreter: a ``python3`` kernelspec pointing at
@@ -16,16 +15,13 @@ small enough to keep in git.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import os
 import re
-import subprocess
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import principled_brdf as pb
@@ -122,111 +118,3 @@ def test_notebook_runs(name, python3_kernel, tmp_path):
         for output in cell.get("outputs", []):
             assert output.output_type != "error", f"{name}: {output.get('ename')}: {output.get('evalue')}"
     _check_figures(name, notebook)
-
-
-# --------------------------------------------------------------------------
-# dask
-
-
-def _load_dask_example():
-    import dask.array  # noqa: F401  (a test dependency: fail, never skip)
-    spec = importlib.util.spec_from_file_location("dask_scale_out", EXAMPLES / "dask_scale_out.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def _hemisphere(rng, n):
-    cos_theta, phi = rng.random(n), 2 * np.pi * rng.random(n)
-    sin_theta = np.sqrt(1 - cos_theta**2)
-    return np.stack([sin_theta * np.cos(phi), sin_theta * np.sin(phi), cos_theta], axis=-1).astype(np.float32)
-
-
-def _same_bits(a, b) -> bool:
-    a, b = np.asarray(a), np.asarray(b)
-    return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a.view(np.uint32), b.view(np.uint32))
-
-
-@pytest.mark.parametrize("cosine", [False, True])
-def test_dask_map_blocks_gives_the_bits_of_pb_eval(cosine):
-    example = _load_dask_example()
-    import dask.array as da
-
-    rng = np.random.default_rng(31)
-    n, chunk = 10_007, 4096  # chunks 4096, 4096, 1815: the last one ragged
-    wi, wo = _hemisphere(rng, n), _hemisphere(rng, n)
-    roughness = rng.uniform(0.0, 1.0, n).astype(np.float32)
-    roughness[:7] = (0.0, 1.0, 0.001, 0.5, 0.0, 1.0, 0.25)
-    base_color = rng.uniform(0.0, 1.0, (n, 3))
-    material = pb.presets.get("car_paint")
-
-    lazy = example.eval_dask(
-        material, da.from_array(wi, chunks=(chunk, 3)), da.from_array(wo, chunks=(chunk, 3)),
-        per_element={"roughness": da.from_array(roughness, chunks=3000),  # other chunks: rechunked to wi's
-                     "base_color": da.from_array(base_color, chunks=(chunk, 3))},
-        cosine=cosine)
-    assert lazy.shape == (n, 3) and lazy.dtype == np.float32
-    assert lazy.chunks == ((4096, 4096, 1815), (3,))
-    expected = pb.eval(material.replace(roughness=roughness, base_color=base_color), wi, wo, cosine=cosine)
-    assert _same_bits(lazy.compute(), expected)
-
-
-def test_dask_with_one_view_direction_and_threads():
-    example = _load_dask_example()
-    import dask.array as da
-
-    rng = np.random.default_rng(32)
-    n = 5_001
-    wi = _hemisphere(rng, n)
-    wo = np.array([0.3, -0.2, np.sqrt(1 - 0.13)], np.float32)
-    roughness = rng.uniform(0.0, 1.0, n)  # float64 in: converted per chunk exactly as pb.Material does
-    material = pb.Material(base_color=(0.7, 0.4, 0.2), clearcoat=0.5, sheen=0.5)
-    expected = pb.eval(material.replace(roughness=roughness), wi, wo)
-    for threads in (1, None):
-        lazy = example.eval_dask(material, da.from_array(wi, chunks=(1000, 3)), wo,
-                                 per_element={"roughness": da.from_array(roughness, chunks=1000)}, threads=threads)
-        assert _same_bits(lazy.compute(), expected)
-    # the model option reaches the kernel
-    lazy = example.eval_dask(material, da.from_array(wi, chunks=(2048, 3)), wo, model="disney2012")
-    assert _same_bits(lazy.compute(), pb.eval(material, wi, wo, model="disney2012"))
-
-
-def test_dask_tasks_serialise_to_worker_processes():
-    """What a distributed cluster needs: tasks that pickle and run in another process."""
-    example = _load_dask_example()
-    import dask.array as da
-
-    rng = np.random.default_rng(33)
-    n = 3_000
-    wi, wo = _hemisphere(rng, n), _hemisphere(rng, n)
-    roughness = rng.uniform(0.0, 1.0, n).astype(np.float32)
-    material = pb.presets.get("brushed_metal")
-    lazy = example.eval_dask(material, da.from_array(wi, chunks=(1024, 3)), da.from_array(wo, chunks=(1024, 3)),
-                             per_element={"roughness": da.from_array(roughness, chunks=1024)})
-    result = lazy.compute(scheduler="processes", num_workers=2)
-    assert _same_bits(result, pb.eval(material.replace(roughness=roughness), wi, wo))
-
-
-def test_dask_rejects_bad_arguments():
-    example = _load_dask_example()
-    import dask.array as da
-
-    wi = da.zeros((10, 3), chunks=(4, 3), dtype=np.float32)
-    with pytest.raises(ValueError, match="per_element"):
-        example.eval_dask(pb.Material(roughness=np.full(10, 0.5)), wi, wi)
-    with pytest.raises(ValueError, match="roughness"):
-        example.eval_dask(pb.Material(), wi, wi, per_element={"roughness": da.zeros(9, chunks=4)})
-    with pytest.raises(TypeError, match="per_element"):
-        example.eval_dask(pb.Material(), wi, wi, per_element={"shininess": da.zeros(10, chunks=4)})
-    with pytest.raises(ValueError, match="wi"):
-        example.eval_dask(pb.Material(), da.zeros((10, 2), chunks=4), wi)
-
-
-def test_dask_example_runs_as_a_script(tmp_path):
-    import dask.array  # noqa: F401  (a test dependency: fail, never skip)
-    result = subprocess.run([sys.executable, str(EXAMPLES / "dask_scale_out.py"), "--n", "600000", "--chunk",
-                             "131072"], capture_output=True, text=True, timeout=300, cwd=tmp_path)
-    assert result.returncode == 0, result.stderr
-    assert "M pairs/s" in result.stdout
-    assert "identical to pb.eval on the materialised arrays: True" in result.stdout
-    assert list(tmp_path.iterdir()) == []

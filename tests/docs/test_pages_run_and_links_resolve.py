@@ -23,7 +23,6 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
-EXAMPLES = ROOT / "examples"
 PAGES = sorted(DOCS.glob("*.md"))
 NOT_RUN = "# not run"
 MAX_NOT_RUN = 2  # per page
@@ -86,7 +85,6 @@ def page_sandbox(monkeypatch, tmp_path):
     matplotlib = pytest.importorskip("matplotlib")
     matplotlib.use("Agg")
     monkeypatch.setenv("MPLBACKEND", "Agg")
-    monkeypatch.syspath_prepend(str(EXAMPLES))  # evaluating.md imports examples/dask_scale_out.py
     working, scratch = tmp_path / "working", tmp_path / "tmp"
     working.mkdir()
     scratch.mkdir()

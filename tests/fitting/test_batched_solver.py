@@ -12,6 +12,7 @@ import pytest
 import principled_brdf as pb
 from principled_brdf import _core
 from principled_brdf._gradient import GRADIENT_NAMES
+from principled_brdf.fit import LOSSES
 from conftest import random_direction_pairs, seeded_rng
 
 TRUTH = dict(base_color=(0.7, 0.3, 0.1), metallic=0.2, subsurface=0.3, specular=0.6, specular_tint=0.3, roughness=0.35,
@@ -23,15 +24,16 @@ def pairs(n, key="batched"):
     return random_direction_pairs(seeded_rng(key), n, min_cos=0.05)
 
 
-def numpy_normal_equations(rows, wi, wo, target, scale, columns, loss, cosine):
-    """JᵀJ (upper triangle by rows), Jᵀr and Σ r² of r = (u(f) - t) s, u = f or log(1 + f),
+def numpy_normal_equations(rows, wi, wo, target, scale, columns, loss, cosine, gain=None):
+    """JᵀJ (upper triangle by rows), Jᵀr and Σ r² of r = (u(g f) - t) s, u(x) = x or log(1 + x),
     from pb.reference.eval_grad (float64), transcribed here."""
     normal, gradient, cost = [], [], []
     for b, row in enumerate(rows):
         material = pb.Material(**{name: row[info.first_slot:info.first_slot + info.slots] if info.slots == 3
                                   else row[info.first_slot] for name, info in pb.PARAMETERS.items()})
         g = pb.reference.eval_grad(material, wi, wo, cosine=cosine)
-        f, jacobian = g.value, g.jacobian[..., columns]
+        gb = 1.0 if gain is None else gain[b]
+        f, jacobian = gb * g.value, gb * g.jacobian[..., columns]
         if loss == "log":
             r, slope = (np.log1p(f) - target[b]) * scale[b], scale[b] / (1.0 + f)
         else:
@@ -57,16 +59,18 @@ def test_the_kernels_normal_equations_are_numpys(isa, loss, cosine):
     target = rng.uniform(0.0, 0.5, (count, n, 3))
     scale = rng.uniform(0.5, 1.0, (count, n, 3))
     scale[1, 5] = 0.0  # a missing sample
+    gain = np.float32([0.5, 4.0, 1.0]).astype(np.float64)  # the scaled log loss's 1/s
     wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
     for columns in (list(range(len(GRADIENT_NAMES))), [GRADIENT_NAMES.index("roughness")], [0, 1, 2, 8, 12]):
         normal, gradient, cost = _core.normal_equations(
             wi=wi32, wo=wo32, slots=rows.astype(np.float32), target=target.astype(np.float32),
             scale=scale.astype(np.float32), problems=np.array([2, 0, 1], np.int64), columns=columns,
-            loss=LOSS_CODES[loss], cosine=cosine, model=0, isa=isa)
+            loss=LOSS_CODES[loss], cosine=cosine, model=0, isa=isa, gain=gain.astype(np.float32))
         order = [2, 0, 1]
         expected = numpy_normal_equations(rows[order], wi32.astype(np.float64), wo32.astype(np.float64),
                                           target.astype(np.float32)[order].astype(np.float64),
-                                          scale.astype(np.float32)[order].astype(np.float64), columns, loss, cosine)
+                                          scale.astype(np.float32)[order].astype(np.float64), columns, loss, cosine,
+                                          gain[order])
         # float32 Jacobians, summed per lane in float32: relative to the entries' natural size
         diagonal = np.stack([expected[0][:, k * len(columns) - k * (k - 1) // 2] for k in range(len(columns))], 1)
         size = np.sqrt(np.einsum("bk,bl->bkl", diagonal, diagonal))[:, *np.triu_indices(len(columns))]
@@ -87,10 +91,11 @@ def test_the_float64_paths_normal_equations_are_numpys():
     target, scale = rng.uniform(0.0, 0.5, (count, n, 3)), rng.uniform(0.5, 1.0, (count, n, 3))
     columns = [0, 1, 2, 7, 12]
     for loss in ("linear", "log"):
-        equations = _solver.float64_equations(pb.fit.__globals__["_material_of"], wi, wo, target, scale, rows,
+        gain = np.array([1.0, 0.25])
+        equations = _solver.float64_equations(pb.fit.__globals__["_material_of"], wi, wo, target, scale, gain, rows,
                                               columns, np.arange(count), LOSS_CODES[loss], True, "disney2014")
         got = equations.evaluate(np.arange(count), rows[:, columns])
-        expected = numpy_normal_equations(rows, wi, wo, target, scale, columns, loss, True)
+        expected = numpy_normal_equations(rows, wi, wo, target, scale, columns, loss, True, gain)
         for a, b in zip(got, expected):
             np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * np.abs(b).max())
 
@@ -112,7 +117,7 @@ FITTED_SLOTS = [0, 1, 2, GRADIENT_NAMES.index("metallic"), GRADIENT_NAMES.index(
 
 
 @pytest.mark.parametrize("precision", ("float32", "float64"))
-@pytest.mark.parametrize("loss", ("log", "relative", "linear"))
+@pytest.mark.parametrize("loss", LOSSES)
 def test_the_default_recovers_the_models_parameters(precision, loss):
     # the relative loss, which weighs the darkest samples most, finds a glossy peak from nearby
     # only (docs/fitting.md); scipy's method ends in the same other minimum from the default start
@@ -136,7 +141,7 @@ def test_every_parameter_from_the_default_start_matches_f():
                                atol=1e-6 * measured.max())
 
 
-@pytest.mark.parametrize("loss", ("log", "relative", "linear"))
+@pytest.mark.parametrize("loss", LOSSES)
 def test_with_noise_the_batched_and_scipy_methods_agree(loss):
     wi, wo, measured, truth = texels(count=4, key="noisy")
     noisy = measured * seeded_rng("noise", loss).lognormal(0.0, 0.05, measured.shape)
@@ -164,7 +169,7 @@ def test_bounds_are_respected():
     np.testing.assert_allclose(result.slots[inside][:, FITTED_SLOTS], truth[inside], atol=2e-3)
 
 
-@pytest.mark.parametrize("loss", ("log", "relative", "linear"))
+@pytest.mark.parametrize("loss", LOSSES)
 def test_a_nan_texel_and_a_black_texel_do_not_abort_the_batch(loss):
     wi, wo, measured, truth = texels(count=4, key="bad-texels")
     measured[1] = np.nan

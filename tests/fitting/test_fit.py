@@ -80,7 +80,7 @@ def test_many_materials_in_one_call():
 @pytest.mark.parametrize("call, error, match", [
     (lambda wi, wo, m: pb.fit(wi, wo, m[:, :2]), ValueError, r"measured: expected \(N, 3\)"),
     (lambda wi, wo, m: pb.fit(wi, wo, -m), ValueError, "measured: values must be finite and >= 0"),
-    (lambda wi, wo, m: pb.fit(wi, wo, m, loss="l1"), ValueError, "loss: expected one of log, relative, linear"),
+    (lambda wi, wo, m: pb.fit(wi, wo, m, loss="l1"), ValueError, "loss: expected one of scaled_log, log, relative, linear"),
     (lambda wi, wo, m: pb.fit(wi, wo, m, fit=["shininess"]), ValueError, "fit: unknown parameter 'shininess'"),
     (lambda wi, wo, m: pb.fit(wi, wo, m, bounds={"roughness": (0.5, 0.1)}), ValueError, r"bounds\['roughness'\]"),
     (lambda wi, wo, m: pb.fit(wi[:5], wo, m), ValueError, "wi, wo: expected"),

@@ -54,4 +54,26 @@ def test_the_default_fit_holds_anisotropy_the_pairs_cannot_determine():
     spread_wi = np.concatenate([wi, spread_wi])
     spread_wo = np.concatenate([wo, wo @ np.array([[0.6, 0.8, 0], [-0.8, 0.6, 0], [0, 0, 1.0]]).T])
     spread = pb.fit(spread_wi, spread_wo, pb.reference.eval(truth, spread_wi, spread_wo), max_iterations=5)
-    assert "anisotropic" in spread.names and not spread.notes
+    assert "anisotropic" in spread.names and not any("anisotropic held" in note for note in spread.notes)
+
+
+def test_parameters_without_effect_go_back_to_their_start():
+    """A metal's diffuse, subsurface and sheen lobes are weighted by 1 - metallic = 0: whatever
+    those parameters reached on the way, the fit sets them back to the start and says so; f
+    stays the same to float32's resolution, and the cost and residuals are those of the
+    material returned."""
+    rng = np.random.default_rng(8)
+    truth = pb.Material(base_color=(0.95, 0.64, 0.54), metallic=1.0, roughness=0.35)
+    wi, wo = pairs_in_a_plane(3000, rng)
+    start = dict(subsurface=0.7, sheen=0.6, sheen_tint=0.2, specular_tint=0.4)  # far from the start put back
+    measured = pb.reference.eval(truth, wi, wo)
+    result = pb.fit(wi, wo, measured, init=start, loss="linear", cosine=False)
+    assert float(result.material.metallic) == pytest.approx(1.0, abs=1e-6)
+    for name, value in start.items():  # the start, exactly: the fit moved them, then put them back
+        assert float(getattr(result.material, name)) == pytest.approx(value, abs=1e-12), name
+    assert any("set back to the start" in note for note in result.notes)
+    # f, residuals and cost as the fitted material gives them (the linear loss: f - m)
+    f = pb.eval(result.material, wi.astype(np.float32), wo.astype(np.float32)).astype(np.float64)
+    np.testing.assert_array_equal(result.residuals, f - measured)
+    np.testing.assert_allclose(f, measured, rtol=1e-4, atol=1e-6 * measured.max())
+    assert float(result.cost) == pytest.approx(0.5 * np.sum((f - measured) ** 2), rel=1e-12)

@@ -108,3 +108,24 @@ def test_fit_a_material_to_a_merl_table(tmp_path):
     result = pb.fit(wi[use], wo[use], values[use], fit=["base_color", "roughness"], init=dict(metallic=0.0))
     assert result.success
     np.testing.assert_allclose(result.slots[[0, 1, 2, 7]], [0.6, 0.25, 0.1, 0.3], atol=2e-4)
+
+
+def test_merl_pairs_are_the_cells_centres_bit_for_bit():
+    """merl_pairs computes half_diff_to_wiwo on the grid's axes: the same bits, for any φh and
+    step; values(step=) picks the same cells in the same order."""
+    i_h, i_d, i_p = np.meshgrid(np.arange(0, 90, 7), np.arange(0, 90, 5), np.arange(0, 180, 11), indexing="ij")
+    theta_h = ((i_h + 0.5) / 90) ** 2 * (0.5 * np.pi)
+    theta_d, phi_d = (i_d + 0.5) / 90 * (0.5 * np.pi), (i_p + 0.5) / 180 * np.pi
+    for phi_h in (0.0, 0.7, -2.5):
+        wi, wo = merl.merl_pairs(phi_h, step=(7, 5, 11))
+        expected = merl.half_diff_to_wiwo(theta_h.ravel(), phi_h, theta_d.ravel(), phi_d.ravel())
+        np.testing.assert_array_equal(wi, expected[0])
+        np.testing.assert_array_equal(wo, expected[1])
+    table = merl.MerlBRDF(np.random.default_rng(2).uniform(0, 1, (3,) + merl.MERL_SHAPE))
+    cells = (i_h * 90 + i_d) * 180 + i_p
+    np.testing.assert_array_equal(table.values(step=(7, 5, 11)), table.values()[cells.ravel()])
+    assert merl.merl_pairs(step=3)[0].shape == (30 * 30 * 60, 3)
+    with pytest.raises(ValueError, match="step: expected strides >= 1"):
+        merl.merl_pairs(step=(1, 0, 1))
+    with pytest.raises(TypeError, match="step: expected a positive integer or three"):
+        table.values(step=(1, 2))

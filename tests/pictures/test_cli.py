@@ -63,9 +63,9 @@ def test_render_preset_with_parameters(tmp_path, capsys):
 
 def test_render_writes_linear_npy_and_exr_and_switches_the_sky(tmp_path):
     common = ["render", "--preset", "chrome", "--resolution", "32", "--samples", "8"]
-    assert main(common + ["--output", str(tmp_path / "sky.npy")]) == 0
+    assert main(common + ["--environment", "sky", "--output", str(tmp_path / "sky.npy")]) == 0
     assert main(common + ["--no-environment", "--output", str(tmp_path / "key.npy")]) == 0
-    assert main(common + ["--exposure", "2", "--output", str(tmp_path / "sky2.npy")]) == 0
+    assert main(common + ["--environment", "sky", "--exposure", "2", "--output", str(tmp_path / "sky2.npy")]) == 0
     sky, key, brighter = (np.load(tmp_path / f"{name}.npy") for name in ("sky", "key", "sky2"))
     assert sky.shape == (32, 32, 3) and sky.dtype == np.float32
     # chrome reflects the sky: without it most of the sphere is black; exposure scales the linear values
@@ -74,9 +74,39 @@ def test_render_writes_linear_npy_and_exr_and_switches_the_sky(tmp_path):
     expected = pb.render.render_sphere(pb.presets.get("chrome"), 32, samples=8)
     np.testing.assert_allclose(sky, expected, rtol=1e-6)
     import OpenEXR  # a test extra
-    assert main(common + ["--output", str(tmp_path / "sky.exr")]) == 0
+    assert main(common + ["--environment", "sky", "--output", str(tmp_path / "sky.exr")]) == 0
     with OpenEXR.File(str(tmp_path / "sky.exr")) as exr:
         np.testing.assert_array_equal(exr.channels()["RGB"].pixels, sky)
+
+
+def test_render_lights_by_the_studio_by_default_and_takes_maps_tone_and_compensation(tmp_path):
+    common = ["render", "--preset", "gold", "--resolution", "24", "--samples", "4"]
+    gold = pb.presets.get("gold")
+    assert main(common + ["--output", str(tmp_path / "studio.npy")]) == 0
+    np.testing.assert_allclose(np.load(tmp_path / "studio.npy"),
+                               pb.render.render_sphere(gold, 24, environment="studio", samples=4), rtol=1e-6)
+    assert main(common + ["--environment", "outdoor", "--light-intensity", "2", "--energy-compensation",
+                          "--output", str(tmp_path / "outdoor.npy")]) == 0
+    np.testing.assert_allclose(np.load(tmp_path / "outdoor.npy"),
+                               pb.render.render_sphere(gold, 24, environment="outdoor", samples=4, light_intensity=2.0,
+                                                       energy_compensation=True), rtol=1e-6)
+    # a map file, written here: a bright band overhead
+    import OpenEXR
+
+    band = np.full((8, 16, 3), 0.02, np.float32)
+    band[1:3] = 5.0
+    with OpenEXR.File({"type": OpenEXR.scanlineimage}, {"RGB": band}) as exr:
+        exr.write(str(tmp_path / "band.exr"))
+    assert main(common + ["--environment", str(tmp_path / "band.exr"), "--output", str(tmp_path / "band.npy")]) == 0
+    np.testing.assert_allclose(np.load(tmp_path / "band.npy"),
+                               pb.render.render_sphere(gold, 24, environment=band, samples=4), rtol=1e-6)
+    linear = np.load(tmp_path / "studio.npy")
+    for tone in ("filmic", "reinhard", "clip"):
+        assert main(common + ["--tone", tone, "--output", str(tmp_path / f"{tone}.png")]) == 0
+        import matplotlib.image
+
+        read = np.round(matplotlib.image.imread(str(tmp_path / f"{tone}.png"))[..., :3] * 255)
+        np.testing.assert_array_equal(read, pb.render.to_srgb8(linear, curve=tone))
 
 
 def test_bench_compares_with_numpy(capsys):
@@ -98,6 +128,10 @@ def test_bench_compares_with_numpy(capsys):
         (["demo", "--output", "x.exr"], "cannot write '.exr' images; supported: .png"),
         (["render", "--output", "x.png", "--preset", "unobtainium"], "invalid choice"),
         (["render", "--output", "x.png", "--light", "0,0"], "three finite comma-separated numbers"),
+        (["render", "--output", "x.png", "--environment", "garden"],
+         "expected sky, studio, outdoor, none or a .exr/.hdr latitude-longitude map, got 'garden'"),
+        (["render", "--output", "x.png", "--environment", "nowhere.hdr"], "no such file: 'nowhere.hdr'"),
+        (["render", "--output", "x.png", "--tone", "aces"], "invalid choice: 'aces'"),
         (["render", "--output", "x.png", "--resolution", "0"], "expected a positive integer"),
         (["render"], "--output"),
         (["demo", "--pairs", "many"], "expected a positive integer"),
@@ -150,6 +184,14 @@ def test_write_png_round_trips_through_matplotlib(tmp_path):
         (["render", "--light", "nan,0,1", "--output", "x.png"], "--light"),
         (["render", "--light", "inf,0,1", "--output", "x.png"], "--light"),
         (["render", "--light", "0,0,0", "--output", "x.png"], "--light"),
+        (["render", "--light-intensity", "-1", "--output", "x.png"], "--light-intensity"),
+        (["render", "--light-intensity", "nan", "--output", "x.png"], "--light-intensity"),
+        (["render", "--environment", "garden", "--output", "x.png"], "--environment"),
+        (["render", "--environment", "map.png", "--output", "x.png"], "--environment"),
+        (["render", "--environment", "missing.exr", "--output", "x.png"], "--environment"),
+        (["render", "--tone", "aces", "--output", "x.png"], "--tone"),
+        (["render", "--energy-compensation=yes", "--output", "x.png"], "--energy-compensation"),
+        (["render", "--resolution", "16384", "--samples", "1024", "--output", "x.png"], "--samples"),
     ],
 )
 def test_options_beyond_what_fits_or_makes_sense_are_one_line_errors(args, option, tmp_path):

@@ -138,10 +138,11 @@ struct EvalJob {
 
 // The normal equations of least-squares problems (docs/fitting.md), for the
 // fitting solver: problem b's residuals over its pairs n and channels c are
-//     r = (u(f) - t) s,  u(f) = f (Loss::kLinear) or log(1 + f) (Loss::kLog),
+//     r = (u(g f) - t) s,  u(x) = x (Loss::kLinear) or log(1 + x) (Loss::kLog),
 // with f = f_c(wi_n, wo_n) of the problem's material (times cos θl with
-// `cosine`), t = target[b, n, c] and s = scale[b, n, c] (the caller folds the
-// loss, the weights and missing samples, s = 0, into t and s). Per problem,
+// `cosine`), g = gain[b] (1 without gains), t = target[b, n, c] and
+// s = scale[b, n, c] (the caller folds the loss, its per-problem level, the
+// weights and missing samples, s = 0, into g, t and s). Per problem,
 // over the wanted columns k <= l (P = columns.count of them):
 //     cost = Σ r²,  gradient_k = Σ r ∂r/∂p_k,  normal_kl = Σ ∂r/∂p_k ∂r/∂p_l,
 // the upper triangle by rows, P (P + 1) / 2 numbers; no per-pair value is
@@ -159,6 +160,7 @@ struct NormalEquationsJob {
     const float* slots = nullptr;         // (B, kParamSlots): each problem's material
     const float* target = nullptr;        // (B, N, 3)
     const float* scale = nullptr;         // (B, N, 3)
+    const float* gain = nullptr;          // (B,), or null for 1
     const std::int64_t* problems = nullptr;  // the `count` problems b to sum, result j for problems[j]
     Model model = Model::kDisney2014;
     Loss loss = Loss::kLinear;

@@ -1,0 +1,84 @@
+"""Fitted parameters that end without effect go back to their start (docs/fitting.md#what-the-fit-holds).
+
+At ``metallic = 1`` the diffuse, subsurface and sheen lobes are weighted by
+``1 - metallic = 0`` and ``specular``, ``specular_tint`` drop out of Cspec0;
+at ``sheen = 0`` ``sheen_tint`` does nothing, at ``clearcoat = 0``
+``clearcoat_gloss``. Whatever values such parameters took on the way are
+noise (a metal that ends with ``sheen = 1`` has no sheen), so they are set back
+to their start when that leaves f unchanged at every sample to float32's
+resolution (within 1e-6 of its largest value; a bound is reached only to
+the solver's tolerance, so ``1 - metallic`` may be 3e-8 rather than 0): the
+fitted f is the same, only its reading changes. The candidates are the
+parameters whose move back changes f by less than that to first order
+(``|∂f/∂p| |p - start| <= 1e-8 max |f|``).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ._gradient import GRADIENT_NAMES
+from .material import PARAMETERS
+
+_FIRST_ORDER_CHANGE = 1e-8  # of max |f|: below float32's resolution (6e-8)
+_SAME_F = 1e-6  # of max |f|: f unchanged to float32's resolution
+_SHOWN_CHANGE = 1e-6  # a parameter set back from closer than this to its start is not named in the note
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+
+    from ._typing import Float64Array
+
+    # f and ∂f/∂slot at the slot values (13,) over one problem's samples: (n, 3), (n, 3, 13)
+    Evaluate = Callable[[Float64Array], tuple[Float64Array, Float64Array]]
+    Value = Callable[[Float64Array], Float64Array]
+
+
+def _whole_parameters(slots: Sequence[int]) -> list[list[int]]:
+    """The fitted slots grouped by parameter (base_color's three together)."""
+    groups = []
+    for info in PARAMETERS.values():
+        group = [k for k in range(info.first_slot, info.first_slot + info.slots) if k in slots]
+        if group:
+            groups.append(group)
+    return groups
+
+
+def reset(values: Float64Array, start: Float64Array, slots: Sequence[int], evaluate: Evaluate,
+          value: Value) -> list[str] | None:
+    """Sets back to ``start``, in ``values`` (13,) in place, the fitted parameters (``slots``)
+    whose derivative is (next to) zero at every sample, when f (``value``) is then unchanged
+    to 1e-6 of its largest value; returns the names of those that moved visibly (by more than
+    1e-6), or None when nothing was set back."""
+    f, jacobian = evaluate(values)
+    resolution = _FIRST_ORDER_CHANGE * float(np.max(np.abs(f), initial=0.0))
+    inert = [group for group in _whole_parameters(slots)
+             if np.any(values[group] != start[group])
+             and float(np.max(np.abs(jacobian[..., group] @ (values[group] - start[group])))) <= resolution]
+    if not inert:
+        return None
+    moved = values.copy()
+    for group in inert:
+        moved[group] = start[group]
+    if not np.max(np.abs(value(moved) - f), initial=0.0) <= _SAME_F * float(np.max(np.abs(f), initial=0.0)):
+        return None
+    shown = [GRADIENT_NAMES[group[0]].removesuffix("_r") for group in inert
+             if np.max(np.abs(values[group] - start[group])) > _SHOWN_CHANGE]
+    values[:] = moved
+    return shown
+
+
+def note(reset_names: Sequence[Sequence[str]], problems: int) -> str | None:
+    """The result's note: which parameters went back to their start, in how many of the problems."""
+    counted: dict[str, int] = {}
+    for names in reset_names:
+        for name in names:
+            counted[name] = counted.get(name, 0) + 1
+    if not counted:
+        return None
+    names = [name for name in PARAMETERS if name in counted]
+    where = "" if problems == 1 else f" (in {max(counted.values())} of {problems} problems)"
+    return (f"{', '.join(names)} set back to the start{where}: no effect on f at the fitted material "
+            "(e.g. the diffuse and sheen lobes of a metal, metallic = 1); f unchanged to float32's resolution")

@@ -1,0 +1,99 @@
+"""What the PyTorch and JAX operations share (docs/interop.md): a material given as
+named arrays, f by the float32 kernels or the float64 reference, and the
+vector-Jacobian product that their backward passes return.
+
+Everything here takes and returns numpy arrays; the framework modules convert.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import _batch, reference
+from .material import PARAMETERS, Material
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+# Options the differentiable operations pass on to eval and eval_grad.
+EVAL_OPTIONS = ("model", "cosine")
+
+
+def parameter_names(material: Mapping[str, Any]) -> list[str]:
+    """The mapping's keys, checked against the parameter table, in the table's order."""
+    unknown = [name for name in material if name not in PARAMETERS]
+    if unknown:
+        raise ValueError(f"material: unknown parameter {unknown[0]!r}; expected names from {', '.join(PARAMETERS)}")
+    return [name for name in PARAMETERS if name in material]
+
+
+def check_options(options: Mapping[str, Any]) -> dict[str, Any]:
+    unknown = [name for name in options if name not in EVAL_OPTIONS]
+    if unknown:
+        raise TypeError(f"unexpected option {unknown[0]!r}; the differentiable eval takes {', '.join(EVAL_OPTIONS)}")
+    return dict(options)
+
+
+def leading_rank(names: list[str], values: list[np.ndarray], wi: np.ndarray, wo: np.ndarray) -> int:
+    """The rank of the broadcast leading shape: directions and base_color carry a trailing 3."""
+    ranks = [wi.ndim - 1, wo.ndim - 1] + [v.ndim - (1 if n == "base_color" else 0) for n, v in zip(names, values)]
+    return max(ranks)
+
+
+def material_of(names: list[str], values: list[np.ndarray]) -> Material:
+    parameters: dict[str, Any] = dict(zip(names, values))
+    return Material(**parameters)
+
+
+def evaluate(names: list[str], values: list[np.ndarray], wi: np.ndarray, wo: np.ndarray, double: bool,
+             options: Mapping[str, Any]) -> np.ndarray:
+    """f by the float64 reference (``double``) or the float32 kernels."""
+    material = material_of(names, values)
+    if double:
+        return reference.eval(material, wi, wo, **options)
+    return _batch.eval(material, np.asarray(wi, np.float32), np.asarray(wo, np.float32), **options)
+
+
+def sum_to_shape(gradient: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """``gradient`` summed over the axes that broadcasting added to an argument of ``shape``."""
+    extra = gradient.ndim - len(shape)
+    if extra:
+        gradient = gradient.sum(axis=tuple(range(extra)))
+    ones = tuple(axis for axis, size in enumerate(shape) if size == 1 and gradient.shape[axis] != 1)
+    if ones:
+        gradient = gradient.sum(axis=ones, keepdims=True)
+    return gradient.reshape(shape)
+
+
+def vjp(names: list[str], values: list[np.ndarray], wi: np.ndarray, wo: np.ndarray, cotangent: np.ndarray,
+        wanted: list[bool], double: bool, options: Mapping[str, Any],
+        shapes: list[tuple[int, ...]] | None = None) -> list[np.ndarray | None]:
+    """``Σ_c cotangent_c ∂f_c/∂p`` for each parameter whose ``wanted`` is set, summed to
+    that parameter's shape or to ``shapes`` (None for the others)."""
+    asked = [name for name, want in zip(names, wanted) if want]
+    result: list[np.ndarray | None] = [None] * len(names)
+    if not asked:
+        return result
+    material = material_of(names, values)
+    if double:
+        gradient = reference.eval_grad(material, wi, wo, wrt=asked, **options)
+    else:
+        gradient = _batch.eval_grad(material, np.asarray(wi, np.float32), np.asarray(wo, np.float32), wrt=asked,
+                                    **options)
+    # (..., 3, P) contracted with the cotangent over the colour axis
+    per_element = np.einsum("...c,...ck->...k", cotangent.astype(gradient.jacobian.dtype, copy=False),
+                            gradient.jacobian)
+    column = 0
+    for index, (name, want) in enumerate(zip(names, wanted)):
+        if not want:
+            continue
+        slots = PARAMETERS[name].slots
+        part = per_element[..., column:column + slots]
+        column += slots
+        if slots == 1:
+            part = part[..., 0]
+        shape = values[index].shape if shapes is None else shapes[index]
+        result[index] = sum_to_shape(part, shape).astype(values[index].dtype, copy=False)
+    return result
