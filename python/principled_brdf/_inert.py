@@ -70,6 +70,23 @@ def reset(values: Float64Array, start: Float64Array, slots: Sequence[int], evalu
     return shown
 
 
+def candidates(value: Float64Array, jacobian: Float64Array, present: Float64Array, values: Float64Array,
+               start: Float64Array, slots: Sequence[int]) -> Float64Array:
+    """Which of B problems ``reset`` may change: f ``(B, n, 3)``, its Jacobian ``(B, n, 3, 13)``,
+    ``present`` ``(B, n)`` the samples to look at, ``values`` and ``start`` ``(B, 13)``. A superset
+    (twice reset's first-order bound), so that a problem left out is one reset would leave."""
+    here = present[..., None]
+    scale = np.max(np.where(here, np.abs(value), 0.0), axis=(1, 2), initial=0.0)
+    bound = 2.0 * _FIRST_ORDER_CHANGE * scale.astype(np.float64)
+    maybe = np.zeros(len(values), bool)
+    for group in _whole_parameters(slots):
+        delta = (values[:, group] - start[:, group]).astype(np.float64)
+        change = np.einsum("bnck,bk->bnc", jacobian[..., group].astype(np.float64), delta)
+        first_order = np.max(np.where(here, np.abs(change), 0.0), axis=(1, 2), initial=0.0)
+        maybe |= np.any(delta != 0.0, axis=1) & (first_order <= bound)
+    return maybe
+
+
 def note(reset_names: Sequence[Sequence[str]], problems: int) -> str | None:
     """The result's note: which parameters went back to their start, in how many of the problems."""
     counted: dict[str, int] = {}

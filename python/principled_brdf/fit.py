@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import _gradient, _inert, _solver, _validate
-from ._loss_scale import log_scale
+from ._loss_scale import log_scale, log_scales
 from ._batch import eval, eval_grad
 from ._gradient import GRADIENT_NAMES
 from .material import PARAMETERS, Material
@@ -449,7 +449,9 @@ def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], wei
     # the log losses' s per problem (1/sr for "log")
     level = np.ones(count)
     if loss == "scaled_log":
-        for row in np.flatnonzero(has_data):
+        complete = np.all(present, axis=1)
+        level[complete] = log_scales(m[complete], cos_theta[complete, :, 0])
+        for row in np.flatnonzero(has_data & ~complete):
             here = present[row]
             level[row] = log_scale(m[row][here], cos_theta[row, :, 0][here])
     # r = (u(g f) - target) scale: the loss folded into the gain g, target and scale (docs/fitting.md)
@@ -505,7 +507,8 @@ def _reset_inert(fitted: Float64Array, start: Float64Array, slots: list[int], so
                  wi: NDArray[Any], wo: NDArray[Any], present: NDArray[np.bool_], model: Model, precision: str,
                  threads: int) -> list[list[str]]:
     """_inert.reset for each solved problem, in place in ``fitted``: f and its Jacobian of a few
-    problems at a time in one call, then each problem's check on its present samples."""
+    problems at a time in one call, then the check of each problem that may have a
+    parameter without effect (_inert.candidates), on its present samples."""
     n = present.shape[1]
     chunk = max(1, (1 << 22) // max(1, n * 3 * len(GRADIENT_NAMES)))
     names: list[list[str]] = []
@@ -518,7 +521,9 @@ def _reset_inert(fitted: Float64Array, start: Float64Array, slots: list[int], so
                           threads=threads or None)
         else:
             g = reference.eval_grad(material, wi_part, wo_part, model=model)
-        for j, row in enumerate(rows):
+        maybe = _inert.candidates(g.value, g.jacobian, present[rows], fitted[rows], start[rows], slots)
+        names.extend([] for _ in range(int(np.count_nonzero(~maybe))))
+        for j, row in zip(np.flatnonzero(maybe), rows[maybe]):
             here = present[row]
             value, jacobian = g.value[j][here].astype(np.float64), g.jacobian[j][here].astype(np.float64)
             _, evaluate_value = _evaluators(wi[row][here] if wi.ndim == 3 else wi[here],
