@@ -9,7 +9,7 @@ synthetic measurements of the model with 2 % noise), with the instruction set.
 ``--texels T`` fits T x T texels; the 1024² texture of docs/fitting.md is
 measured as a slice (e.g. ``--texels 128 --pairs 256``) and extrapolated by
 the texel count. ``--eval-subsets`` times eval_grad with one column, a few and
-all 13 against eval in cache.
+all 13, and eval_vjp, against eval in cache (``--subset-pairs`` a call).
 """
 
 from __future__ import annotations
@@ -45,16 +45,20 @@ def texture(rng: np.random.Generator, count: int) -> pb.Material:
                        sheen=rng.uniform(0, 0.5, (count, 1)), clearcoat=rng.uniform(0, 0.5, (count, 1)))
 
 
-def eval_subsets(repeats: int, threads: int) -> None:
+def eval_subsets(repeats: int, threads: int, pairs: int) -> None:
     rng = np.random.default_rng(2)
-    n = 4096
+    n = pairs
     wi, wo = unit(rng, n).astype(np.float32), unit(rng, n).astype(np.float32)
     m = pb.Material(base_color=(0.7, 0.4, 0.2), roughness=0.4, metallic=0.3, sheen=0.2, clearcoat=0.3)
-    inner = 200
-    base = best_of(repeats, lambda: [pb.eval(m, wi, wo, threads=threads) for _ in range(inner)])
-    print(f"eval_grad / eval at {n} pairs in cache, uniform material ({threads} threads):")
+    inner = max(1, (1 << 20) // n)
+    f = np.empty((n, 3), np.float32)  # outputs allocated once: the kernels' time, not the page faults'
+    base = best_of(repeats, lambda: [pb.eval(m, wi, wo, threads=threads, out=f) for _ in range(inner)])
+    print(f"eval_grad / eval at {n} pairs in cache, uniform material ({threads} threads, out= preallocated):")
     for wrt in (["roughness"], ["clearcoat_gloss"], ["base_color"], ["base_color", "roughness", "metallic"], None):
-        t = best_of(repeats, lambda: [pb.eval_grad(m, wi, wo, wrt=wrt, threads=threads) for _ in range(inner)])
+        columns = len(GRADIENT_NAMES) if wrt is None else len(pb.eval_grad(m, wi[:1], wo[:1], wrt=wrt).names)
+        jacobian = np.empty((n, 3, columns), np.float32)
+        t = best_of(repeats, lambda: [pb.eval_grad(m, wi, wo, wrt=wrt, threads=threads, out=(f, jacobian))
+                                      for _ in range(inner)])
         label = "all 13" if wrt is None else ", ".join(wrt)
         print(f"  {label:40s} {base / t:.2f}x  ({n * inner / t / 1e6:.1f} M pairs/s)")
     g = rng.normal(size=(n, 3)).astype(np.float32)
@@ -71,10 +75,13 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--eval-subsets", action="store_true")
+    parser.add_argument("--subset-pairs", type=int, default=16384,
+                        help="pairs a call for --eval-subsets (in L2; large enough that the call's Python "
+                             "overhead is small)")
     args = parser.parse_args()
     print(f"instruction set {pb.cpu_info()['isa']}, {args.threads} threads")
     if args.eval_subsets:
-        eval_subsets(args.repeats, args.threads)
+        eval_subsets(args.repeats, args.threads, args.subset_pairs)
     rng = np.random.default_rng(1)
     count, n = args.texels * args.texels, args.pairs
     wi, wo = unit(rng, n), unit(rng, n)

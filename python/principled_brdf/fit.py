@@ -53,6 +53,11 @@ METHODS = ("batched", "scipy")
 # The batched solver stops when a taken step lowers the cost by less than this
 # fraction: the float32 kernels' cost is exact to about 1e-7 of itself.
 _FTOL = {"float32": 1e-7, "float64": 1e-10}
+
+
+def _batch_problems(pairs: int) -> int:
+    """Problems the batched solver takes together: about 4 million samples' worth."""
+    return max(1, (1 << 22) // max(1, pairs))
 # The "relative" loss divides by max(m, _RELATIVE_FLOOR_FRACTION * max m, _RELATIVE_FLOOR) (1/sr):
 # the absolute floor keeps a black problem (every m = 0) finite; it then fits f towards 0.
 _RELATIVE_FLOOR_FRACTION = 1e-3
@@ -346,9 +351,19 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     _validate.model_index(model)  # checked before any work; eval_grad takes the name
 
     if method == "batched":
-        fitted, costs, iterations, success, messages, residuals_out, reset_names = _fit_batched(
-            wi, wo, problems, weights, start, lower, upper, slots, loss, cosine, model, precision, max_iterations,
-            thread_count)
+        if wi.ndim != wo.ndim:  # one of them per problem: both
+            wi, wo = np.ascontiguousarray(wi_rows), np.ascontiguousarray(wo_rows)
+        # a few million samples at a time: the solver's arrays stay small whatever the texture
+        # (a problem's result does not depend on the problems solved with it)
+        parts = [_fit_batched(wi[rows] if wi.ndim == 3 else wi, wo[rows] if wo.ndim == 3 else wo, problems[rows],
+                              None if weights is None else weights[rows], start, lower, upper, slots, loss, cosine,
+                              model, precision, max_iterations, thread_count)
+                 for begin in range(0, max(count, 1), _batch_problems(n))
+                 for rows in [slice(begin, min(count, begin + _batch_problems(n)))]]
+        fitted, costs, iterations, success = (np.concatenate([part[k] for part in parts]) for k in range(4))
+        messages = [message for part in parts for message in part[4]]
+        residuals_out = np.concatenate([part[5] for part in parts])
+        reset_names = [names for part in parts for names in part[6]]
     else:
         fitted, costs, iterations, success, messages, residuals_out, reset_names = _fit_scipy(
             wi_rows, wo_rows, problems, weights, start, lower, upper, slots, loss, cosine, model, precision,

@@ -224,3 +224,19 @@ def test_the_batched_method_leaves_blas_alone(monkeypatch):
     wi, wo, measured, truth = texels(count=2, n=100, key="blas")
     result = pb.fit(wi, wo, measured, fit=FITTED)
     assert result.success.all()
+
+
+def test_a_texture_solved_in_parts_is_the_texture_solved_at_once(monkeypatch):
+    """fit takes a large batch a few million samples at a time: the parts give the same bits."""
+    import sys
+
+    wi, wo, measured, _ = texels(count=5, n=100, key="parts")
+    whole = pb.fit(wi, wo, measured, fit=FITTED)
+    monkeypatch.setattr(sys.modules["principled_brdf.fit"], "_batch_problems", lambda pairs: 2)
+    parts = pb.fit(wi, wo, measured, fit=FITTED)
+    np.testing.assert_array_equal(parts.slots, whole.slots)
+    np.testing.assert_array_equal(parts.cost, whole.cost)
+    assert parts.message == whole.message and parts.notes == whole.notes
+    # directions per problem for one of wi, wo
+    per_problem = pb.fit(wi, np.broadcast_to(wo, (5,) + wo.shape), measured, fit=FITTED)
+    np.testing.assert_array_equal(per_problem.slots, whole.slots)
