@@ -545,7 +545,9 @@ def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent
     if not isinstance(precision, str) or precision not in ("float32", "float64"):
         raise ValueError(f"precision: expected 'float32' or 'float64', got {precision!r}")
     soa = _layout(layout) == "soa"
-    g = np.asarray(as_real_array("cotangent", cotangent), dtype=np.float64)
+    g = np.asarray(as_real_array("cotangent", cotangent))
+    if g.dtype != np.float32:
+        g = g.astype(np.float64)
     if g.ndim == 0 or g.shape[0 if soa else -1] != 3:
         raise ValueError(f"cotangent: expected shape {'(3, ...)' if soa else '(..., 3)'} like f, got {g.shape}")
     if not np.isfinite(g).all():
@@ -559,8 +561,8 @@ def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent
         g_aos = g if not soa else np.moveaxis(g, 0, -1)
         products = np.einsum("...c,...ck->...k", np.broadcast_to(g_aos, jacobian.shape[:-1]), jacobian)
         return _sum_to_parameters(material, products, wanted, np.float64)
-    g32 = g.astype(np.float32)
-    if np.isinf(g32).any():
+    g32 = g.astype(np.float32, copy=False)
+    if g32 is not g and np.isinf(g32).any():
         raise ValueError("cotangent: values beyond float32's range")
 
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
@@ -583,7 +585,10 @@ def _sum_to_parameters(material: Material, products: NDArray[Any], wanted: list[
         column = products[..., k]
         extra = column.ndim - len(own)
         axes = tuple(range(extra)) + tuple(extra + a for a, d in enumerate(own) if d == 1 and column.shape[extra + a] != 1)
-        total = column.sum(axis=axes, dtype=np.float64, keepdims=False) if axes else column.astype(np.float64)
+        if not axes:  # one product an element: as it is
+            result[GRADIENT_NAMES[slot]] = np.ascontiguousarray(column, dtype=dtype).reshape(own)
+            continue
+        total = column.sum(axis=axes, dtype=np.float64, keepdims=False)
         result[GRADIENT_NAMES[slot]] = np.asarray(total, dtype=np.float64).reshape(own).astype(dtype)
     return result
 
