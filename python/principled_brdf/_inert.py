@@ -28,6 +28,9 @@ _SHOWN_CHANGE = 1e-6  # a parameter set back from closer than this to its start 
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
+    from typing import Any
+
+    from numpy.typing import NDArray
 
     from ._typing import Float64Array
 
@@ -70,8 +73,8 @@ def reset(values: Float64Array, start: Float64Array, slots: Sequence[int], evalu
     return shown
 
 
-def candidates(value: Float64Array, jacobian: Float64Array, present: Float64Array, values: Float64Array,
-               start: Float64Array, slots: Sequence[int]) -> Float64Array:
+def candidates(value: NDArray[np.floating[Any]], jacobian: NDArray[np.floating[Any]], present: NDArray[np.bool_],
+               values: Float64Array, start: Float64Array, slots: Sequence[int]) -> NDArray[np.bool_]:
     """Which of B problems ``reset`` may change: f ``(B, n, 3)``, its Jacobian ``(B, n, 3, 13)``,
     ``present`` ``(B, n)`` the samples to look at, ``values`` and ``start`` ``(B, 13)``. A superset
     (twice reset's first-order bound), so that a problem left out is one reset would leave."""
