@@ -139,8 +139,8 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
     const std::int64_t n = job.pairs;
     RawMaterial m;
     for (int s = 0; s < kParamSlots; ++s) m.slot[s] = Floats(job.slots[b * kParamSlots + s]);
-    const Prepared<Output::kGradient> material = prepare<Output::kGradient>(m);
-    const Floats gain(job.gain != nullptr ? job.gain[b] : 1.0f);
+    Prepared<Output::kGradient> material = prepare<Output::kGradient>(m);
+    Floats gain(job.gain != nullptr ? job.gain[b] : 1.0f);
     const std::int64_t directions = job.per_problem_directions ? 3 * n * b : 0;
     const float* wi = job.wi + directions;
     const float* wo = job.wo + directions;
