@@ -33,7 +33,7 @@ ARGUMENT_NAMES = ("wi", "wo", "u", "out", "material", "model", "layout", "thread
                   "seed", "specular_sampler", "n", "first", "samples", "cos_theta_o", "resolution", "light",
                   "light_intensity", "ambient", "leading shapes", "h", "w", "u1", "u2", "alpha", "alpha_x",
                   "alpha_y", "gamma", "p", "approximation", "correlated", "closed_forms", "params",
-                  "energy_compensation", "wrt",
+                  "energy_compensation", "wrt", "cotangent",
                   "out[0]", "out[1]", "measured", "weights", "bounds", "fit", "init", "loss", "max_iterations",
                   "precision", "normal", "tangent", "frame", "theta", "phi", "theta_h", "phi_h", "theta_d", "phi_d",
                   "color", "linear", "exposure", "curve", "table", "brdf", "interpolation", "theta_o", "phi_d",
@@ -178,6 +178,7 @@ OPTION_VALUES = {
     "layout": ("aos", "aos", "aos", "soa", "AOS", None),
     "specular_sampler": ("visible", "distribution", "best"),
     "seed": (0, 7, 2**64 - 1, 2**64, -1, 1.0, None),
+    "wrt": (None, "roughness", ["base_color", "sheen"], ("clearcoat_gloss", "metallic"), [], "gloss", ["roughness"] * 2, 3),
 }
 
 
@@ -234,10 +235,12 @@ def draw_pair_call(data, leading, seed, option_names):
 
 @FUZZ
 @given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1),
-       entry=st.sampled_from(("eval", "eval_out", "eval_lobes", "pdf", "eval_grad")))
+       entry=st.sampled_from(("eval", "eval_out", "eval_lobes", "pdf", "eval_grad", "eval_vjp")))
 def test_fuzz_evaluation(data, leading, seed, entry):
-    drawn = draw_pair_call(data, leading, seed, ["model", "threads", "check", "cosine", "isa", "layout"]
-                           if entry != "pdf" else ["threads", "check", "isa", "layout", "specular_sampler"])
+    names = {"pdf": ["threads", "check", "isa", "layout", "specular_sampler"],
+             "eval_grad": ["model", "threads", "check", "cosine", "isa", "layout", "wrt"],
+             "eval_vjp": ["model", "threads", "check", "cosine", "isa", "layout", "wrt"]}
+    drawn = draw_pair_call(data, leading, seed, names.get(entry, ["model", "threads", "check", "cosine", "isa", "layout"]))
     if drawn is None:
         return
     opts, layout, wi, wo, material = drawn
@@ -265,6 +268,7 @@ def test_fuzz_evaluation(data, leading, seed, entry):
             out.flags.writeable = False
         elif out_kind == "wrong_shape":
             out = out[..., :2]
+    cotangent = soa(data.draw(direction_argument(leading, rng_from(seed + 1))), layout) if entry == "eval_vjp" else None
     wi_seen = np.array(wi, dtype=np.float32, copy=True) if isinstance(wi, np.ndarray) and wi.dtype.kind == "f" else None
     wo_seen = np.array(wo, dtype=np.float32, copy=True) if isinstance(wo, np.ndarray) and wo.dtype.kind == "f" else None
 
@@ -272,17 +276,21 @@ def test_fuzz_evaluation(data, leading, seed, entry):
             "eval_out": lambda: pb.eval(material, wi, wo, out=out, **opts),
             "eval_lobes": lambda: pb.eval_lobes(material, wi, wo, **opts),
             "pdf": lambda: pb.pdf(material, wi, wo, **opts),
-            "eval_grad": lambda: pb.eval_grad(material, wi, wo, **opts)}[entry]
+            "eval_grad": lambda: pb.eval_grad(material, wi, wo, **opts),
+            "eval_vjp": lambda: pb.eval_vjp(material, wi, wo, cotangent, **opts)}[entry]
     result = outcome(call)
     if result is None:
         return
-    arrays = list(result) if entry == "eval_lobes" else [result.value, result.jacobian] if entry == "eval_grad" else [result]
+    arrays = (list(result) if entry == "eval_lobes" else [result.value, result.jacobian] if entry == "eval_grad"
+              else list(result.values()) if entry == "eval_vjp" else [result])
     for array in arrays:
         assert array.dtype == np.float32
         assert np.isfinite(array).all(), "non-finite output for accepted input"
     if entry == "eval_out":
         assert result is out
-    if wi_seen is None or wo_seen is None or entry == "pdf":
+    if entry == "eval_vjp":
+        assert_vjp_contracts_the_jacobian(result, material, wi, wo, cotangent, opts)
+    if wi_seen is None or wo_seen is None or entry in ("pdf", "eval_vjp"):
         return
     a, b = float32_pairs(wi_seen, wo_seen, layout)
     if not (unit_length(a).all() and unit_length(b).all()):
@@ -293,6 +301,22 @@ def test_fuzz_evaluation(data, leading, seed, entry):
     for actual, wanted in zip(arrays, list(expected) if entry == "eval_lobes" else [expected]):  # eval_grad: its value
         actual = np.moveaxis(actual, 0, -1) if layout == "soa" else actual
         assert_matches_reference(actual, wanted, *np.broadcast_arrays(a, b))
+
+
+def assert_vjp_contracts_the_jacobian(products, material, wi, wo, cotangent, opts):
+    """An accepted eval_vjp equals Σ_c g_c ∂f_c/∂p from eval_grad of the same call, slot by slot."""
+    gradient = pb.eval_grad(material, wi, wo, **opts)
+    soa_layout = opts.get("layout", "aos") == "soa"
+    jacobian = np.moveaxis(gradient.jacobian, (0, 1), (-2, -1)) if soa_layout else gradient.jacobian  # (..., 3, P)
+    g = np.asarray(cotangent, np.float64)
+    g = np.moveaxis(g, 0, -1) if soa_layout else g
+    g = np.broadcast_to(g, jacobian.shape[:-1])
+    expected = np.einsum("...c,...cp->...p", g, jacobian.astype(np.float64))
+    magnitude = np.einsum("...c,...cp->...p", np.abs(g), np.abs(jacobian.astype(np.float64)))  # float32 rounding's scale
+    for column, name in enumerate(gradient.names):
+        actual = np.asarray(products[name], np.float64)
+        error = np.abs(actual - expected[..., column])
+        assert np.all(error <= 1e-5 * magnitude[..., column] + 1e-30), (name, error.max(), magnitude.max())
 
 
 @FUZZ
