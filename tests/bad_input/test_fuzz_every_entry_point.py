@@ -33,7 +33,7 @@ ARGUMENT_NAMES = ("wi", "wo", "u", "out", "material", "model", "layout", "thread
                   "seed", "specular_sampler", "n", "first", "samples", "cos_theta_o", "resolution", "light",
                   "light_intensity", "ambient", "leading shapes", "h", "w", "u1", "u2", "alpha", "alpha_x",
                   "alpha_y", "gamma", "p", "approximation", "correlated", "closed_forms", "params",
-                  "energy_compensation", "wrt", "cotangent",
+                  "energy_compensation", "wrt", "cotangent", "method",
                   "out[0]", "out[1]", "measured", "weights", "bounds", "fit", "init", "loss", "max_iterations",
                   "precision", "normal", "tangent", "frame", "theta", "phi", "theta_h", "phi_h", "theta_d", "phi_d",
                   "color", "linear", "exposure", "curve", "table", "brdf", "interpolation", "theta_o", "phi_d",
@@ -647,9 +647,18 @@ def test_fuzz_measured_and_fit(data, seed, entry, tmp_path_factory):
             kwargs["max_iterations"] = data.draw(st.sampled_from((5, 0, -1, 2.5, "5")))
         if data.draw(st.booleans()):
             kwargs["weights"] = data.draw(st.sampled_from((np.ones(n), np.ones(n + 1), -np.ones(n), "w")))
+        if data.draw(st.booleans()):
+            kwargs["method"] = data.draw(st.sampled_from(("batched", "scipy", "newton")))
+        if data.draw(st.booleans()):
+            kwargs["precision"] = data.draw(st.sampled_from(("float32", "float64", "half")))
+        if data.draw(st.booleans()):  # a batch: the faulty problem beside a clean one, which must still be fitted
+            clean = pb.reference.eval(pb.Material(roughness=0.4), wi_fit, wo_fit)
+            measured = np.stack([clean[:, :measured.shape[1]], measured]) if measured.ndim == 2 else measured
         fitted = outcome(lambda: pb.fit(wi_fit, wo_fit, measured, **kwargs))
         result = None if fitted is None else np.concatenate([np.ravel(getattr(fitted.material, name))
                                                              for name in pb.PARAMETERS])
+        if fitted is not None and np.ndim(measured) == 3:
+            assert np.ravel(fitted.success)[0] or kwargs.get("max_iterations") in (5,), "a clean problem failed"
     if result is not None:
         assert np.isfinite(np.asarray(result, dtype=np.float64)).all(), f"{entry}: non-finite result"
 
