@@ -38,6 +38,18 @@ class _ParamInfo:
 PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
 
 
+
+def _owned_copy(array: Float64Array) -> Float64Array:
+    """A read-only copy of ``array``; a broadcast view (stride-0 axes, np.broadcast_to)
+    stays one, over a copy of the values it holds, never expanded."""
+    cut = tuple(slice(0, 1) if stride == 0 and size > 1 else slice(None) for stride, size in zip(array.strides, array.shape))
+    if all(c == slice(None) for c in cut):
+        copy = array.copy()
+        copy.flags.writeable = False
+        return copy
+    return np.broadcast_to(array[cut].copy(), array.shape)  # (read-only)
+
+
 class Material:
     """Disney principled BRDF parameters (docs/model.md, "The model").
 
@@ -100,8 +112,7 @@ class Material:
             if info.slots == 3 and (array.ndim == 0 or array.shape[-1] != 3):
                 raise ValueError(f"{name}: expected an RGB triple, shape (3,) or (..., 3), got shape {array.shape}")
             require_in_domain(name, array, info.lower, info.upper)
-            array = array.copy()  # a Material never aliases the caller's buffers
-            array.flags.writeable = False
+            array = _owned_copy(array)  # a Material never aliases the caller's buffers
             object.__setattr__(self, name, array)
         object.__setattr__(self, "_float32_cache", {})
         object.__setattr__(self, "_kernel_numbers", None)
@@ -220,6 +231,22 @@ class Material:
             array = getattr(self, name)
             target = leading_shape + (3,) if PARAMETERS[name].slots == 3 else leading_shape
             cached = np.ascontiguousarray(np.broadcast_to(array, target), dtype=np.float32)
+            cached.flags.writeable = False
+            if len(self._float32_cache) > 32:
+                self._float32_cache.clear()
+            self._float32_cache[key] = cached
+        return cached
+
+    def _float32_compact(self, name: str) -> Float32Array:
+        """A per-element parameter as contiguous float32 in its compact form (its
+        broadcast axes of size 1, as _owned_copy keeps them; cached)."""
+        key = (name, None)
+        cached = self._float32_cache.get(key)
+        if cached is None:
+            array = getattr(self, name)
+            cut = tuple(slice(0, 1) if stride == 0 and size > 1 else slice(None)
+                        for stride, size in zip(array.strides, array.shape))
+            cached = np.ascontiguousarray(array[cut], dtype=np.float32)
             cached.flags.writeable = False
             if len(self._float32_cache) > 32:
                 self._float32_cache.clear()
