@@ -36,7 +36,7 @@ from ._validate import (
     unit_length,
 )
 from . import _gradient
-from ._segments import compact, choose_split, leading_of, part
+from ._segments import choose_split, compact, leading_of, part, unexpanded
 from ._gradient import GRADIENT_NAMES, Gradient
 from .material import PARAMETERS, Material
 
@@ -135,8 +135,7 @@ def _float32_input(name: str, value: object) -> tuple[Float32Array, FloatArray]:
     require_float32(name, given)
     if given.ndim == 0:
         return np.ascontiguousarray(given, dtype=np.float32), given
-    cut = tuple(slice(0, 1) if stride == 0 and size > 1 else slice(None) for stride, size in zip(given.strides, given.shape))
-    return np.broadcast_to(np.ascontiguousarray(given[cut], dtype=np.float32), given.shape), given
+    return np.broadcast_to(np.ascontiguousarray(unexpanded(given), dtype=np.float32), given.shape), given
 
 
 class _Directions:

@@ -10,7 +10,7 @@ along those axes only.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -20,6 +20,13 @@ if TYPE_CHECKING:
 # Inner runs shorter than this are not worth a segment: the padded tail of
 # each run (at most one SIMD batch) would cost more than a copy saves.
 SMALLEST_SEGMENT = 256
+
+
+def unexpanded(array: NDArray[Any]) -> NDArray[Any]:
+    """``array`` with every stride-0 axis (a broadcast view's) cut to size 1: a view
+    of the values it holds (``np.broadcast_to(unexpanded(a), a.shape)`` is ``a``)."""
+    return array[tuple(slice(0, 1) if stride == 0 and size > 1 else slice(None)
+                       for stride, size in zip(array.strides, array.shape))]
 
 
 def compact(array: NDArray[np.float32], depth: int, vector_axis: int | None) -> NDArray[np.float32]:

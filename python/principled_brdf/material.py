@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _color, _core
+from ._segments import unexpanded
 from ._validate import as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
 
 if TYPE_CHECKING:
@@ -42,12 +43,12 @@ PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
 def _owned_copy(array: Float64Array) -> Float64Array:
     """A read-only copy of ``array``; a broadcast view (stride-0 axes, np.broadcast_to)
     stays one, over a copy of the values it holds, never expanded."""
-    cut = tuple(slice(0, 1) if stride == 0 and size > 1 else slice(None) for stride, size in zip(array.strides, array.shape))
-    if all(c == slice(None) for c in cut):
-        copy = array.copy()
-        copy.flags.writeable = False
-        return copy
-    return np.broadcast_to(array[cut].copy(), array.shape)  # (read-only)
+    values = unexpanded(array)
+    if values.shape != array.shape:
+        return np.broadcast_to(values.copy(), array.shape)  # (read-only)
+    copy = array.copy()
+    copy.flags.writeable = False
+    return copy
 
 
 class Material:
@@ -223,30 +224,13 @@ class Material:
                 rows[:, info.first_slot] = np.broadcast_to(array, leading_shape).reshape(n)
         return rows
 
-    def _float32(self, name: str, leading_shape: tuple[int, ...]) -> Float32Array:
-        """A per-element parameter broadcast to ``leading_shape`` as contiguous float32 (cached)."""
-        key = (name, leading_shape)
-        cached = self._float32_cache.get(key)
-        if cached is None:
-            array = getattr(self, name)
-            target = leading_shape + (3,) if PARAMETERS[name].slots == 3 else leading_shape
-            cached = np.ascontiguousarray(np.broadcast_to(array, target), dtype=np.float32)
-            cached.flags.writeable = False
-            if len(self._float32_cache) > 32:
-                self._float32_cache.clear()
-            self._float32_cache[key] = cached
-        return cached
-
     def _float32_compact(self, name: str) -> Float32Array:
         """A per-element parameter as contiguous float32 in its compact form (its
         broadcast axes of size 1, as _owned_copy keeps them; cached)."""
         key = (name, None)
         cached = self._float32_cache.get(key)
         if cached is None:
-            array = getattr(self, name)
-            cut = tuple(slice(0, 1) if stride == 0 and size > 1 else slice(None)
-                        for stride, size in zip(array.strides, array.shape))
-            cached = np.ascontiguousarray(array[cut], dtype=np.float32)
+            cached = np.ascontiguousarray(unexpanded(getattr(self, name)), dtype=np.float32)
             cached.flags.writeable = False
             if len(self._float32_cache) > 32:
                 self._float32_cache.clear()
