@@ -120,16 +120,32 @@ def test_broadcast_calls_give_the_bits_of_materialised_ones(isa, case):
                                   pb.eval_pdf(full, wi_full, wo_full, isa=isa)[1])
 
 
-def test_a_grid_of_views_against_a_texture_makes_no_full_size_copy():
+@pytest.mark.parametrize("layout", ["aos", "soa"])
+def test_a_grid_of_views_against_a_texture_makes_no_full_size_copy(layout):
     rng = np.random.default_rng(7)
     views = unit(rng, (8, 8, 1, 1))
+    views = views if layout == "aos" else soa(views)
     material = texture(rng, (128, 128))
-    pb.eval(material, views, [0.0, 0.0, 1.0])  # the material's float32 arrays, cached on it
+    pb.eval(material, views, [0.0, 0.0, 1.0], layout=layout)  # the material's float32 arrays, cached on it
     tracemalloc.start()
+    f = pb.eval(material, views, [0.0, 0.0, 1.0], layout=layout)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert f.size == 8 * 8 * 128 * 128 * 3
+    assert peak < 1.1 * f.nbytes, f"peak {peak / 1e6:.1f} MB for a {f.nbytes / 1e6:.1f} MB result"
+
+
+def test_a_material_of_broadcast_views_is_neither_stored_nor_read_expanded():
+    rng = np.random.default_rng(9)
+    leading = (8, 8, 128, 128)
+    roughness = np.broadcast_to(rng.uniform(0.05, 1, (128, 128)), leading)  # 8 MB expanded as float64
+    views = np.broadcast_to(unit(rng, (8, 8, 1, 1)), leading + (3,))
+    tracemalloc.start()
+    material = pb.Material(roughness=roughness)
     f = pb.eval(material, views, [0.0, 0.0, 1.0])
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
-    assert f.shape == (8, 8, 128, 128, 3)
+    assert material.shape == leading
     assert peak < 1.1 * f.nbytes, f"peak {peak / 1e6:.1f} MB for a {f.nbytes / 1e6:.1f} MB result"
 
 
