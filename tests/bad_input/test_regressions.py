@@ -353,7 +353,7 @@ def test_the_kernels_never_see_misaligned_data():
     # would still reach them, rather than hand the kernels a float* off alignment.
     n = 8
     wi = misaligned(np.tile(np.float32([0, 0, 1]), (n, 1)))
-    params = pb._batch._params(pb.Material(), (n,))
+    params = pb._batch._parameter_views(pb.Material(), 1)  # (uniform: numbers)
     options = pb._core.EvalOptions(threads=1)
     wo = np.float32([0, 0, 1])
     with pytest.raises(ValueError, match="wi: array data is not aligned"):
