@@ -228,13 +228,46 @@ class _Segmented(NamedTuple):
 
     vectors: list[tuple[Float32Array | None, int]]  # (array, layout code) of each direction argument
     params: list[float | tuple[float, ...] | Float32Array]
-    segments: tuple[int, int, list[NDArray[np.int64] | None], list[bool]]  # _core's segments=
+    segments: tuple[int, int, list[NDArray[np.int64] | None], list[bool]] | None  # _core's segments= (None: one run)
+
+
+def _unsegmented(leading: tuple[int, ...], layout: str, directions: list[_Directions | None],
+                 material: Material) -> _Segmented | None:
+    """The arguments of a call that needs no segments (each one vector or
+    number, or C-contiguous of the call's shape), or None: the common cases,
+    without the segments' bookkeeping."""
+    n = _size(leading)
+    vectors: list[tuple[Float32Array | None, int]] = []
+    for direction in directions:
+        if direction is None:
+            vectors.append((None, 0))
+        elif not direction.array.flags.c_contiguous:
+            return None
+        elif _size(direction.leading) == 1:  # () or (1, ...): one vector
+            vectors.append((direction.array.reshape(3), _SINGLE))
+        elif direction.leading == leading:
+            vectors.append(_flat_vec3(direction.array, layout))
+        else:
+            return None
+    params: list[float | tuple[float, ...] | Float32Array] = []
+    for (name, info), number in zip(PARAMETERS.items(), _kernel_numbers(material)):
+        if number is not None:
+            params.append(number)
+            continue
+        values = material._float32_compact(name)
+        if values.shape != (leading + (3,) if info.slots == 3 else leading):
+            return None
+        params.append(values.reshape((n, 3) if info.slots == 3 else (n,)))
+    return _Segmented(vectors, params, None)
 
 
 def _segmented(leading: tuple[int, ...], layout: str, directions: list[_Directions | None],
                material: Material) -> _Segmented:
     """Wi, wo and the third argument (cotangent or u; None entries for absent
     ones) and the material, read in place along the axes they broadcast on."""
+    plain = _unsegmented(leading, layout, directions, material)
+    if plain is not None:
+        return plain
     depth = len(leading)
     axis = -1 if layout == "aos" else 0
     views = [None if d is None else compact(d.array, depth, axis) for d in directions]
