@@ -3,12 +3,13 @@
 Input handling, once per call:
 
 * directions are ``(..., 3)`` (``layout="aos"``, the default) or ``(3, ...)``
-  (``layout="soa"``); a float32 C-contiguous array is read in place, anything
-  else (other dtypes, strides) is converted once to a float32 copy;
-* a direction whose leading shape is ``()`` is one vector for every element
-  (read once, never copied); other broadcasts are materialised;
+  (``layout="soa"``); a float32 array is read in place, anything else (other
+  dtypes) is converted once to float32 in its compact form (stride-0 axes
+  not expanded);
+* arguments that broadcast (by shape or as stride-0 views) are read in
+  place by segments (_segments.py), never expanded to the call's shape;
 * uniform material parameters are passed as numbers (no per-element loads);
-  per-element ones as float32 arrays, cached on the Material.
+  per-element ones as compact float32 arrays, cached on the Material.
 """
 
 from __future__ import annotations
