@@ -149,9 +149,12 @@ def test_a_material_of_broadcast_views_is_neither_stored_nor_read_expanded():
     assert peak < 1.1 * f.nbytes, f"peak {peak / 1e6:.1f} MB for a {f.nbytes / 1e6:.1f} MB result"
 
 
-def test_a_bad_direction_in_a_segment_is_named_in_its_own_shape():
+@pytest.mark.parametrize("layout", ["aos", "soa"])
+def test_a_bad_direction_in_a_segment_is_named_in_its_own_shape(layout):
     rng = np.random.default_rng(8)
     views = unit(rng, (3, 2, 1, 1))
     views[2, 1, 0, 0] = [0.0, 0.0, 1.5]
+    light = np.broadcast_to(np.float32([0.0, 0.0, 1.0]), (40, 40, 3))  # a stride-0 view
+    convert = (lambda v: v) if layout == "aos" else (lambda v: np.moveaxis(v, -1, 0))
     with pytest.raises(ValueError, match=r"wi\[2, 1, 0, 0\]: length 1.5"):
-        pb.eval(texture(rng, (40, 40)), views, [0.0, 0.0, 1.0])
+        pb.eval(texture(rng, (40, 40)), convert(views), convert(light), layout=layout)
