@@ -5,10 +5,12 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "bindings.hpp"
 #include "principled_brdf/batch.hpp"
@@ -60,9 +62,98 @@ void output_views(const py::sequence& arrays, int count, int layout, std::int64_
     }
 }
 
+// The segments of a call (Segments in batch.hpp), from Python: None, one
+// segment of n elements; or (count, length, offsets, single) with count
+// length = n, offsets 3 + 11 entries (wi, wo, the cotangent or u, then the
+// parameters in the order of kParams), each None or `count` non-negative
+// int64 offsets in floats, and single 11 flags: the parameter is one value a
+// segment. The inputs are then checked against their own sizes: every
+// segment's elements lie within them.
+struct SegmentTables {
+    bool given = false;
+    Segments segments;
+    std::int64_t largest[3 + kParams.size()] = {};  // each input's largest offset
+    bool single[kParams.size()] = {};
+    std::vector<py::array_t<std::int64_t, py::array::c_style>> keep;
+};
+
+constexpr int kTableInputs = 3 + static_cast<int>(kParams.size());
+
+SegmentTables segments_from(const py::object& value, std::int64_t n) {
+    SegmentTables tables;
+    tables.segments.length = n;
+    if (value.is_none()) return tables;
+    tables.given = true;
+    auto entries = value.cast<py::tuple>();
+    if (entries.size() != 4) throw std::invalid_argument("segments: expected (count, length, offsets, single)");
+    Segments& segments = tables.segments;
+    segments.count = entries[0].cast<std::int64_t>();
+    segments.length = entries[1].cast<std::int64_t>();
+    if (segments.count < 0 || segments.length < 0 ||
+        (segments.length > 0 && segments.count > std::numeric_limits<std::int64_t>::max() / segments.length) ||
+        segments.count * segments.length != n)
+        throw std::invalid_argument("segments: expected count * length == n");
+    auto offsets = entries[2].cast<py::sequence>();
+    auto single = entries[3].cast<std::vector<bool>>();
+    if (py::len(offsets) != static_cast<std::size_t>(kTableInputs) || single.size() != kParams.size())
+        throw std::invalid_argument("segments: expected 14 offset tables and 11 flags");
+    for (int input = 0; input < kTableInputs; ++input) {
+        if (offsets[input].is_none()) continue;
+        tables.keep.push_back(py::cast<py::array_t<std::int64_t, py::array::c_style>>(offsets[input]));
+        const auto& table = tables.keep.back();
+        if (!table.is(offsets[input]) || table.ndim() != 1 || table.shape(0) != segments.count)
+            throw std::invalid_argument("segments: an offset table is not `count` C-contiguous int64 values");
+        const std::int64_t* data = table.data();
+        for (std::int64_t s = 0; s < segments.count; ++s) {
+            if (data[s] < 0) throw std::invalid_argument("segments: negative offset");
+            tables.largest[input] = std::max(tables.largest[input], data[s]);
+        }
+        if (input < kSegmentSlots) {
+            segments.offsets[input] = data;
+        } else {
+            const ParamInfo& info = kParams[input - kSegmentSlots];
+            for (int k = 0; k < info.slots; ++k) segments.offsets[kSegmentSlots + info.first_slot + k] = data;
+        }
+    }
+    for (std::size_t p = 0; p < kParams.size(); ++p) {
+        tables.single[p] = single[p];
+        for (int k = 0; k < kParams[p].slots; ++k) segments.single[kParams[p].first_slot + k] = single[p];
+    }
+    return tables;
+}
+
+void require_within(bool ok, const char* name) {
+    if (!ok) throw std::invalid_argument(std::string(name) + ": a segment reaches past the array");
+}
+
+// A direction input: vec3_view for one segment; with segments, any length of
+// its own that every segment's elements fit in.
+Vec3Array input_view(const Float32Array& a, int layout, std::int64_t n, const char* name, const SegmentTables& tables,
+                     int input) {
+    if (!tables.given) return vec3_view(a, layout, n, name);
+    const auto kind = static_cast<Vec3Layout>(layout);
+    const std::int64_t largest = tables.largest[input], length = tables.segments.length;
+    require_aligned(a.data(), name);
+    switch (kind) {
+        case Vec3Layout::kInterleaved:
+            if (a.ndim() != 2 || a.shape(1) != 3) throw std::invalid_argument(std::string(name) + ": expected (M, 3)");
+            require_within(largest + 3 * length <= 3 * a.shape(0), name);
+            return {a.data(), kind, 0};
+        case Vec3Layout::kRows:
+            if (a.ndim() != 2 || a.shape(0) != 3) throw std::invalid_argument(std::string(name) + ": expected (3, M)");
+            require_within(largest + length <= a.shape(1), name);
+            return {a.data(), kind, a.shape(1)};
+        case Vec3Layout::kSingle:
+            require_within(largest + 3 <= a.size(), name);
+            return {a.data(), kind, 0};
+    }
+    throw std::invalid_argument(std::string(name) + ": unknown layout");
+}
+
 // params: 11 entries in the order of kParams, each a number (base_color: a
 // 3-sequence) or a float32 array of n values ((n, 3) for base_color).
-void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, py::list& keep_alive) {
+void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, py::list& keep_alive,
+                 const SegmentTables& tables = SegmentTables{}) {
     if (static_cast<std::size_t>(py::len(params)) != kParams.size())
         throw std::invalid_argument("params: expected one entry per parameter");
     for (std::size_t p = 0; p < kParams.size(); ++p) {
@@ -71,8 +162,13 @@ void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, p
         if (py::isinstance<py::array>(value)) {
             auto array = py::cast<Float32Array>(value);
             keep_alive.append(array);
-            const bool ok = info.slots == 3 ? (array.ndim() == 2 && array.shape(0) == n && array.shape(1) == 3)
-                                            : (array.ndim() == 1 && array.shape(0) == n);
+            bool ok = info.slots == 3 ? (array.ndim() == 2 && array.shape(1) == 3) : array.ndim() == 1;
+            if (!tables.given) {
+                ok = ok && array.shape(0) == n;
+            } else {  // offsets and extents in floats
+                const std::int64_t extent = tables.single[p] ? info.slots : info.slots * tables.segments.length;
+                require_within(tables.largest[kSegmentSlots + p] + extent <= array.size(), info.name);
+            }
             if (!ok) throw std::invalid_argument(std::string(info.name) + ": per-element array of the wrong shape");
             require_aligned(array.data(), info.name);
             for (int s = 0; s < info.slots; ++s)
@@ -118,11 +214,12 @@ struct SampleOptions : BatchOptions {
 
 // The inputs of an evaluation: directions, parameters and options.
 EvalJob eval_job(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout, const py::sequence& params,
-                 std::int64_t n, Output output, const EvalOptions& options, py::list& keep_alive) {
+                 std::int64_t n, Output output, const EvalOptions& options, py::list& keep_alive,
+                 const SegmentTables& tables) {
     EvalJob job;
-    job.wi = vec3_view(wi, wi_layout, n, "wi");
-    job.wo = vec3_view(wo, wo_layout, n, "wo");
-    fill_params(params, n, job.params, keep_alive);
+    job.wi = input_view(wi, wi_layout, n, "wi", tables, kSegmentWi);
+    job.wo = input_view(wo, wo_layout, n, "wo", tables, kSegmentWo);
+    fill_params(params, n, job.params, keep_alive, tables);
     job.model = model_from(options.model);
     job.output = output;
     job.cosine = options.cosine;
@@ -135,15 +232,16 @@ EvalJob eval_job(const Float32Array& wi, int wi_layout, const Float32Array& wo, 
 // wo is not a unit vector (the outputs then hold the results of some elements only).
 std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                         const py::sequence& params, const py::sequence& outputs, int out_layout, std::int64_t n,
-                        bool lobes, const EvalOptions options) {
+                        bool lobes, const EvalOptions options, const py::object& segments) {
     py::list keep_alive;
+    const SegmentTables tables = segments_from(segments, n);
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, lobes ? Output::kLobes : Output::kTotal, options,
-                           keep_alive);
+                           keep_alive, tables);
     std::vector<Float32Array> keep_outputs;
     output_views(outputs, lobes ? kLobeCount : 1, out_layout, n, "out", job.out, keep_outputs);
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return eval(job, n, options.threads, options.isa);
+    return eval(job, tables.segments, options.threads, options.isa);
 }
 
 }  // namespace
@@ -178,11 +276,13 @@ float* derivative_output(Float32Array& a, const std::vector<py::ssize_t>& width,
 // (N, 3, P) arrays, or (3, N) and (3, P, N) with out_layout rows.
 std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                              const py::sequence& params, Float32Array out, Float32Array jacobian, int out_layout,
-                             std::int64_t n, const EvalOptions options, const py::object& columns) {
+                             std::int64_t n, const EvalOptions options, const py::object& columns,
+                             const py::object& segments) {
     if (options.energy_compensation)
         throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
     py::list keep_alive;
-    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kGradient, options, keep_alive);
+    const SegmentTables tables = segments_from(segments, n);
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kGradient, options, keep_alive, tables);
     job.columns = columns_from(columns);
     job.out[0] = output_view(out, out_layout, n, "out");
     const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
@@ -191,7 +291,7 @@ std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float3
     job.jacobian_row_stride = rows ? n : 0;
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return eval(job, n, options.threads, options.isa);
+    return eval(job, tables.segments, options.threads, options.isa);
 }
 
 // Σ_c g_c ∂f_c/∂p per element for the cotangent g ((N, 3), (3, N) or one
@@ -199,20 +299,21 @@ std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float3
 std::int64_t batch_eval_vjp(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                             const py::sequence& params, const Float32Array& cotangent, int cotangent_layout,
                             Float32Array vjp, int out_layout, std::int64_t n, const EvalOptions options,
-                            const py::object& columns) {
+                            const py::object& columns, const py::object& segments) {
     if (options.energy_compensation)
         throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
     py::list keep_alive;
-    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kVjp, options, keep_alive);
+    const SegmentTables tables = segments_from(segments, n);
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kVjp, options, keep_alive, tables);
     job.columns = columns_from(columns);
-    job.cotangent = vec3_view(cotangent, cotangent_layout, n, "cotangent");
+    job.cotangent = input_view(cotangent, cotangent_layout, n, "cotangent", tables, kSegmentThird);
     const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
     job.jacobian = derivative_output(vjp, {job.columns.count}, rows, n, "vjp",
                                      "a writeable (N, P) array, or (P, N) for the rows layout");
     job.jacobian_row_stride = rows ? n : 0;
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return eval(job, n, options.threads, options.isa);
+    return eval(job, tables.segments, options.threads, options.isa);
 }
 
 template <class T>
@@ -226,11 +327,12 @@ T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const ch
 // The sampling pdf alone (out is None) or with f into out, in one pass.
 std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                        const py::sequence& params, Float32Array pdf, const py::object& out, int out_layout,
-                       std::int64_t n, const PdfOptions options) {
+                       std::int64_t n, const PdfOptions options, const py::object& segments) {
     py::list keep_alive;
     const bool with_value = !out.is_none();
+    const SegmentTables tables = segments_from(segments, n);
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, with_value ? Output::kValuePdf : Output::kPdf,
-                           options, keep_alive);
+                           options, keep_alive, tables);
     job.sampler = sampler_from(options.sampler);
     job.pdf = scalar_output(pdf, n, "pdf");
     Float32Array value;
@@ -241,23 +343,24 @@ std::int64_t batch_pdf(const Float32Array& wi, int wi_layout, const Float32Array
     }
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return eval(job, n, options.threads, options.isa);
+    return eval(job, tables.segments, options.threads, options.isa);
 }
 
 std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::object& u, int u_layout,
                           const py::sequence& params, Float32Array wi, Float32Array weight, Float32Array pdf,
                           py::array_t<std::int32_t, py::array::c_style> lobe, const py::object& lobe_weights,
-                          int out_layout, std::int64_t n, const SampleOptions options) {
+                          int out_layout, std::int64_t n, const SampleOptions options, const py::object& segments) {
     SampleJob job;
-    job.wo = vec3_view(wo, wo_layout, n, "wo");
+    const SegmentTables tables = segments_from(segments, n);
+    job.wo = input_view(wo, wo_layout, n, "wo", tables, kSegmentWo);
     Float32Array u_array;
     if (!u.is_none()) {
         u_array = py::cast<Float32Array>(u);
-        job.u = vec3_view(u_array, u_layout, n, "u");
+        job.u = input_view(u_array, u_layout, n, "u", tables, kSegmentThird);
     }
     job.seed = options.seed;
     py::list keep_alive;
-    fill_params(params, n, job.params, keep_alive);
+    fill_params(params, n, job.params, keep_alive, tables);
     job.model = model_from(options.model);
     job.sampler = sampler_from(options.sampler);
     job.energy_compensation = options.energy_compensation;
@@ -272,7 +375,7 @@ std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::objec
     if (options.check_tolerance > 0.0) job.check = direction_check(options.check_tolerance);
     if (n == 0) return -1;
     py::gil_scoped_release release;
-    return sample(job, n, options.threads, options.isa);
+    return sample(job, tables.segments, options.threads, options.isa);
 }
 
 py::array_t<float> uniforms(std::uint64_t seed, std::int64_t first, std::int64_t n) {
@@ -393,25 +496,26 @@ void bind_batch(py::module_& m) {
     // Every argument by keyword: the arrays with their layout codes, and the options.
     m.def("batch_eval", &batch_eval, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
           py::arg("wo_layout"), py::arg("params"), py::arg("outputs"), py::arg("out_layout"), py::arg("n"),
-          py::arg("lobes"), py::arg("options"),
-          "SIMD evaluation (f, or the lobes) into preallocated float32 outputs (validated by the caller).");
+          py::arg("lobes"), py::arg("options"), py::arg("segments") = py::none(),
+          "SIMD evaluation (f, or the lobes) into preallocated float32 outputs (validated by the caller); "
+          "segments: (count, length, offsets, single), inputs read in place per segment.");
     m.def("batch_eval_grad", &batch_eval_grad, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
           py::arg("wo_layout"), py::arg("params"), py::arg("out"), py::arg("jacobian"), py::arg("out_layout"),
-          py::arg("n"), py::arg("options"), py::arg("columns") = py::none(),
+          py::arg("n"), py::arg("options"), py::arg("columns") = py::none(), py::arg("segments") = py::none(),
           "SIMD f and its Jacobian over the parameter slots (columns: their indices, None for all) into "
           "preallocated float32 outputs.");
     m.def("batch_eval_vjp", &batch_eval_vjp, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
           py::arg("wo_layout"), py::arg("params"), py::arg("cotangent"), py::arg("cotangent_layout"), py::arg("vjp"),
           py::arg("out_layout"), py::arg("n"), py::arg("options"), py::arg("columns") = py::none(),
-          "SIMD vector-Jacobian product Σ_c g_c ∂f_c/∂p per element into a preallocated float32 output.");
+          py::arg("segments") = py::none(), "SIMD vector-Jacobian product Σ_c g_c ∂f_c/∂p per element into a preallocated float32 output.");
     m.def("batch_pdf", &batch_pdf, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
           py::arg("wo_layout"), py::arg("params"), py::arg("pdf"), py::arg("out") = py::none(),
-          py::arg("out_layout") = 0, py::arg("n"), py::arg("options"),
+          py::arg("out_layout") = 0, py::arg("n"), py::arg("options"), py::arg("segments") = py::none(),
           "SIMD sampling pdf into a preallocated float32 array (and f into out, in the same pass, if given).");
     m.def("batch_sample", &batch_sample, py::kw_only(), py::arg("wo"), py::arg("wo_layout"), py::arg("u"),
           py::arg("u_layout"), py::arg("params"), py::arg("wi"), py::arg("weight"), py::arg("pdf"), py::arg("lobe"),
           py::arg("lobe_weights") = py::none(), py::arg("out_layout"), py::arg("n"), py::arg("options"),
-          "SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given).");
+          py::arg("segments") = py::none(), "SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given).");
     m.def("counter_uniforms", &uniforms, py::arg("seed"), py::arg("first"), py::arg("n"),
           "The counter-based uniforms (n, 3) that sampling uses for elements first .. first + n - 1.");
     m.def("direction_length2_bounds", &direction_length2_bounds, py::arg("tolerance"),

@@ -75,6 +75,100 @@ const kernel::KernelTable& kernels_for(const std::string& isa) {
     return isa.empty() ? kernel::active() : kernel::by_name(isa, "isa");
 }
 
+// ---------------------------------------------------------------- segments
+namespace {
+
+std::int64_t segment_offset(const Segments& segments, int input, std::int64_t s) {
+    return segments.offsets[input] != nullptr ? segments.offsets[input][s] : 0;
+}
+
+template <class Job>
+void advance_params(const Job& job, Job& part, const Segments& segments, std::int64_t s) {
+    part.per_element_material = !job.uniform_material();
+    for (int slot = 0; slot < kParamSlots; ++slot) {
+        const ParamSlot& from = job.params[slot];
+        if (!from.per_element()) continue;
+        const float* data = from.data + segment_offset(segments, kSegmentSlots + slot, s);
+        part.params[slot] = segments.single[slot] ? ParamSlot{*data, nullptr, 1} : ParamSlot{0.0f, data, from.stride};
+    }
+}
+
+void advance_output(MutableVec3Array& out, std::int64_t first) {
+    if (out.data != nullptr) out.data += out.layout == Vec3Layout::kRows ? first : 3 * first;
+}
+
+void advance_input(Vec3Array& in, const Segments& segments, int input, std::int64_t s) {
+    if (in.data != nullptr) in.data += segment_offset(segments, input, s);
+}
+
+EvalJob segment_job(const EvalJob& job, const Segments& segments, std::int64_t s) {
+    EvalJob part = job;
+    const std::int64_t first = s * segments.length;
+    advance_input(part.wi, segments, kSegmentWi, s);
+    advance_input(part.wo, segments, kSegmentWo, s);
+    if (job.output == Output::kVjp) advance_input(part.cotangent, segments, kSegmentThird, s);
+    advance_params(job, part, segments, s);
+    for (MutableVec3Array& out : part.out) advance_output(out, first);
+    if (part.pdf != nullptr) part.pdf += first;
+    if (part.jacobian != nullptr) {
+        const std::int64_t width = job.output == Output::kVjp ? job.columns.count : 3 * job.columns.count;
+        part.jacobian += job.jacobian_row_stride > 0 ? first : width * first;
+    }
+    return part;
+}
+
+SampleJob segment_job(const SampleJob& job, const Segments& segments, std::int64_t s) {
+    SampleJob part = job;
+    const std::int64_t first = s * segments.length;
+    advance_input(part.wo, segments, kSegmentWo, s);
+    advance_input(part.u, segments, kSegmentThird, s);
+    advance_params(job, part, segments, s);
+    advance_output(part.wi, first);
+    advance_output(part.weight, first);
+    for (MutableVec3Array& out : part.lobe_weight) advance_output(out, first);
+    part.pdf += first;
+    part.lobe += first;
+    part.first_index = job.first_index + first;  // the generator sees the call's element indices
+    return part;
+}
+
+// range(job, begin, end) over the call's elements in per-thread chunks, each
+// chunk's elements segment by segment; the first bad element (the call's index), or -1.
+template <class Job, class Range>
+std::int64_t run_segments(const Job& job, const Segments& segments, int threads, const Range& range) {
+    const std::int64_t length = segments.length;
+    return run_chunks(segments.count * length, threads, [&](std::int64_t begin, std::int64_t end) -> std::int64_t {
+        for (std::int64_t s = begin / length; s * length < end; ++s) {
+            const std::int64_t first = s * length;
+            const std::int64_t bad = range(segment_job(job, segments, s), std::max(begin, first) - first,
+                                           std::min(end, first + length) - first);
+            if (bad >= 0) return first + bad;
+        }
+        return -1;
+    });
+}
+
+}  // namespace
+
+std::int64_t eval(const EvalJob& job, const Segments& segments, int threads, const std::string& isa) {
+    if (segments.count <= 1) return eval(segments.count == 1 ? segment_job(job, segments, 0) : job, segments.count * segments.length, threads, isa);
+    const kernel::KernelTable& kernels = kernels_for(isa);
+    EvalJob streamed = job;
+    streamed.out[0].streaming = job.output == Output::kTotal && job.out[0].layout == Vec3Layout::kInterleaved &&
+                                streaming_output(segments.count * segments.length);
+    return run_segments(streamed, segments, threads, [&](const EvalJob& part, std::int64_t begin, std::int64_t end) {
+        return kernels.eval_range(part, begin, end);
+    });
+}
+
+std::int64_t sample(const SampleJob& job, const Segments& segments, int threads, const std::string& isa) {
+    if (segments.count <= 1) return sample(segments.count == 1 ? segment_job(job, segments, 0) : job, segments.count * segments.length, threads, isa);
+    const kernel::KernelTable& kernels = kernels_for(isa);
+    return run_segments(job, segments, threads, [&](const SampleJob& part, std::int64_t begin, std::int64_t end) {
+        return kernels.sample_range(part, begin, end);
+    });
+}
+
 std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa) {
     const kernel::KernelTable& kernels = kernels_for(isa);
     EvalJob streamed = job;

@@ -292,7 +292,7 @@ std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int
 }
 
 inline std::int64_t sample_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
-    const bool per_element = !uniform_material(job.params);
+    const bool per_element = !job.uniform_material();
     if (job.model == Model::kDisney2012)
         return per_element ? sample_range_for<Model::kDisney2012, true>(job, begin, end)
                            : sample_range_for<Model::kDisney2012, false>(job, begin, end);

@@ -3,12 +3,13 @@
 Input handling, once per call:
 
 * directions are ``(..., 3)`` (``layout="aos"``, the default) or ``(3, ...)``
-  (``layout="soa"``); a float32 C-contiguous array is read in place, anything
-  else (other dtypes, strides) is converted once to a float32 copy;
-* a direction whose leading shape is ``()`` is one vector for every element
-  (read once, never copied); other broadcasts are materialised;
+  (``layout="soa"``); a float32 array is read in place, anything else (other
+  dtypes) is converted once to float32 in its compact form (stride-0 axes
+  not expanded);
+* arguments that broadcast (by shape or as stride-0 views) are read in
+  place by segments (_segments.py), never expanded to the call's shape;
 * uniform material parameters are passed as numbers (no per-element loads);
-  per-element ones as float32 arrays, cached on the Material.
+  per-element ones as compact float32 arrays, cached on the Material.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from ._validate import (
     unit_length,
 )
 from . import _gradient
+from ._segments import choose_split, compact, leading_of, part, unexpanded
 from ._gradient import GRADIENT_NAMES, Gradient
 from .material import PARAMETERS, Material
 
@@ -121,16 +123,20 @@ def _isa(isa: str | None) -> str:
 
 
 def _float32_input(name: str, value: object) -> tuple[Float32Array, FloatArray]:
-    """(float32 C-contiguous aligned array, the values as given): read in place
-    when ``value`` already is one, else converted once (after a check that the
-    values fit in float32, so that 1e300 is not reported as infinity)."""
+    """(float32 aligned array, the values as given): a float32 array is read in
+    place whatever its strides (the segments read its compact form), anything
+    else converted once in its compact form (stride-0 axes not expanded),
+    after a check that the values fit in float32, so that 1e300 is not
+    reported as infinity."""
     if isinstance(value, np.ndarray) and value.dtype == np.float32:
-        if value.flags.c_contiguous and value.flags.aligned:
+        if value.flags.aligned:
             return value, value
         return np.require(value, np.float32, ["C_CONTIGUOUS", "ALIGNED"]), value
     given = as_real_array(name, value)
     require_float32(name, given)
-    return np.ascontiguousarray(given, dtype=np.float32), given
+    if given.ndim == 0:
+        return np.ascontiguousarray(given, dtype=np.float32), given
+    return np.broadcast_to(np.ascontiguousarray(unexpanded(given), dtype=np.float32), given.shape), given
 
 
 class _Directions:
@@ -149,33 +155,6 @@ class _Directions:
                 raise ValueError(f"{name}: expected shape (3, ...) with layout='soa', got {array.shape}")
             self.leading = array.shape[1:]
         self.layout = layout
-
-    def flat(self, leading: tuple[int, ...]) -> tuple[Float32Array, int]:
-        """(array, layout code) with ``leading`` elements; broadcasts if needed."""
-        array = self.array
-        if self.leading == ():
-            return array.reshape(3), _SINGLE
-        if self.leading != leading:
-            if self.layout == "aos":
-                target = leading + (3,)
-            else:  # numpy aligns trailing axes: the vector axis must lead the leading ones
-                array = array.reshape((3,) + (1,) * (len(leading) - len(self.leading)) + self.leading)
-                target = (3,) + leading
-            array = np.ascontiguousarray(np.broadcast_to(array, target))
-        n = _size(leading)
-        return (array.reshape(n, 3), _INTERLEAVED) if self.layout == "aos" else (array.reshape(3, n), _ROWS)
-
-    def segment(self, outer: tuple[int, ...], inner: tuple[int, ...]) -> tuple[Float32Array, int]:
-        """(array, layout code) of the segment at the outer index ``outer`` of a call split
-        into segments of shape ``inner`` (layout "aos"): a view, one vector or ``inner``'s."""
-        own = self.leading
-        depth = len(outer) + len(inner)
-        padded = (1,) * (depth - len(own)) + own
-        index = tuple(0 if size == 1 else i for i, size in zip(outer, padded[:len(outer)]))
-        block = self.array.reshape(padded + (3,))[index]
-        if all(size == 1 for size in padded[len(outer):]):
-            return block.reshape(3), _SINGLE
-        return block.reshape(-1, 3), _INTERLEAVED
 
     def _own_index(self, element: int, leading: tuple[int, ...]) -> tuple[int, ...]:
         """The index into this argument's own leading shape of ``element`` of the broadcast ``leading``."""
@@ -235,17 +214,98 @@ def _kernel_numbers(material: Material) -> list[float | tuple[float, ...] | None
     return numbers
 
 
-def _params(material: Material, leading: tuple[int, ...]) -> list[float | tuple[float, ...] | Float32Array]:
-    """One entry per parameter: a number (uniform) or a float32 per-element array."""
-    n = _size(leading)
+def _parameter_views(material: Material, depth: int) -> list[float | tuple[float, ...] | Float32Array]:
+    """One entry per parameter: a number (uniform), or the compact float32
+    per-element values (compact(), cached on the material) padded to ``depth`` axes."""
     entries: list[float | tuple[float, ...] | Float32Array] = []
     for (name, info), number in zip(PARAMETERS.items(), _kernel_numbers(material)):
-        if number is not None:
-            entries.append(number)
-        else:
-            per_element = material._float32(name, leading)
-            entries.append(per_element.reshape((n, 3) if info.slots == 3 else (n,)))
+        entries.append(number if number is not None else
+                       compact(material._float32_compact(name), depth, -1 if info.slots == 3 else None))
     return entries
+
+
+class _Segmented(NamedTuple):
+    """A call's arguments as the segmented batch layer reads them."""
+
+    vectors: list[tuple[Float32Array | None, int]]  # (array, layout code) of each direction argument
+    params: list[float | tuple[float, ...] | Float32Array]
+    segments: tuple[int, int, list[NDArray[np.int64] | None], list[bool]] | None  # _core's segments= (None: one run)
+
+
+def _unsegmented(leading: tuple[int, ...], layout: str, directions: list[_Directions | None],
+                 material: Material) -> _Segmented | None:
+    """The arguments of a call that needs no segments (each one vector or
+    number, or C-contiguous of the call's shape), or None: the common cases,
+    without the segments' bookkeeping."""
+    n = _size(leading)
+    vectors: list[tuple[Float32Array | None, int]] = []
+    for direction in directions:
+        if direction is None:
+            vectors.append((None, 0))
+        elif not direction.array.flags.c_contiguous:
+            return None
+        elif _size(direction.leading) == 1:  # () or (1, ...): one vector
+            vectors.append((direction.array.reshape(3), _SINGLE))
+        elif direction.leading == leading:
+            vectors.append(_flat_vec3(direction.array, layout))
+        else:
+            return None
+    params: list[float | tuple[float, ...] | Float32Array] = []
+    for (name, info), number in zip(PARAMETERS.items(), _kernel_numbers(material)):
+        if number is not None:
+            params.append(number)
+            continue
+        values = material._float32_compact(name)
+        if values.shape != (leading + (3,) if info.slots == 3 else leading):
+            return None
+        params.append(values.reshape((n, 3) if info.slots == 3 else (n,)))
+    return _Segmented(vectors, params, None)
+
+
+def _segmented(leading: tuple[int, ...], layout: str, directions: list[_Directions | None],
+               material: Material) -> _Segmented:
+    """Wi, wo and the third argument (cotangent or u; None entries for absent
+    ones) and the material, read in place along the axes they broadcast on."""
+    plain = _unsegmented(leading, layout, directions, material)
+    if plain is not None:
+        return plain
+    depth = len(leading)
+    axis = -1 if layout == "aos" else 0
+    views = [None if d is None else compact(d.array, depth, axis) for d in directions]
+    params = _parameter_views(material, depth)
+    param_axes = [-1 if info.slots == 3 else None for info in PARAMETERS.values()]
+    shapes = [leading_of(v, axis) for v in views if v is not None]
+    shapes += [leading_of(p, a) for p, a in zip(params, param_axes) if isinstance(p, np.ndarray)]
+    split = choose_split(leading, shapes)
+    offsets: list[NDArray[np.int64] | None] = []
+    vectors: list[tuple[Float32Array | None, int]] = []
+    for view in views:
+        if view is None:
+            vectors.append((None, 0))
+            offsets.append(None)
+            continue
+        piece = part(view, leading, split, axis)
+        if layout == "aos" or piece.single:  # one vector a segment: three floats in a row
+            array = piece.array if layout == "aos" else np.ascontiguousarray(np.moveaxis(piece.array, 0, -1))
+            vectors.append((array.reshape(-1, 3), _SINGLE if piece.single else _INTERLEAVED))
+            offsets.append(None if piece.offsets is None else 3 * piece.offsets)
+        else:
+            vectors.append((piece.array.reshape(3, -1), _ROWS))
+            offsets.append(piece.offsets)
+    entries: list[float | tuple[float, ...] | Float32Array] = []
+    single: list[bool] = []
+    for value, param_axis in zip(params, param_axes):
+        if not isinstance(value, np.ndarray):
+            entries.append(value)
+            single.append(False)
+            offsets.append(None)
+            continue
+        piece = part(value, leading, split, param_axis)
+        entries.append(piece.array.reshape(-1, 3) if param_axis == -1 else piece.array.reshape(-1))
+        single.append(piece.single)
+        offsets.append(None if piece.offsets is None else (3 if param_axis == -1 else 1) * piece.offsets)
+    count = _size(leading[:split])
+    return _Segmented(vectors, entries, (count, _size(leading[split:]), offsets, single))
 
 
 def _output(out: object, shape: tuple[int, ...], name: str = "out") -> Float32Array:
@@ -305,47 +365,16 @@ def _flat_vec3(array: Float32Array, layout: str) -> tuple[Float32Array, int]:
     return (array.reshape(n, 3), _INTERLEAVED) if layout == "aos" else (array.reshape(3, n), _ROWS)
 
 
-# A call whose arguments broadcast over some leading axes runs as one kernel call per
-# index of those axes when each call still covers at least this many elements:
-# the arguments are then read in place (numpy views), never copied to the full shape.
-_SMALLEST_SEGMENT = 1024
-
-
-def _segment_split(leading: tuple[int, ...], material_shape: tuple[int, ...],
-                   *direction_shapes: tuple[int, ...]) -> int | None:
-    """The number of outer axes over which to split a call so that each argument is read in
-    place, or None when one call reads everything in place (or segments would be small).
-
-    Within a segment (the inner axes ``leading[s:]``) a direction is one vector or an array
-    of the inner shape, whatever it does over the outer axes; the material must not vary
-    over the outer axes (its per-element arrays serve every segment)."""
-    shapes = [material_shape, *direction_shapes]
-    if all(shape in ((), leading) for shape in shapes):
-        return None
-
-    def padded(shape: tuple[int, ...]) -> tuple[int, ...]:
-        return (1,) * (len(leading) - len(shape)) + shape
-
-    for split in range(1, len(leading)):
-        inner = leading[split:]
-        if _size(inner) < _SMALLEST_SEGMENT:
-            return None
-        material = padded(material_shape)
-        if material_shape and not (all(d == 1 for d in material[:split]) and material[split:] == inner):
-            continue
-        if all(padded(shape)[split:] in (inner, (1,) * len(inner)) for shape in direction_shapes):
-            return split
-    return None
-
-
 def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine: bool, layout: Layout,
               threads: SupportsIndex | None, check: bool, isa: str | None,
               outputs_for_shape: Callable[[tuple[int, ...], str], list[Float32Array]], pdf_sampler: int | None = None,
               gradient: bool = False, energy_compensation: bool = False, columns: list[int] | None = None,
-              vjp: bool = False) -> list[Float32Array]:
+              cotangent: Float32Array | None = None) -> list[Float32Array]:
     """eval / eval_lobes / pdf / eval_grad / eval_vjp: validated arguments in, outputs written.
-    ``columns``: the slots a derivative is taken by (None: all). ``vjp``: the
-    outputs are the product and the cotangent, broadcast to the call's shape."""
+    ``columns``: the slots a derivative is taken by (None: all). ``cotangent``
+    (float32, f's layout, broadcasting to the call's shape): the output is
+    the vector-Jacobian product."""
+    vjp = cotangent is not None
     _require_material(material)
     energy_compensation = flag("energy_compensation", energy_compensation)
     if (gradient or vjp) and energy_compensation:
@@ -373,56 +402,41 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
                                    energy_compensation=energy_compensation, check_tolerance=tolerance,
                                    threads=thread_count, isa=isa_name)
 
-    def run(wi_flat: Float32Array, wi_code: int, wo_flat: Float32Array, wo_code: int,
-            params: list[float | tuple[float, ...] | Float32Array], segment: list[Float32Array], n: int) -> int:
-        """One kernel call over ``n`` elements; the first element it rejects, or -1."""
-        if isinstance(options, _core.PdfOptions):
-            f = _flat_vec3(segment[1], layout)[0] if len(segment) == 2 else None  # eval_pdf: f in the same pass
-            return int(_core.batch_pdf(
-                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-                pdf=segment[0].reshape(n), out=f, out_layout=out_layout, n=n, options=options))
+    third = None
+    if cotangent is not None:
+        third = _Directions("cotangent", cotangent, layout)
+        np.broadcast_to(cotangent, _vec3_shape(leading, layout))  # numpy's error unless it broadcasts to the call's shape
+    call = _segmented(leading, layout, [wi_dirs, wo_dirs, third], material)
+    (wi_flat, wi_code), (wo_flat, wo_code), (cotangent_flat, cotangent_code) = call.vectors
+    params, segments, n = call.params, call.segments, _size(leading)
+    for k, output in enumerate(outputs):
+        _require_no_partial_overlap(output, {"wi": wi_flat, "wo": wo_flat}, _output_name(outputs, k))
+    if isinstance(options, _core.PdfOptions):
+        f = _flat_vec3(outputs[1], layout)[0] if len(outputs) == 2 else None  # eval_pdf: f in the same pass
+        bad = _core.batch_pdf(wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+                              pdf=outputs[0].reshape(n), out=f, out_layout=out_layout, n=n, options=options,
+                              segments=segments)
+    elif gradient:
         width = len(GRADIENT_NAMES) if columns is None else len(columns)
-        if gradient:
-            value, jacobian = segment
-            return int(_core.batch_eval_grad(
-                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-                out=_flat_vec3(value, layout)[0],
-                jacobian=jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)),
-                out_layout=out_layout, n=n, options=options, columns=columns))
-        if vjp:
-            product, cotangent = segment
-            cotangent_flat, cotangent_code = _flat_vec3(cotangent, layout)
-            return int(_core.batch_eval_vjp(
-                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-                cotangent=cotangent_flat, cotangent_layout=cotangent_code,
-                vjp=product.reshape((n, width) if layout == "aos" else (width, n)),
-                out_layout=out_layout, n=n, options=options, columns=columns))
-        return int(_core.batch_eval(
+        value, jacobian = outputs
+        bad = _core.batch_eval_grad(
             wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-            outputs=[_flat_vec3(o, layout)[0] for o in segment], lobes=len(segment) == len(LOBE_NAMES),
-            out_layout=out_layout, n=n, options=options))
-
-    split = _segment_split(leading, material.shape, wi_dirs.leading, wo_dirs.leading) if layout == "aos" else None
-    if split is None:
-        wi_flat, wi_code = wi_dirs.flat(leading)
-        wo_flat, wo_code = wo_dirs.flat(leading)
-        for k, output in enumerate(outputs):
-            _require_no_partial_overlap(output, {"wi": wi_flat, "wo": wo_flat}, _output_name(outputs, k))
-        bad = run(wi_flat, wi_code, wo_flat, wo_code, _params(material, leading), outputs, _size(leading))
+            out=_flat_vec3(value, layout)[0],
+            jacobian=jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)),
+            out_layout=out_layout, n=n, options=options, columns=columns, segments=segments)
+    elif vjp:
+        width = len(GRADIENT_NAMES) if columns is None else len(columns)
+        (product,) = outputs
+        bad = _core.batch_eval_vjp(
+            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+            cotangent=cotangent_flat, cotangent_layout=cotangent_code,
+            vjp=product.reshape((n, width) if layout == "aos" else (width, n)),
+            out_layout=out_layout, n=n, options=options, columns=columns, segments=segments)
     else:
-        for k, output in enumerate(outputs):
-            _require_no_partial_overlap(output, {"wi": wi_dirs.array, "wo": wo_dirs.array}, _output_name(outputs, k))
-        inner = leading[split:]
-        params = _params(material, inner)
-        inner_n = _size(inner)
-        bad = -1
-        for segment_index, outer in enumerate(np.ndindex(leading[:split])):
-            wi_flat, wi_code = wi_dirs.segment(outer, inner)
-            wo_flat, wo_code = wo_dirs.segment(outer, inner)
-            local = run(wi_flat, wi_code, wo_flat, wo_code, params, [output[outer] for output in outputs], inner_n)
-            if local >= 0:
-                bad = segment_index * inner_n + local
-                break
+        bad = _core.batch_eval(
+            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+            outputs=[_flat_vec3(o, layout)[0] for o in outputs], lobes=len(outputs) == len(LOBE_NAMES),
+            out_layout=out_layout, n=n, options=options, segments=segments)
     if bad >= 0:
         raise _direction_error(bad, leading, wi_dirs, wo_dirs)
     return outputs
@@ -566,11 +580,10 @@ def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent
         raise ValueError("cotangent: values beyond float32's range")
 
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
-        product = np.empty(leading + (len(wanted),) if not soa else (len(wanted),) + leading, np.float32)
-        return [product, np.ascontiguousarray(np.broadcast_to(g32, _vec3_shape(leading, layout)))]
+        return [np.empty(leading + (len(wanted),) if not soa else (len(wanted),) + leading, np.float32)]
 
-    product, _ = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
-                           energy_compensation=False, columns=wanted, vjp=True)
+    (product,) = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
+                           energy_compensation=False, columns=wanted, cotangent=g32)
     return _sum_to_parameters(material, product if not soa else np.moveaxis(product, 0, -1), wanted, np.float32)
 
 
@@ -721,16 +734,16 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     pdf_out = np.empty(leading, np.float32)
     lobe_out = np.empty(leading, np.int32)
     shares = [np.empty_like(wi_out) for _ in LOBE_NAMES] if with_lobes else None
-    wo_flat, wo_code = wo_dirs.flat(leading)
-    u_flat, u_code = uniforms.flat(leading) if uniforms is not None else (None, 0)
+    call = _segmented(leading, layout, [None, wo_dirs, uniforms], material)
+    (wo_flat, wo_code), (u_flat, u_code) = call.vectors[1:]
     options = _core.SampleOptions(model=model_id, sampler=sampler, energy_compensation=energy_compensation, seed=seed,
                                   check_tolerance=DIRECTION_LENGTH_TOLERANCE if check else 0.0,
                                   threads=thread_count, isa=isa_name)
     bad = _core.batch_sample(
-        wo=wo_flat, wo_layout=wo_code, u=u_flat, u_layout=u_code, params=_params(material, leading),
+        wo=wo_flat, wo_layout=wo_code, u=u_flat, u_layout=u_code, params=call.params,
         wi=_flat_vec3(wi_out, layout)[0], weight=_flat_vec3(weight_out, layout)[0], pdf=pdf_out.reshape(n),
         lobe=lobe_out.reshape(n), lobe_weights=None if shares is None else [_flat_vec3(s, layout)[0] for s in shares],
-        out_layout=_INTERLEAVED if layout == "aos" else _ROWS, n=n, options=options,
+        out_layout=_INTERLEAVED if layout == "aos" else _ROWS, n=n, options=options, segments=call.segments,
     )
     if bad >= 0:
         raise _direction_error(bad, leading, wo_dirs)

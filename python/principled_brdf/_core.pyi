@@ -30,6 +30,8 @@ _Float32Out: TypeAlias = NDArray[np.float32]
 # One entry per parameter of PARAMETER_TABLE, in its order: a number (base_color:
 # three numbers) when uniform, else a float32 array of N values ((N, 3) for base_color).
 _Params: TypeAlias = Sequence[float | Sequence[float] | NDArray[np.float32]]
+# (count, length, 14 offset tables or None, 11 flags): a call in segments reading broadcast inputs in place
+_Segments: TypeAlias = tuple[int, int, Sequence[NDArray[np.int64] | None], Sequence[bool]]
 
 # (name, first slot, slots, defaults, lower bound, upper bound) per parameter
 PARAMETER_TABLE: Final[list[tuple[str, int, int, tuple[float, ...], float, float]]]
@@ -148,8 +150,9 @@ def batch_eval(
     n: _Int,
     lobes: bool,
     options: EvalOptions,
+    segments: _Segments | None = None,
 ) -> int:
-    """SIMD evaluation (f, or the lobes) into preallocated float32 outputs (validated by the caller)."""
+    """SIMD evaluation (f, or the lobes) into preallocated float32 outputs (validated by the caller); segments: (count, length, offsets, single), inputs read in place per segment."""
 
 def batch_eval_grad(
     *,
@@ -164,6 +167,7 @@ def batch_eval_grad(
     n: _Int,
     options: EvalOptions,
     columns: Sequence[int] | None = None,
+    segments: _Segments | None = None,
 ) -> int:
     """SIMD f and its Jacobian over the parameter slots (columns: their indices, None for all) into preallocated float32 outputs."""
 
@@ -181,6 +185,7 @@ def batch_eval_vjp(
     n: _Int,
     options: EvalOptions,
     columns: Sequence[int] | None = None,
+    segments: _Segments | None = None,
 ) -> int:
     """SIMD vector-Jacobian product Σ_c g_c ∂f_c/∂p per element into a preallocated float32 output."""
 
@@ -222,6 +227,7 @@ def batch_pdf(
     out_layout: _Int = 0,
     n: _Int,
     options: PdfOptions,
+    segments: _Segments | None = None,
 ) -> int:
     """SIMD sampling pdf into a preallocated float32 array (and f into out, in the same pass, if given)."""
 
@@ -240,6 +246,7 @@ def batch_sample(
     out_layout: _Int,
     n: _Int,
     options: SampleOptions,
+    segments: _Segments | None = None,
 ) -> int:
     """SIMD sampling into preallocated outputs (and each lobe's share of the weight, if given)."""
 

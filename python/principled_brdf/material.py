@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _color, _core
+from ._segments import unexpanded
 from ._validate import as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
 
 if TYPE_CHECKING:
@@ -36,6 +37,18 @@ class _ParamInfo:
 
 # Names, defaults and domains come from the C++ table (params.hpp), defined once.
 PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
+
+
+
+def _owned_copy(array: Float64Array) -> Float64Array:
+    """A read-only copy of ``array``; a broadcast view (stride-0 axes, np.broadcast_to)
+    stays one, over a copy of the values it holds, never expanded."""
+    values = unexpanded(array)
+    if values.shape != array.shape:
+        return np.broadcast_to(values.copy(), array.shape)  # (read-only)
+    copy = array.copy()
+    copy.flags.writeable = False
+    return copy
 
 
 class Material:
@@ -100,8 +113,7 @@ class Material:
             if info.slots == 3 and (array.ndim == 0 or array.shape[-1] != 3):
                 raise ValueError(f"{name}: expected an RGB triple, shape (3,) or (..., 3), got shape {array.shape}")
             require_in_domain(name, array, info.lower, info.upper)
-            array = array.copy()  # a Material never aliases the caller's buffers
-            array.flags.writeable = False
+            array = _owned_copy(array)  # a Material never aliases the caller's buffers
             object.__setattr__(self, name, array)
         object.__setattr__(self, "_float32_cache", {})
         object.__setattr__(self, "_kernel_numbers", None)
@@ -212,14 +224,13 @@ class Material:
                 rows[:, info.first_slot] = np.broadcast_to(array, leading_shape).reshape(n)
         return rows
 
-    def _float32(self, name: str, leading_shape: tuple[int, ...]) -> Float32Array:
-        """A per-element parameter broadcast to ``leading_shape`` as contiguous float32 (cached)."""
-        key = (name, leading_shape)
+    def _float32_compact(self, name: str) -> Float32Array:
+        """A per-element parameter as contiguous float32 in its compact form (its
+        broadcast axes of size 1, as _owned_copy keeps them; cached)."""
+        key = (name, None)
         cached = self._float32_cache.get(key)
         if cached is None:
-            array = getattr(self, name)
-            target = leading_shape + (3,) if PARAMETERS[name].slots == 3 else leading_shape
-            cached = np.ascontiguousarray(np.broadcast_to(array, target), dtype=np.float32)
+            cached = np.ascontiguousarray(unexpanded(getattr(self, name)), dtype=np.float32)
             cached.flags.writeable = False
             if len(self._float32_cache) > 32:
                 self._float32_cache.clear()

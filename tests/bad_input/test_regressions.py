@@ -353,7 +353,7 @@ def test_the_kernels_never_see_misaligned_data():
     # would still reach them, rather than hand the kernels a float* off alignment.
     n = 8
     wi = misaligned(np.tile(np.float32([0, 0, 1]), (n, 1)))
-    params = pb._batch._params(pb.Material(), (n,))
+    params = pb._batch._parameter_views(pb.Material(), 1)  # (uniform: numbers)
     options = pb._core.EvalOptions(threads=1)
     wo = np.float32([0, 0, 1])
     with pytest.raises(ValueError, match="wi: array data is not aligned"):
@@ -364,6 +364,36 @@ def test_the_kernels_never_see_misaligned_data():
                             outputs=[misaligned(np.empty((n, 3), np.float32))], out_layout=0, n=n, lobes=False,
                             options=options)
 
+
+
+def test_segments_reaching_past_an_input_are_refused():
+    # a call in segments reads each input at its own offsets: the bindings
+    # check that every segment's elements lie within the array, whatever the caller passed
+    count, length = 4, 8
+    n = count * length
+    params = pb._batch._parameter_views(pb.Material(), 1)
+    options = pb._core.EvalOptions(threads=1)
+    wi = np.tile(np.float32([0, 0, 1]), (length, 1))
+    wo = np.float32([0, 0, 1])
+    out = [np.empty((n, 3), np.float32)]
+
+    def call(offsets, single=False):
+        tables = [offsets if k == 0 else None for k in range(14)]
+        pb._core.batch_eval(wi=wi, wi_layout=2 if single else 0, wo=wo, wo_layout=2, params=params, outputs=out,
+                            out_layout=0, n=n, lobes=False, options=options,
+                            segments=(count, length, tables, [False] * 11))
+
+    call(np.zeros(count, np.int64))  # every segment reads the same rows
+    with pytest.raises(ValueError, match="wi: a segment reaches past the array"):
+        call(np.array([0, 0, 0, 3], np.int64))
+    with pytest.raises(ValueError, match="segments: negative offset"):
+        call(np.array([0, -3, 0, 0], np.int64))
+    call(np.array([0, 3, 6, 3 * length - 3], np.int64), single=True)  # one vector a segment: 3 floats
+    with pytest.raises(ValueError, match="wi: a segment reaches past the array"):
+        call(np.array([0, 3, 6, 3 * length - 2], np.int64), single=True)
+    with pytest.raises(ValueError, match="count \\* length == n"):
+        pb._core.batch_eval(wi=wi, wi_layout=0, wo=wo, wo_layout=2, params=params, outputs=out, out_layout=0, n=n,
+                            lobes=False, options=options, segments=(count, length + 1, [None] * 14, [False] * 11))
 
 # ------------------------------------------------------------------ tiny colors, long vectors, frames, helpers
 

@@ -132,8 +132,11 @@ struct EvalJob {
     // The direction check, fused into the evaluation. On a bad direction the
     // outputs hold the results of some other elements only.
     DirectionCheck check;
+    // read the parameters per batch even where every slot holds one value
+    // (a segment of a per-element call: Segments below)
+    bool per_element_material = false;
 
-    bool uniform_material() const { return principled_brdf::uniform_material(params); }
+    bool uniform_material() const { return !per_element_material && principled_brdf::uniform_material(params); }
 };
 
 // The normal equations of least-squares problems (docs/fitting.md), for the
@@ -188,6 +191,28 @@ struct SampleJob {
     // (the lobe's value cos θl / pdf, in kLobeNames' order); unused when the first is null
     MutableVec3Array lobe_weight[kLobeCount];
     DirectionCheck check;  // of wo, as in EvalJob
+    bool per_element_material = false;  // as in EvalJob
+
+    bool uniform_material() const { return !per_element_material && principled_brdf::uniform_material(params); }
+};
+
+// A call as `count` segments of `length` elements, element j of segment s
+// being the call's element s length + j: the inputs that broadcast along the
+// segments' axes are read in place (numpy's stride-0 views), never expanded.
+// Segment s runs the call's job with each input's data advanced by its own
+// offsets[input][s] floats (null: 0 for every segment) and every output's by
+// s length elements; within a segment each input is contiguous, or one vector
+// (Vec3Layout::kSingle), or with single[slot] one value of a parameter slot,
+// read as a number (the segment's job then keeps per_element_material when the
+// call has per-element slots, so every segment runs the call's loop).
+enum SegmentInput : int { kSegmentWi = 0, kSegmentWo = 1, kSegmentThird = 2, kSegmentSlots = 3 };  // third: cotangent or u
+inline constexpr int kSegmentInputs = kSegmentSlots + kParamSlots;
+
+struct Segments {
+    std::int64_t count = 1;
+    std::int64_t length = 0;
+    const std::int64_t* offsets[kSegmentInputs] = {};
+    bool single[kParamSlots] = {};
 };
 
 // Instruction sets compiled into this build and supported by this CPU, best
@@ -203,6 +228,9 @@ int float_lanes(const std::string& isa);
 // Returns -1 when every element was written, or with job.check enabled the
 // first element whose wi or wo fails it (then some elements are unwritten).
 std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa = "");
+// The same over segments.count * segments.length elements in segments
+// (element indices the call's); threads share the segments' elements as eval's.
+std::int64_t eval(const EvalJob& job, const Segments& segments, int threads, const std::string& isa = "");
 
 // The normal equations of job.problems[0 .. count - 1] (directions unchecked:
 // the caller checked them), on `threads` threads and `isa` as eval.
@@ -210,6 +238,8 @@ void normal_equations(const NormalEquationsJob& job, std::int64_t count, int thr
 
 // As eval, for sampling; returns -1 or an element whose wo is bad.
 std::int64_t sample(const SampleJob& job, std::int64_t n, int threads, const std::string& isa = "");
+// The same in segments (the generator's indices the call's elements').
+std::int64_t sample(const SampleJob& job, const Segments& segments, int threads, const std::string& isa = "");
 
 // The counter-based uniforms sample() uses for elements first .. first + n - 1,
 // written as (n, 3) interleaved into out (scalar code, bit-identical to the kernels').
