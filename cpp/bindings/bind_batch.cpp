@@ -170,6 +170,30 @@ std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float3
     return eval(job, n, options.threads, options.isa);
 }
 
+// ∂f/∂(wi, wo): a (N, 3, 6) array, or (3, 6, N) with out_layout rows. The directions are not
+// checked here (eval_grad checks them in its pass for f); check_tolerance is ignored.
+void batch_eval_direction_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                               const py::sequence& params, Float32Array jacobian, int out_layout, std::int64_t n,
+                               const EvalOptions options) {
+    constexpr int kDirections = 6;  // wi_x, wi_y, wi_z, wo_x, wo_y, wo_z
+    py::list keep_alive;
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kGradient, options, keep_alive);
+    job.check = DirectionCheck{};
+    const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
+    const bool shape_ok = rows ? (jacobian.ndim() == 3 && jacobian.shape(0) == 3 && jacobian.shape(1) == kDirections &&
+                                  jacobian.shape(2) == n)
+                               : (jacobian.ndim() == 3 && jacobian.shape(0) == n && jacobian.shape(1) == 3 &&
+                                  jacobian.shape(2) == kDirections);
+    if (!shape_ok || !jacobian.writeable())
+        throw std::invalid_argument("jacobian: expected a writeable (N, 3, 6) array, or (3, 6, N) for the rows layout");
+    require_aligned(jacobian.data(), "jacobian");
+    job.jacobian = jacobian.mutable_data();
+    job.jacobian_row_stride = rows ? n : 0;
+    if (n == 0) return;
+    py::gil_scoped_release release;
+    eval_direction_grad(job, n, options.threads, options.isa);
+}
+
 template <class T>
 T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const char* name) {
     if (a.ndim() != 1 || a.shape(0) != n || !a.writeable())
@@ -354,6 +378,10 @@ void bind_batch(py::module_& m) {
           py::arg("wo_layout"), py::arg("params"), py::arg("out"), py::arg("jacobian"), py::arg("out_layout"),
           py::arg("n"), py::arg("options"),
           "SIMD f and its Jacobian over the parameter slots into preallocated float32 outputs.");
+    m.def("batch_eval_direction_grad", &batch_eval_direction_grad, py::kw_only(), py::arg("wi"), py::arg("wi_layout"),
+          py::arg("wo"), py::arg("wo_layout"), py::arg("params"), py::arg("jacobian"), py::arg("out_layout"), py::arg("n"),
+          py::arg("options"),
+          "SIMD derivatives of f in wi and wo (N,3,6) into a preallocated float32 array; directions already checked.");
     m.def("batch_pdf", &batch_pdf, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
           py::arg("wo_layout"), py::arg("params"), py::arg("pdf"), py::arg("out") = py::none(),
           py::arg("out_layout") = 0, py::arg("n"), py::arg("options"),

@@ -82,6 +82,14 @@ std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::st
     return run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) { return kernels.eval_range(streamed, begin, end); });
 }
 
+void eval_direction_grad(const EvalJob& job, std::int64_t n, int threads, const std::string& isa) {
+    const kernel::KernelTable& kernels = kernels_for(isa);
+    run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) {
+        kernels.direction_gradient_range(job, begin, end);
+        return std::int64_t{-1};
+    });
+}
+
 std::int64_t sample(const SampleJob& job, std::int64_t n, int threads, const std::string& isa) {
     const kernel::KernelTable& kernels = kernels_for(isa);
     return run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) { return kernels.sample_range(job, begin, end); });

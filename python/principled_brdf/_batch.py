@@ -35,7 +35,7 @@ from ._validate import (
     seed_value,
     unit_length,
 )
-from . import _gradient
+from . import _direction_grad, _gradient
 from ._gradient import GRADIENT_NAMES, Gradient
 from .material import PARAMETERS, Material
 
@@ -487,8 +487,15 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     parameter still gets a per-element derivative. ``out=(value, jacobian)``
     writes into preallocated float32 arrays of exactly those shapes. The other
     arguments are :func:`eval`'s; ``energy_compensation=True`` raises
-    NotImplementedError.
+    NotImplementedError. ``wrt`` may also name ``"wi"`` and ``"wo"``: three
+    columns each (``wi_x, wi_y, wi_z``, ``wo_x, wo_y, wo_z``) after the
+    parameters', the derivatives of f in the 3-vectors as given
+    (docs/gradients.md, "Derivatives in the directions").
     """
+    if _direction_grad.asks_for_directions(wrt):
+        return _direction_grad.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
+                                         threads=threads, out=out, check=check, isa=isa,
+                                         energy_compensation=energy_compensation)
     wanted = _gradient.columns(wrt)
     full = len(wanted) == len(GRADIENT_NAMES)
     _require_pair(out, "jacobian")

@@ -145,6 +145,14 @@ int float_lanes(const std::string& isa);
 // first element whose wi or wo fails it (then some elements are unwritten).
 std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa = "");
 
+// The derivatives of f (times cos θl if job.cosine) in the directions
+// (docs/gradients.md): element i's ∂f_c/∂w_k, k = wi_x, wi_y, wi_z, wo_x,
+// wo_y, wo_z, at job.jacobian[18 i + 6 c + k] (an (N, 3, 6) array) or, with
+// job.jacobian_row_stride > 0, at job.jacobian[(6 c + k) jacobian_row_stride + i]
+// (a (3, 6, N) array). job.out and job.check are not used: the caller checks
+// the directions (eval_grad does in its pass for f).
+void eval_direction_grad(const EvalJob& job, std::int64_t n, int threads, const std::string& isa = "");
+
 // As eval, for sampling; returns -1 or an element whose wo is bad.
 std::int64_t sample(const SampleJob& job, std::int64_t n, int threads, const std::string& isa = "");
 
