@@ -146,52 +146,111 @@ std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Arra
     return eval(job, n, options.threads, options.isa);
 }
 
-// f (out) and its Jacobian: (N, 3) and (N, 3, 13) arrays, or (3, N) and (3, 13, N) with out_layout rows.
+}  // namespace
+
+// The parameter slots of a derivative: None for all of them, or distinct slot
+// indices in increasing order.
+Columns columns_from(const py::object& slots) {
+    if (slots.is_none()) return Columns{};
+    auto list = py::cast<std::vector<int>>(slots);
+    if (list.empty() || static_cast<int>(list.size()) > kParamSlots)
+        throw std::invalid_argument("columns: expected 1 to " + std::to_string(kParamSlots) + " slot indices");
+    for (std::size_t k = 0; k < list.size(); ++k)
+        if (list[k] < 0 || list[k] >= kParamSlots || (k > 0 && list[k] <= list[k - 1]))
+            throw std::invalid_argument("columns: expected increasing slot indices below " + std::to_string(kParamSlots));
+    return Columns(list.data(), static_cast<int>(list.size()));
+}
+
+namespace {
+
+// A derivative's output: (N, width...) by element, or (width..., N) by rows.
+float* derivative_output(Float32Array& a, const std::vector<py::ssize_t>& width, bool rows, std::int64_t n,
+                         const char* name, const char* expected) {
+    bool ok = a.ndim() == static_cast<py::ssize_t>(width.size()) + 1 && a.writeable();
+    for (std::size_t k = 0; ok && k < width.size(); ++k) ok = a.shape(rows ? k : k + 1) == width[k];
+    ok = ok && a.shape(rows ? a.ndim() - 1 : 0) == n;
+    if (!ok) throw std::invalid_argument(std::string(name) + ": expected " + expected);
+    require_aligned(a.data(), name);
+    return a.mutable_data();
+}
+
+// f (out) and its Jacobian in the P slots of `columns` (None: all): (N, 3) and
+// (N, 3, P) arrays, or (3, N) and (3, P, N) with out_layout rows.
 std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                              const py::sequence& params, Float32Array out, Float32Array jacobian, int out_layout,
-                             std::int64_t n, const EvalOptions options) {
+                             std::int64_t n, const EvalOptions options, const py::object& columns) {
     if (options.energy_compensation)
         throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
     py::list keep_alive;
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kGradient, options, keep_alive);
+    job.columns = columns_from(columns);
     job.out[0] = output_view(out, out_layout, n, "out");
     const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
-    const bool shape_ok = rows ? (jacobian.ndim() == 3 && jacobian.shape(0) == 3 && jacobian.shape(1) == kParamSlots &&
-                                  jacobian.shape(2) == n)
-                               : (jacobian.ndim() == 3 && jacobian.shape(0) == n && jacobian.shape(1) == 3 &&
-                                  jacobian.shape(2) == kParamSlots);
-    if (!shape_ok || !jacobian.writeable())
-        throw std::invalid_argument("jacobian: expected a writeable (N, 3, 13) array, or (3, 13, N) for the rows layout");
-    require_aligned(jacobian.data(), "jacobian");
-    job.jacobian = jacobian.mutable_data();
+    job.jacobian = derivative_output(jacobian, {3, job.columns.count}, rows, n, "jacobian",
+                                     "a writeable (N, 3, P) array, or (3, P, N) for the rows layout");
     job.jacobian_row_stride = rows ? n : 0;
     if (n == 0) return -1;
     py::gil_scoped_release release;
     return eval(job, n, options.threads, options.isa);
 }
 
-// ∂f/∂(wi, wo): a (N, 3, 6) array, or (3, 6, N) with out_layout rows. The directions are not
-// checked here (eval_grad checks them in its pass for f); check_tolerance is ignored.
-void batch_eval_direction_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
-                               const py::sequence& params, Float32Array jacobian, int out_layout, std::int64_t n,
-                               const EvalOptions options) {
-    constexpr int kDirections = 6;  // wi_x, wi_y, wi_z, wo_x, wo_y, wo_z
+// Σ_c g_c ∂f_c/∂p per element for the cotangent g ((N, 3), (3, N) or one
+// (3,) vector) and the P slots of `columns`: into vjp, (N, P), or (P, N) with out_layout rows.
+std::int64_t batch_eval_vjp(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                            const py::sequence& params, const Float32Array& cotangent, int cotangent_layout,
+                            Float32Array vjp, int out_layout, std::int64_t n, const EvalOptions options,
+                            const py::object& columns) {
+    if (options.energy_compensation)
+        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
     py::list keep_alive;
-    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kGradient, options, keep_alive);
-    job.check = DirectionCheck{};
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kVjp, options, keep_alive);
+    job.columns = columns_from(columns);
+    job.cotangent = vec3_view(cotangent, cotangent_layout, n, "cotangent");
     const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
-    const bool shape_ok = rows ? (jacobian.ndim() == 3 && jacobian.shape(0) == 3 && jacobian.shape(1) == kDirections &&
-                                  jacobian.shape(2) == n)
-                               : (jacobian.ndim() == 3 && jacobian.shape(0) == n && jacobian.shape(1) == 3 &&
-                                  jacobian.shape(2) == kDirections);
-    if (!shape_ok || !jacobian.writeable())
-        throw std::invalid_argument("jacobian: expected a writeable (N, 3, 6) array, or (3, 6, N) for the rows layout");
-    require_aligned(jacobian.data(), "jacobian");
-    job.jacobian = jacobian.mutable_data();
+    job.jacobian = derivative_output(vjp, {job.columns.count}, rows, n, "vjp",
+                                     "a writeable (N, P) array, or (P, N) for the rows layout");
     job.jacobian_row_stride = rows ? n : 0;
-    if (n == 0) return;
+    if (n == 0) return -1;
     py::gil_scoped_release release;
-    eval_direction_grad(job, n, options.threads, options.isa);
+    return eval(job, n, options.threads, options.isa);
+}
+
+// f (out) and its Jacobian in the six direction components wi_x ... wo_z:
+// (N, 3) and (N, 3, 6) arrays, or (3, N) and (3, 6, N) with out_layout rows.
+std::int64_t batch_eval_direction_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                                       const py::sequence& params, Float32Array out, Float32Array jacobian,
+                                       int out_layout, std::int64_t n, const EvalOptions options) {
+    if (options.energy_compensation)
+        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
+    py::list keep_alive;
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kDirectionGradient, options, keep_alive);
+    job.out[0] = output_view(out, out_layout, n, "out");
+    const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
+    job.jacobian = derivative_output(jacobian, {3, kDirectionComponents}, rows, n, "jacobian",
+                                     "a writeable (N, 3, 6) array, or (3, 6, N) for the rows layout");
+    job.jacobian_row_stride = rows ? n : 0;
+    if (n == 0) return -1;
+    py::gil_scoped_release release;
+    return eval(job, n, options.threads, options.isa);
+}
+
+// Σ_c g_c ∂f_c/∂w per element for the cotangent g (as batch_eval_vjp's) and
+// the six direction components: into vjp, (N, 6), or (6, N) with out_layout rows.
+std::int64_t batch_eval_direction_vjp(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                                      const py::sequence& params, const Float32Array& cotangent, int cotangent_layout,
+                                      Float32Array vjp, int out_layout, std::int64_t n, const EvalOptions options) {
+    if (options.energy_compensation)
+        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
+    py::list keep_alive;
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kDirectionVjp, options, keep_alive);
+    job.cotangent = vec3_view(cotangent, cotangent_layout, n, "cotangent");
+    const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
+    job.jacobian = derivative_output(vjp, {kDirectionComponents}, rows, n, "vjp",
+                                     "a writeable (N, 6) array, or (6, N) for the rows layout");
+    job.jacobian_row_stride = rows ? n : 0;
+    if (n == 0) return -1;
+    py::gil_scoped_release release;
+    return eval(job, n, options.threads, options.isa);
 }
 
 template <class T>
@@ -376,12 +435,21 @@ void bind_batch(py::module_& m) {
           "SIMD evaluation (f, or the lobes) into preallocated float32 outputs (validated by the caller).");
     m.def("batch_eval_grad", &batch_eval_grad, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
           py::arg("wo_layout"), py::arg("params"), py::arg("out"), py::arg("jacobian"), py::arg("out_layout"),
-          py::arg("n"), py::arg("options"),
-          "SIMD f and its Jacobian over the parameter slots into preallocated float32 outputs.");
+          py::arg("n"), py::arg("options"), py::arg("columns") = py::none(),
+          "SIMD f and its Jacobian over the parameter slots (columns: their indices, None for all) into "
+          "preallocated float32 outputs.");
+    m.def("batch_eval_vjp", &batch_eval_vjp, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
+          py::arg("wo_layout"), py::arg("params"), py::arg("cotangent"), py::arg("cotangent_layout"), py::arg("vjp"),
+          py::arg("out_layout"), py::arg("n"), py::arg("options"), py::arg("columns") = py::none(),
+          "SIMD vector-Jacobian product Σ_c g_c ∂f_c/∂p per element into a preallocated float32 output.");
     m.def("batch_eval_direction_grad", &batch_eval_direction_grad, py::kw_only(), py::arg("wi"), py::arg("wi_layout"),
-          py::arg("wo"), py::arg("wo_layout"), py::arg("params"), py::arg("jacobian"), py::arg("out_layout"), py::arg("n"),
-          py::arg("options"),
-          "SIMD derivatives of f in wi and wo (N,3,6) into a preallocated float32 array; directions already checked.");
+          py::arg("wo"), py::arg("wo_layout"), py::arg("params"), py::arg("out"), py::arg("jacobian"),
+          py::arg("out_layout"), py::arg("n"), py::arg("options"),
+          "SIMD f and its Jacobian in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z into preallocated float32 outputs.");
+    m.def("batch_eval_direction_vjp", &batch_eval_direction_vjp, py::kw_only(), py::arg("wi"), py::arg("wi_layout"),
+          py::arg("wo"), py::arg("wo_layout"), py::arg("params"), py::arg("cotangent"), py::arg("cotangent_layout"),
+          py::arg("vjp"), py::arg("out_layout"), py::arg("n"), py::arg("options"),
+          "SIMD Σ_c g_c ∂f_c/∂w per element for the six direction components into a preallocated float32 output.");
     m.def("batch_pdf", &batch_pdf, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
           py::arg("wo_layout"), py::arg("params"), py::arg("pdf"), py::arg("out") = py::none(),
           py::arg("out_layout") = 0, py::arg("n"), py::arg("options"),

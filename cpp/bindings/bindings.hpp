@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "principled_brdf/batch.hpp"
 #include "principled_brdf/params.hpp"
 
 namespace principled_brdf::bindings {
@@ -25,9 +26,13 @@ inline SpecularSampler sampler_from(int index) {
     return enum_from<SpecularSampler>(index, kSpecularSamplerNames, "specular_sampler");
 }
 
+// The parameter slots of a derivative (Columns): None for all, or increasing slot indices.
+Columns columns_from(const pybind11::object& slots);
+
 void bind_params(pybind11::module_& m);
 void bind_reference(pybind11::module_& m);
 void bind_microfacet(pybind11::module_& m);
 void bind_batch(pybind11::module_& m);
+void bind_fit(pybind11::module_& m);
 
 }  // namespace principled_brdf::bindings

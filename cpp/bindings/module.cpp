@@ -9,4 +9,5 @@ PYBIND11_MODULE(_core, m) {
     principled_brdf::bindings::bind_reference(m);
     principled_brdf::bindings::bind_microfacet(m);
     principled_brdf::bindings::bind_batch(m);
+    principled_brdf::bindings::bind_fit(m);
 }

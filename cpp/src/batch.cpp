@@ -82,11 +82,15 @@ std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::st
     return run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) { return kernels.eval_range(streamed, begin, end); });
 }
 
-void eval_direction_grad(const EvalJob& job, std::int64_t n, int threads, const std::string& isa) {
+void normal_equations(const NormalEquationsJob& job, std::int64_t count, int threads, const std::string& isa) {
     const kernel::KernelTable& kernels = kernels_for(isa);
-    run_chunks(n, threads, [&](std::int64_t begin, std::int64_t end) {
-        kernels.direction_gradient_range(job, begin, end);
-        return std::int64_t{-1};
+    // tasks of a few problems (their sums do not depend on the split)
+    const std::int64_t per_task = std::max<std::int64_t>(1, std::min<std::int64_t>(64, kMinElementsPerThread / std::max<std::int64_t>(1, job.pairs)));
+    const std::int64_t tasks = (count + per_task - 1) / per_task;
+    if (tasks == 0) return;
+    parallel_for(static_cast<int>(tasks), resolve_threads(threads), [&](int t) {
+        const std::int64_t begin = t * per_task;
+        kernels.normal_equations_range(job, begin, std::min(count, begin + per_task));
     });
 }
 

@@ -47,8 +47,9 @@ constexpr std::int64_t kLanes = static_cast<std::int64_t>(Floats::size);
 #include "kernel_material.hpp"
 #include "kernel_memory.hpp"
 #include "kernel_sampling.hpp"
-#include "kernel_eval.hpp"
 #include "kernel_direction_gradient.hpp"
+#include "kernel_eval.hpp"
+#include "kernel_normal.hpp"
 #include "kernel_sample.hpp"
 
 }  // namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS
@@ -64,8 +65,7 @@ namespace principled_brdf::kernel {
 const KernelTable& PRINCIPLED_BRDF_JOIN(PRINCIPLED_BRDF_ARCH_NS, _kernels)() {
     namespace isa = PRINCIPLED_BRDF_ARCH_NS;
     static constexpr KernelTable table{PRINCIPLED_BRDF_QUOTE(PRINCIPLED_BRDF_ARCH_NS), static_cast<int>(isa::kLanes),
-                                       &isa::eval_range, &isa::sample_range,
-                                       &isa::direction_gradient_range};
+                                       &isa::eval_range, &isa::sample_range, &isa::normal_equations_range};
     return table;
 }
 

@@ -25,8 +25,8 @@ struct KernelTable {
     std::int64_t (*eval_range)(const EvalJob& job, std::int64_t begin, std::int64_t end);
     // As eval_range, for sampling (the check is on wo).
     std::int64_t (*sample_range)(const SampleJob& job, std::int64_t begin, std::int64_t end);
-    // ∂f/∂(wi, wo) of elements [begin, end) (eval_direction_grad in batch.hpp).
-    void (*direction_gradient_range)(const EvalJob& job, std::int64_t begin, std::int64_t end);
+    // The normal equations of job.problems[begin .. end) (batch.hpp).
+    void (*normal_equations_range)(const NormalEquationsJob& job, std::int64_t begin, std::int64_t end);
 };
 
 // Defined in kernel_<isa>.cpp, each compiled with its own flags; call one

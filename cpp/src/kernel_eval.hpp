@@ -3,22 +3,48 @@
 #pragma once  // (per translation unit)
 
 // What a batch needs of its material: the lobes' constants and, for the
-// Jacobian, their partials (nothing otherwise).
+// Jacobian in the parameters, their partials, or for the derivatives in the
+// directions, the constants over dual numbers (nothing otherwise).
 struct NoPartials {};
+
+// The outputs that take derivatives in the parameters: the Jacobian and the vector-Jacobian product.
+constexpr bool differentiates(Output output) { return output == Output::kGradient || output == Output::kVjp; }
+// The outputs with a Jacobian or a product in `jacobian` (in the parameters or in the directions).
+constexpr bool has_jacobian(Output output) { return differentiates(output) || in_directions(output); }
+// The outputs that read a cotangent.
+constexpr bool is_vjp(Output output) { return output == Output::kVjp || output == Output::kDirectionVjp; }
 
 template <Output output>
 struct Prepared {
-    Shading<Floats> shading;
-    std::conditional_t<output == Output::kGradient, MaterialPartials<Floats>, NoPartials> partials;
+    std::conditional_t<in_directions(output), DirectionShading, Shading<Floats>> shading;
+    std::conditional_t<differentiates(output), MaterialPartials<Floats>, NoPartials> partials;
 };
 
 template <Output output>
 PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
     // built in place: assigning into a default-constructed one would copy the whole Shading per batch
-    if constexpr (output == Output::kGradient) {
+    if constexpr (differentiates(output)) {
         return {shading_of(m), material_partials_of(m.slot)};
+    } else if constexpr (in_directions(output)) {
+        return {direction_shading_of(m.slot), NoPartials{}};
     } else {
         return {shading_of(m), NoPartials{}};
+    }
+}
+
+// The f values an element of `output` writes to job.out (0 to kLobeCount).
+constexpr int value_outputs(Output output) {
+    return output == Output::kLobes ? kLobeCount : output == Output::kPdf || is_vjp(output) ? 0 : 1;
+}
+
+// The floats an element of `job`'s output writes to job.jacobian.
+inline int jacobian_width(const EvalJob& job) {
+    switch (job.output) {
+        case Output::kGradient: return 3 * job.columns.count;
+        case Output::kVjp: return job.columns.count;
+        case Output::kDirectionGradient: return kDirectionJacobianWidth;
+        case Output::kDirectionVjp: return kDirectionSlots;
+        default: return 0;
     }
 }
 
@@ -43,9 +69,11 @@ PB_KERNEL_INLINE PreparedOf<output, compensated> prepare_for(const RawMaterial& 
     }
 }
 
-// Where a batch's Jacobian goes, row r = kParamSlots c + p holding ∂f_c/∂p of
-// every lane: straight to memory by rows (the (3, N) layout), or through the
-// stack, transposed to element-major order when the batch is done (finish).
+// `width` rows of kLanes values as kLanes elements of `width` values each,
+// Where a batch's Jacobian goes (eval_gradient's sink), row r = P c + k
+// holding ∂f_c/∂p of every lane for the k-th of the P wanted slots: straight
+// to memory by rows (the (3, P, N) layout), or through the stack, transposed
+// to element-major order when the batch is done (finish).
 template <Layouts layouts>
 struct JacobianStore {
     const EvalJob& job;
@@ -59,8 +87,10 @@ struct JacobianStore {
         return layouts == Layouts::kRows || (layouts == Layouts::kMixed && job.jacobian_row_stride > 0);
     }
 
-    PB_KERNEL_INLINE void put(int c, int p, Floats value) {
-        const int r = kParamSlots * c + p;
+    bool wants(int p) const { return job.columns.wants(p); }
+
+    PB_KERNEL_INLINE void operator()(int c, int p, Floats value) {
+        const int r = job.columns.count * c + job.columns.position[p];
         if (by_rows()) {
             value.store_unaligned(job.jacobian + r * job.jacobian_row_stride + i);
         } else {
@@ -70,8 +100,50 @@ struct JacobianStore {
 
     PB_KERNEL_INLINE void finish() {
         if (by_rows()) return;
+        if (!job.columns.all()) {
+            store_lanes_by_element(lanes, 3 * job.columns.count, job.jacobian + 3 * job.columns.count * i);
+            return;
+        }
         for (int r = kJacobianWidth; r < padded_rows(kJacobianWidth); ++r) Floats(0.0f).store_aligned(lanes[r]);
         store_rows_by_element<kJacobianWidth>(lanes, job.jacobian + kJacobianWidth * i);
+    }
+};
+
+// The vector-Jacobian product's sink: Σ_c g_c ∂f_c/∂p for the wanted slots,
+// the channels summed in order as they come, stored by rows (the (P, N)
+// layout) or by element when the batch is done.
+template <Layouts layouts>
+struct VjpSink {
+    const EvalJob& job;
+    std::int64_t i;
+    Rgb<Floats> cotangent;
+    alignas(64) float lanes[kParamSlots][kLanes];
+
+    VjpSink(const EvalJob& job_, std::int64_t i_, const Vec3<Floats>& g) : job(job_), i(i_), cotangent{g.x, g.y, g.z} {}
+
+    bool by_rows() const {
+        return layouts == Layouts::kRows || (layouts == Layouts::kMixed && job.jacobian_row_stride > 0);
+    }
+
+    bool wants(int p) const { return job.columns.wants(p); }
+
+    PB_KERNEL_INLINE void operator()(int c, int p, Floats value) {
+        float* sum = lanes[job.columns.position[p]];
+        Floats term = channel_of(cotangent, c);
+        if (c == 0) {
+            (term * value).store_aligned(sum);
+        } else {
+            mul_add(term, value, Floats::load_aligned(sum)).store_aligned(sum);
+        }
+    }
+
+    PB_KERNEL_INLINE void finish() {
+        if (by_rows()) {
+            for (int k = 0; k < job.columns.count; ++k)
+                Floats::load_aligned(lanes[k]).store_unaligned(job.jacobian + k * job.jacobian_row_stride + i);
+        } else {
+            store_lanes_by_element(lanes, job.columns.count, job.jacobian + job.columns.count * i);
+        }
     }
 };
 
@@ -81,7 +153,7 @@ template <Model model, Output output, Layouts layouts, LobeSet lobes = LobeSet::
 PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi,
                                              const Vec3<Floats>& wo, const Shading<Floats>& s,
                                              const MultipleScatteringLobe<Floats>& ms) {
-    static_assert(output != Output::kGradient, "the energy compensation has no gradient");
+    static_assert(!has_jacobian(output), "the energy compensation has no derivatives");
     Geometry<Floats> g = geometry_of(wi, wo);
     Mask above = above_surface(g);
     View<Floats> view = view_of<model, lobes>(wo, s);
@@ -109,8 +181,8 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
 }
 
 template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes = LobeSet::kAll>
-PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
-                                 const PreparedOf<output, compensated>& material) {
+PB_KERNEL_INLINE void eval_values_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
+                                        const PreparedOf<output, compensated>& material) {
     if constexpr (compensated) {
         eval_compensated_batch<model, output, layouts, lobes>(job, i, wi, wo, material.shading, material.ms);
         return;
@@ -125,10 +197,15 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
         Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
         auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
         JacobianStore<layouts> store{job, i};
-        Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked,
-                                                   [&](int c, int p, Floats x) { store.put(c, p, x); });
+        Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked, store);
         store.finish();
         store_rgb<layouts>(job.out[0], i, {masked(f.r), masked(f.g), masked(f.b)});
+    } else if constexpr (output == Output::kVjp) {
+        Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
+        auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
+        VjpSink<layouts> sink{job, i, load_vec3<layouts>(job.cotangent, i)};
+        eval_gradient<model>(g, s, view, material.partials, masked, sink);
+        sink.finish();
     } else if constexpr (output == Output::kPdf) {
         Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);
@@ -151,6 +228,17 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
         } else {
             store_rgb<layouts, true>(job.out[0], i, masked(values.template total<lobes>(s)));
         }
+    }
+}
+
+// One batch at i of any output.
+template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes = LobeSet::kAll>
+PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
+                                 const PreparedOf<output, compensated>& material) {
+    if constexpr (in_directions(output)) {
+        eval_direction_batch<model, output, layouts>(job, i, wi, wo, material.shading);
+    } else {
+        eval_values_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, material);
     }
 }
 
@@ -248,14 +336,16 @@ PB_KERNEL_INLINE std::int64_t eval_two_batches(const EvalJob& job, std::int64_t 
 // The last pad.count < kLanes elements, as one batch.
 template <Model model, Output output, bool per_element, bool compensated, LobeSet lobes>
 bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, compensated>& uniform) {
-    alignas(64) PadBuffer wi, wo, params[kParamSlots], out[kLobeCount];
+    alignas(64) PadBuffer wi, wo, cotangent, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
-    alignas(64) float jacobian[output == Output::kGradient ? kJacobianWidth * kLanes : 1];
+    alignas(64) float jacobian[has_jacobian(output) ? kJacobianWidth * kLanes : 1];
+    static_assert(kJacobianWidth >= kDirectionJacobianWidth, "the directions' Jacobian fits the buffer");
     EvalJob padded = job;
     padded.wi = pad_vec3(job.wi, pad, wi);
     padded.wo = pad_vec3(job.wo, pad, wo);
+    if constexpr (is_vjp(output)) padded.cotangent = pad_vec3(job.cotangent, pad, cotangent);
     pad_params(job.params, padded.params, pad, params);
-    const int outputs = output == Output::kLobes ? kLobeCount : output == Output::kPdf ? 0 : 1;
+    constexpr int outputs = value_outputs(output);
     for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
     padded.pdf = pdf;
     padded.jacobian = jacobian;
@@ -265,12 +355,13 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, 
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf || output == Output::kValuePdf) unpad_scalars(job.pdf, pad, pdf);
-    if constexpr (output == Output::kGradient) {
+    if constexpr (has_jacobian(output)) {
+        const int width = jacobian_width(job);  // values an element
         for (std::int64_t j = 0; j < pad.count; ++j)
-            for (int r = 0; r < kJacobianWidth; ++r) {
+            for (int r = 0; r < width; ++r) {
                 const std::int64_t e = pad.begin + j;
-                const std::int64_t index = job.jacobian_row_stride > 0 ? r * job.jacobian_row_stride + e : kJacobianWidth * e + r;
-                job.jacobian[index] = jacobian[kJacobianWidth * j + r];
+                const std::int64_t index = job.jacobian_row_stride > 0 ? r * job.jacobian_row_stride + e : width * e + r;
+                job.jacobian[index] = jacobian[width * j + r];
             }
     }
     return true;
@@ -287,7 +378,7 @@ std::int64_t eval_batches(const EvalJob& job, std::int64_t begin, std::int64_t e
         if constexpr (compensated) row.template use_for<model>(uniform.ms);
     }
     std::int64_t i = begin;
-    if constexpr (!per_element) {
+    if constexpr (!per_element && !in_directions(output)) {  // (the directions' batches are long enough alone)
         for (; i + 2 * kLanes <= end; i += 2 * kLanes) {
             const std::int64_t stopped = eval_two_batches<model, output, layouts, compensated, lobes>(job, i, uniform);
             if (stopped >= 0) return stopped;
@@ -331,11 +422,12 @@ std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end)
 }
 
 inline Layouts layouts_of(const EvalJob& job) {
-    const int outputs = job.output == Output::kLobes ? kLobeCount : job.output == Output::kPdf ? 0 : 1;
+    int outputs = value_outputs(job.output);
     for (Vec3Layout layout : {Vec3Layout::kInterleaved, Vec3Layout::kRows}) {
         bool all = job.wi.layout == layout && job.wo.layout == layout;
         for (int k = 0; k < outputs; ++k) all = all && job.out[k].layout == layout;
-        if (job.output == Output::kGradient) all = all && (job.jacobian_row_stride > 0) == (layout == Vec3Layout::kRows);
+        if (is_vjp(job.output)) all = all && job.cotangent.layout == layout;
+        if (has_jacobian(job.output)) all = all && (job.jacobian_row_stride > 0) == (layout == Vec3Layout::kRows);
         if (all) return layout == Vec3Layout::kInterleaved ? Layouts::kInterleaved : Layouts::kRows;
     }
     return Layouts::kMixed;
@@ -354,6 +446,9 @@ std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t
         return layouts_of(job) == Layouts::kInterleaved
                        ? eval_checked<model, output, per_element, Layouts::kInterleaved, true, lobes>(job, begin, end)
                        : eval_checked<model, output, per_element, Layouts::kMixed, true, lobes>(job, begin, end);
+    }
+    if constexpr (in_directions(output)) {  // one loop for every layout: the loads are a small part of a batch
+        return eval_checked<model, output, per_element, Layouts::kMixed, false, lobes>(job, begin, end);
     }
     switch (layouts_of(job)) {
         case Layouts::kInterleaved:
@@ -380,7 +475,7 @@ std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t
     return eval_range_for<model, output, false, compensated>(job, begin, end);
 }
 
-// The energy compensation's loops: every output but the Jacobian (the bindings refuse it).
+// The energy compensation's loops: every output but the derivatives (the bindings refuse them).
 template <Output output>
 std::int64_t eval_compensated_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, output, true>(job, begin, end)
@@ -388,7 +483,7 @@ std::int64_t eval_compensated_range(const EvalJob& job, std::int64_t begin, std:
 }
 
 inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    if (job.energy_compensation && job.output != Output::kGradient) {
+    if (job.energy_compensation && !has_jacobian(job.output)) {
         switch (job.output) {
             case Output::kPdf: return eval_compensated_range<Output::kPdf>(job, begin, end);
             case Output::kValuePdf: return eval_compensated_range<Output::kValuePdf>(job, begin, end);
@@ -405,6 +500,15 @@ inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int6
         case Output::kGradient:
             return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kGradient>(job, begin, end)
                                                    : eval_range_for<Model::kDisney2014, Output::kGradient>(job, begin, end);
+        case Output::kVjp:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kVjp>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kVjp>(job, begin, end);
+        case Output::kDirectionGradient:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kDirectionGradient>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kDirectionGradient>(job, begin, end);
+        case Output::kDirectionVjp:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kDirectionVjp>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kDirectionVjp>(job, begin, end);
         case Output::kLobes:
             return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kLobes>(job, begin, end)
                                                    : eval_range_for<Model::kDisney2014, Output::kLobes>(job, begin, end);

@@ -6,7 +6,7 @@ See the README for the model and the API tour.
 from . import (environment, frames, measured, microfacet, piecewise, plot, presets, procedural_environments, reference,
                render, synthetic)
 from .fit import FitResult, fit
-from ._batch import Lobes, Sample, ValuePdf, cpu_info, eval, eval_grad, eval_lobes, eval_pdf, pdf, random_uniforms, sample
+from ._batch import Lobes, Sample, ValuePdf, cpu_info, eval, eval_grad, eval_lobes, eval_vjp, eval_pdf, pdf, random_uniforms, sample
 from ._gradient import GRADIENT_NAMES, Gradient
 from .albedo import Albedo, albedo
 from .material import PARAMETERS, BrightColorWarning, Material, gamma22_to_linear, linear_to_srgb, srgb_to_linear
@@ -15,7 +15,7 @@ __all__ = [
     "Material", "PARAMETERS", "BrightColorWarning", "srgb_to_linear", "linear_to_srgb", "gamma22_to_linear",
     "eval", "eval_lobes", "eval_pdf", "pdf", "sample", "random_uniforms", "cpu_info",
     "Lobes", "Sample", "ValuePdf", "Albedo", "albedo",
-    "eval_grad", "Gradient", "GRADIENT_NAMES", "fit", "FitResult",
+    "eval_grad", "eval_vjp", "Gradient", "GRADIENT_NAMES", "fit", "FitResult",
     "reference", "microfacet", "measured", "synthetic", "frames", "presets", "render", "plot",
     "environment", "procedural_environments", "piecewise",
 ]

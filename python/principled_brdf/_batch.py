@@ -47,7 +47,7 @@ if TYPE_CHECKING:
 
     from ._typing import Float32Array, FloatArray, Layout, Model, RealArrayLike, SpecularSampler
 
-__all__ = ["eval", "eval_lobes", "eval_grad", "eval_pdf", "ValuePdf", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
+__all__ = ["eval", "eval_lobes", "eval_grad", "eval_vjp", "eval_pdf", "ValuePdf", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
 
 _INTERLEAVED, _ROWS, _SINGLE = 0, 1, 2
 
@@ -264,6 +264,11 @@ def _output(out: object, shape: tuple[int, ...], name: str = "out") -> Float32Ar
     return out
 
 
+def _output_name(outputs: list[Float32Array], k: int) -> str:
+    """How an error names output k: ``out``, or ``out[k]`` of several."""
+    return "out" if len(outputs) == 1 else f"out[{k}]"
+
+
 def _require_no_partial_overlap(out: NDArray[Any], inputs: dict[str, NDArray[Any] | None], name: str = "out") -> None:
     """An ``out=`` that is exactly an input computes in place; one that partly overlaps
     an input would read elements it has already overwritten: a ValueError."""
@@ -336,11 +341,15 @@ def _segment_split(leading: tuple[int, ...], material_shape: tuple[int, ...],
 def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine: bool, layout: Layout,
               threads: SupportsIndex | None, check: bool, isa: str | None,
               outputs_for_shape: Callable[[tuple[int, ...], str], list[Float32Array]], pdf_sampler: int | None = None,
-              gradient: bool = False, energy_compensation: bool = False) -> list[Float32Array]:
-    """eval / eval_lobes / pdf / eval_grad: validated arguments in, outputs written."""
+              gradient: bool = False, energy_compensation: bool = False, columns: list[int] | None = None,
+              vjp: bool = False, directions: bool = False) -> list[Float32Array]:
+    """eval / eval_lobes / pdf / eval_grad / eval_vjp: validated arguments in, outputs written.
+    ``columns``: the slots a derivative is taken by (None: all). ``vjp``: the
+    outputs are the product and the cotangent, broadcast to the call's shape.
+    ``directions``: the derivatives in the six direction components instead of the slots."""
     _require_material(material)
     energy_compensation = flag("energy_compensation", energy_compensation)
-    if gradient and energy_compensation:
+    if (gradient or vjp or directions) and energy_compensation:
         raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
                                   "multiple-scattering lobe is not implemented); evaluate f with pb.eval")
     layout = _layout(layout)
@@ -373,14 +382,35 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
             return int(_core.batch_pdf(
                 wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
                 pdf=segment[0].reshape(n), out=f, out_layout=out_layout, n=n, options=options))
+        width = len(GRADIENT_NAMES) if columns is None else len(columns)
+        if directions:
+            first, second = segment
+            if vjp:
+                cotangent_flat, cotangent_code = _flat_vec3(second, layout)
+                return int(_core.batch_eval_direction_vjp(
+                    wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+                    cotangent=cotangent_flat, cotangent_layout=cotangent_code,
+                    vjp=first.reshape((n, 6) if layout == "aos" else (6, n)), out_layout=out_layout, n=n,
+                    options=options))
+            return int(_core.batch_eval_direction_grad(
+                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+                out=_flat_vec3(first, layout)[0], jacobian=second.reshape((n, 3, 6) if layout == "aos" else (3, 6, n)),
+                out_layout=out_layout, n=n, options=options))
         if gradient:
             value, jacobian = segment
-            width = len(GRADIENT_NAMES)
             return int(_core.batch_eval_grad(
                 wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
                 out=_flat_vec3(value, layout)[0],
                 jacobian=jacobian.reshape((n, 3, width) if layout == "aos" else (3, width, n)),
-                out_layout=out_layout, n=n, options=options))
+                out_layout=out_layout, n=n, options=options, columns=columns))
+        if vjp:
+            product, cotangent = segment
+            cotangent_flat, cotangent_code = _flat_vec3(cotangent, layout)
+            return int(_core.batch_eval_vjp(
+                wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+                cotangent=cotangent_flat, cotangent_layout=cotangent_code,
+                vjp=product.reshape((n, width) if layout == "aos" else (width, n)),
+                out_layout=out_layout, n=n, options=options, columns=columns))
         return int(_core.batch_eval(
             wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
             outputs=[_flat_vec3(o, layout)[0] for o in segment], lobes=len(segment) == len(LOBE_NAMES),
@@ -390,12 +420,12 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     if split is None:
         wi_flat, wi_code = wi_dirs.flat(leading)
         wo_flat, wo_code = wo_dirs.flat(leading)
-        for output in outputs:
-            _require_no_partial_overlap(output, {"wi": wi_flat, "wo": wo_flat})
+        for k, output in enumerate(outputs):
+            _require_no_partial_overlap(output, {"wi": wi_flat, "wo": wo_flat}, _output_name(outputs, k))
         bad = run(wi_flat, wi_code, wo_flat, wo_code, _params(material, leading), outputs, _size(leading))
     else:
-        for output in outputs:
-            _require_no_partial_overlap(output, {"wi": wi_dirs.array, "wo": wo_dirs.array})
+        for k, output in enumerate(outputs):
+            _require_no_partial_overlap(output, {"wi": wi_dirs.array, "wo": wo_dirs.array}, _output_name(outputs, k))
         inner = leading[split:]
         params = _params(material, inner)
         inner_n = _size(inner)
@@ -503,22 +533,85 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
         value, jacobian = _output_pair(out, _vec3_shape(leading, layout), _jacobian_shape(leading, layout, len(wanted)),
                                        "jacobian")
-        if full:
-            return [value, jacobian]
-        # the selected columns are copied into out[1] after the pass: it must not overlap the inputs either
-        _require_no_partial_overlap(jacobian, {"wi": _as_array(wi), "wo": _as_array(wo)}, "out[1]")
-        return [value, np.empty(_jacobian_shape(leading, layout, len(GRADIENT_NAMES)), np.float32)]
+        return [value, jacobian]
 
-    value, jacobian_all = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
-                                    gradient=True, energy_compensation=energy_compensation)
-    if full:
-        return Gradient(value, jacobian_all, GRADIENT_NAMES)
-    axis = -1 if _layout(layout) == "aos" else 1
-    selected = np.take(jacobian_all, wanted, axis=axis)
-    if out is not None:
-        out[1][...] = selected
-        selected = out[1]
-    return Gradient(value, selected, tuple(GRADIENT_NAMES[k] for k in wanted))
+    # the kernel computes and writes the wanted columns only
+    value, jacobian = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
+                                gradient=True, energy_compensation=energy_compensation,
+                                columns=None if full else wanted)
+    return Gradient(value, jacobian, tuple(GRADIENT_NAMES[k] for k in wanted))
+
+
+def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent: RealArrayLike, *,
+             wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014", cosine: bool = False,
+             layout: Layout = "aos", threads: SupportsIndex | None = None, check: bool = True,
+             isa: str | None = None, precision: Literal["float32", "float64"] = "float32") -> dict[str, FloatArray]:
+    """The vector-Jacobian product of f: for a cotangent g shaped like f,
+    ``Σ_c g_c ∂f_c/∂p`` for each parameter slot p that ``wrt`` selects (as
+    :func:`eval_grad`'s; default all), without forming the Jacobian
+    (docs/gradients.md).
+
+    Returns ``{slot name: array}`` in the table's order, each array shaped like
+    that parameter's own value in ``material`` (without ``base_color``'s
+    trailing 3): a per-element parameter gets one product per element (summed
+    over the axes it is broadcast along), a uniform one the sum over every
+    element, a 0-d array. ``cotangent``: real, ``(..., 3)`` (``(3, ...)`` for
+    ``layout="soa"``) broadcasting with the call's shape. ``precision``:
+    ``"float32"`` (the SIMD kernel; sums over elements taken in float64, then
+    rounded) or ``"float64"`` (the reference). The other arguments are
+    :func:`eval_grad`'s.
+    """
+    _require_material(material)
+    wanted = _gradient.columns(wrt)
+    if not isinstance(precision, str) or precision not in ("float32", "float64"):
+        raise ValueError(f"precision: expected 'float32' or 'float64', got {precision!r}")
+    soa = _layout(layout) == "soa"
+    g = np.asarray(as_real_array("cotangent", cotangent))
+    if g.dtype != np.float32:
+        g = g.astype(np.float64)
+    if g.ndim == 0 or g.shape[0 if soa else -1] != 3:
+        raise ValueError(f"cotangent: expected shape {'(3, ...)' if soa else '(..., 3)'} like f, got {g.shape}")
+    if not np.isfinite(g).all():
+        i = int(np.flatnonzero(~np.isfinite(g))[0])
+        raise ValueError(f"{element_name('cotangent', i, g.shape)}: {float(g.ravel()[i])!r} is not finite")
+    if precision == "float64":
+        from . import reference  # (imports this module)
+
+        gradient = reference.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout)
+        jacobian = gradient.jacobian if not soa else np.moveaxis(gradient.jacobian, (0, 1), (-2, -1))
+        g_aos = g if not soa else np.moveaxis(g, 0, -1)
+        products = np.einsum("...c,...ck->...k", np.broadcast_to(g_aos, jacobian.shape[:-1]), jacobian)
+        return _sum_to_parameters(material, products, wanted, np.float64)
+    g32 = g.astype(np.float32, copy=False)
+    if g32 is not g and np.isinf(g32).any():
+        raise ValueError("cotangent: values beyond float32's range")
+
+    def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
+        product = np.empty(leading + (len(wanted),) if not soa else (len(wanted),) + leading, np.float32)
+        return [product, np.ascontiguousarray(np.broadcast_to(g32, _vec3_shape(leading, layout)))]
+
+    product, _ = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
+                           energy_compensation=False, columns=wanted, vjp=True)
+    return _sum_to_parameters(material, product if not soa else np.moveaxis(product, 0, -1), wanted, np.float32)
+
+
+def _sum_to_parameters(material: Material, products: NDArray[Any], wanted: list[int],
+                       dtype: type[np.floating[Any]]) -> dict[str, FloatArray]:
+    """``products`` ``(..., P)`` summed down to each selected parameter's own shape (float64 sums)."""
+    result: dict[str, FloatArray] = {}
+    for k, slot in enumerate(wanted):
+        info = next(i for i in PARAMETERS.values() if i.first_slot <= slot < i.first_slot + i.slots)
+        value = np.asarray(getattr(material, info.name))
+        own = value.shape[:-1] if info.slots == 3 else value.shape
+        column = products[..., k]
+        extra = column.ndim - len(own)
+        axes = tuple(range(extra)) + tuple(extra + a for a, d in enumerate(own) if d == 1 and column.shape[extra + a] != 1)
+        if not axes:  # one product an element: as it is
+            result[GRADIENT_NAMES[slot]] = np.ascontiguousarray(column, dtype=dtype).reshape(own)
+            continue
+        total = column.sum(axis=axes, dtype=np.float64, keepdims=False)
+        result[GRADIENT_NAMES[slot]] = np.asarray(total, dtype=np.float64).reshape(own).astype(dtype)
+    return result
 
 
 def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",

@@ -163,8 +163,52 @@ def batch_eval_grad(
     out_layout: _Int,
     n: _Int,
     options: EvalOptions,
+    columns: Sequence[int] | None = None,
 ) -> int:
-    """SIMD f and its Jacobian over the parameter slots into preallocated float32 outputs."""
+    """SIMD f and its Jacobian over the parameter slots (columns: their indices, None for all) into preallocated float32 outputs."""
+
+def batch_eval_vjp(
+    *,
+    wi: _Float32In,
+    wi_layout: _Int,
+    wo: _Float32In,
+    wo_layout: _Int,
+    params: _Params,
+    cotangent: _Float32In,
+    cotangent_layout: _Int,
+    vjp: _Float32Out,
+    out_layout: _Int,
+    n: _Int,
+    options: EvalOptions,
+    columns: Sequence[int] | None = None,
+) -> int:
+    """SIMD vector-Jacobian product Σ_c g_c ∂f_c/∂p per element into a preallocated float32 output."""
+
+def normal_equations(
+    *,
+    wi: _Float32In,
+    wo: _Float32In,
+    slots: _Float32In,
+    target: _Float32In,
+    scale: _Float32In,
+    problems: NDArray[np.int64],
+    columns: Sequence[int] | None,
+    loss: _Int,
+    cosine: bool,
+    model: _Int,
+    threads: _Int = 0,
+    isa: str = "",
+    gain: _Float32In | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """(normal, gradient, cost) of the residuals (u(gain f) - target) scale of each listed problem, by the SIMD kernels: JᵀJ's upper triangle by rows, Jᵀr and Σ r² (float64)."""
+
+def damped_steps(
+    normal: NDArray[np.float64],
+    gradient: NDArray[np.float64],
+    damping: NDArray[np.float64],
+    free: NDArray[np.bool_],
+) -> NDArray[np.float64]:
+    """Per problem, δ solving (A + diag(damping)) δ = -gradient over the free parameters (0 for the others; NaN where the damped matrix is not positive definite)."""
 
 def batch_pdf(
     *,

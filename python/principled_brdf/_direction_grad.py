@@ -15,13 +15,13 @@ import numpy as np
 
 from . import _batch, _core, _gradient
 from ._gradient import GRADIENT_NAMES, Gradient
-from ._validate import broadcast_leading, flag, model_index
+from ._validate import MODELS, flag, model_index
 
 if TYPE_CHECKING:
     from ._typing import FloatArray, Layout, Model, RealArrayLike
     from .material import Material
 
-__all__ = ["DIRECTION_NAMES", "asks_for_directions", "eval_grad", "reference_eval_grad"]
+__all__ = ["DIRECTION_MODELS", "DIRECTION_NAMES", "asks_for_directions", "eval_grad", "reference_eval_grad", "vjp"]
 
 DIRECTION_NAMES = ("wi_x", "wi_y", "wi_z", "wo_x", "wo_y", "wo_z")
 _DIRECTION_GROUPS = {"wi": DIRECTION_NAMES[:3], "wo": DIRECTION_NAMES[3:]}
@@ -78,46 +78,68 @@ def _refuse_energy_compensation(energy_compensation: object) -> None:
                                   "multiple-scattering lobe is not implemented); evaluate f with pb.eval")
 
 
+# The models whose derivatives in the directions are implemented.
+DIRECTION_MODELS = ("disney2014", "disney2012")
+
+
+def require_direction_model(model: object) -> None:
+    """A ValueError naming ``model`` when it is a model without derivatives in the directions."""
+    if isinstance(model, str) and model not in DIRECTION_MODELS and model in MODELS:
+        raise ValueError(f"wrt: derivatives with respect to wi and wo are not implemented for model {model!r} "
+                         f"(available for {', '.join(DIRECTION_MODELS)})")
+
+
 def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, wrt: object, model: Model, cosine: bool,
               layout: Layout, threads: Any, out: Any, check: bool, isa: str | None,
               energy_compensation: bool) -> Gradient:
     """pb.eval_grad with direction columns in ``wrt`` (its arguments, checked as it checks them)."""
     parameters, directions = split(wrt)
+    require_direction_model(model)
     _refuse_energy_compensation(energy_compensation)
     layout = _batch._layout(layout)
     soa = layout == "soa"
     _batch._require_pair(out, "jacobian")
     options = dict(model=model, cosine=cosine, layout=layout, threads=threads, check=check, isa=isa)
-    # f and the parameter columns, the directions checked on the way (this pass raises on a bad one)
-    if parameters:
+    parts = []
+    if parameters:  # f and the parameter columns first, the directions checked on the way
         first = _batch.eval_grad(material, wi, wo, wrt=[GRADIENT_NAMES[k] for k in parameters], **options)
-        value, parts = first.value, [first.jacobian]
-    else:
-        value, parts = _batch.eval(material, wi, wo, **options), []
-    wi_dirs, wo_dirs = _batch._Directions("wi", wi, layout), _batch._Directions("wo", wo, layout)
-    leading = broadcast_leading(wi=wi_dirs.leading, wo=wo_dirs.leading, material=material.shape)
-    n = _batch._size(leading)
-    if out is not None:  # checked before the direction pass, written after it
-        _batch._output_pair(out, value.shape, _batch._jacobian_shape(leading, layout, len(parameters) + len(directions)),
-                            "jacobian")
-    wi_flat, wi_code = wi_dirs.flat(leading)
-    wo_flat, wo_code = wo_dirs.flat(leading)
-    by_direction = np.empty((3, 6, n) if soa else (n, 3, 6), np.float32)
-    evaluation = _core.EvalOptions(model=model_index(model), cosine=flag("cosine", cosine), energy_compensation=False,
-                                   check_tolerance=0.0, threads=_batch._threads(threads), isa=_batch._isa(isa))
-    if n:
-        _core.batch_eval_direction_grad(wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code,
-                                        params=_batch._params(material, leading), jacobian=by_direction,
-                                        out_layout=_batch._ROWS if soa else _batch._INTERLEAVED, n=n,
-                                        options=evaluation)
-    selected = by_direction[:, directions] if soa else by_direction[..., directions]
-    parts.append(selected.reshape((3, len(directions)) + leading if soa else leading + (3, len(directions))))
+        parts.append(first.jacobian)
+        options["check"] = False
+    model_id = model_index(model)
+
+    def outputs(leading: tuple[int, ...], layout: str) -> list[FloatArray]:
+        return [np.empty(_batch._vec3_shape(leading, layout), np.float32),
+                np.empty(_batch._jacobian_shape(leading, layout, len(DIRECTION_NAMES)), np.float32)]
+
+    value, by_direction = _batch._evaluate(material, wi, wo, model_id, cosine, layout, options["threads"],
+                                           options["check"], isa, outputs, directions=True)
+    if parameters:
+        value = first.value
+    parts.append(by_direction if len(directions) == len(DIRECTION_NAMES) else
+                 by_direction[:, directions] if soa else by_direction[..., directions])
     jacobian = _joined(parts, soa)
     if out is not None:
-        out[0][...] = value
-        out[1][...] = jacobian
-        value, jacobian = out
-    return Gradient(value, jacobian, _names(parameters, directions))
+        pair = _batch._output_pair(out, value.shape, jacobian.shape, "jacobian")
+        pair[0][...] = value
+        pair[1][...] = jacobian
+        value, jacobian = pair
+    return Gradient(value, np.ascontiguousarray(jacobian), _names(parameters, directions))
+
+
+def vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent: FloatArray, *, model: Model,
+        cosine: bool, threads: Any = None, isa: str | None = None) -> tuple[FloatArray, FloatArray]:
+    """``Σ_c g_c ∂f_c/∂wi`` and ``∂f_c/∂wo`` per element (float32 kernels), each ``(..., 3)`` at the
+    call's broadcast shape, for a finite float32 cotangent ``(..., 3)`` broadcasting with it."""
+    require_direction_model(model)
+    g32 = np.asarray(cotangent, np.float32)
+
+    def outputs(leading: tuple[int, ...], layout: str) -> list[FloatArray]:
+        return [np.empty(leading + (len(DIRECTION_NAMES),), np.float32),
+                np.ascontiguousarray(np.broadcast_to(g32, leading + (3,)))]
+
+    product, _ = _batch._evaluate(material, wi, wo, model_index(model), cosine, "aos", threads, True, isa, outputs,
+                                  directions=True, vjp=True)
+    return product[..., :3], product[..., 3:]
 
 
 def reference_eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, wrt: object, model: Model,
@@ -126,6 +148,7 @@ def reference_eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike
     from . import reference
 
     parameters, directions = split(wrt)
+    require_direction_model(model)
     _refuse_energy_compensation(energy_compensation)
     soa = reference._layout(layout)
     options = dict(model=model, cosine=cosine, layout=layout)

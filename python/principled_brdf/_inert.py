@@ -28,6 +28,9 @@ _SHOWN_CHANGE = 1e-6  # a parameter set back from closer than this to its start 
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
+    from typing import Any
+
+    from numpy.typing import NDArray
 
     from ._typing import Float64Array
 
@@ -68,6 +71,23 @@ def reset(values: Float64Array, start: Float64Array, slots: Sequence[int], evalu
              if np.max(np.abs(values[group] - start[group])) > _SHOWN_CHANGE]
     values[:] = moved
     return shown
+
+
+def candidates(value: NDArray[np.floating[Any]], jacobian: NDArray[np.floating[Any]], present: NDArray[np.bool_],
+               values: Float64Array, start: Float64Array, slots: Sequence[int]) -> NDArray[np.bool_]:
+    """Which of B problems ``reset`` may change: f ``(B, n, 3)``, its Jacobian ``(B, n, 3, 13)``,
+    ``present`` ``(B, n)`` the samples to look at, ``values`` and ``start`` ``(B, 13)``. A superset
+    (twice reset's first-order bound), so that a problem left out is one reset would leave."""
+    here = present[..., None]
+    scale = np.max(np.where(here, np.abs(value), 0.0), axis=(1, 2), initial=0.0)
+    bound = 2.0 * _FIRST_ORDER_CHANGE * scale.astype(np.float64)
+    maybe = np.zeros(len(values), bool)
+    for group in _whole_parameters(slots):
+        delta = (values[:, group] - start[:, group]).astype(np.float64)
+        change = np.einsum("bnck,bk->bnc", jacobian[..., group].astype(np.float64), delta)
+        first_order = np.max(np.where(here, np.abs(change), 0.0), axis=(1, 2), initial=0.0)
+        maybe |= np.any(delta != 0.0, axis=1) & (first_order <= bound)
+    return maybe
 
 
 def note(reset_names: Sequence[Sequence[str]], problems: int) -> str | None:

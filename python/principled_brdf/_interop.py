@@ -76,6 +76,25 @@ def vjp(names: list[str], values: list[np.ndarray], wi: np.ndarray, wo: np.ndarr
     result: list[np.ndarray | None] = [None] * len(names)
     if not asked:
         return result
+    if shapes is not None:  # a gradient per entry of an axis the value is broadcast along: the value at that shape
+        values = [np.broadcast_to(v, shape) for v, shape in zip(values, shapes)]
+    material = material_of(names, values)
+    if double:
+        gradient = reference.eval_grad(material, wi, wo, wrt=asked, **options)
+        # (..., 3, P) contracted with the cotangent over the colour axis
+        per_element = np.einsum("...c,...ck->...k", cotangent.astype(np.float64, copy=False), gradient.jacobian)
+        columns = dict(zip(gradient.names, np.moveaxis(per_element, -1, 0)))
+    else:
+        columns = _batch.eval_vjp(material, np.asarray(wi, np.float32), np.asarray(wo, np.float32), cotangent,
+                                  wrt=asked, **options)
+    for index, (name, want) in enumerate(zip(names, wanted)):
+        if not want:
+            continue
+        part = columns[name] if PARAMETERS[name].slots == 1 else np.stack([columns[f"{name}_{c}"] for c in "rgb"],
+                                                                           axis=-1)
+        shape = values[index].shape if shapes is None else shapes[index]
+        result[index] = sum_to_shape(np.asarray(part), shape).astype(values[index].dtype, copy=False)
+    return result
     material = material_of(names, values)
     if double:
         gradient = reference.eval_grad(material, wi, wo, wrt=asked, **options)

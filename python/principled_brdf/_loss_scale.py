@@ -29,3 +29,12 @@ def log_scale(measured: Float64Array, cos_theta: Float64Array) -> float:
     ``(n,)`` the loss's cosine factor c."""
     weighted = measured * cos_theta[:, None]
     return max(float(np.median(weighted)), _MEAN_FRACTION * float(np.mean(weighted)), _FLOOR)
+
+
+def log_scales(measured: Float64Array, cos_theta: Float64Array) -> Float64Array:
+    """``log_scale`` of B problems with every sample present: ``measured`` ``(B, n, 3)``,
+    ``cos_theta`` ``(B, n)``; the same values as one problem at a time."""
+    if len(measured) == 0:
+        return np.zeros(0)
+    weighted = (measured * cos_theta[..., None]).reshape(len(measured), -1)
+    return np.maximum(np.maximum(np.median(weighted, axis=1), _MEAN_FRACTION * np.mean(weighted, axis=1)), _FLOOR)

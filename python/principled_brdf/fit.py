@@ -1,10 +1,13 @@
 """Fitting the model to measured values of f (docs/fitting.md).
 
-Least squares (``scipy.optimize.least_squares``, trust-region reflective) on
-residuals between the model and the measurements at given direction pairs,
-with the analytic Jacobian of :func:`principled_brdf.eval_grad`: scipy's
-finite differences through a float32 kernel take steps that vanish in its
-rounding, and stop at the start point.
+Least squares on residuals between the model and the measurements at given
+direction pairs, with the analytic derivatives of the model (finite
+differences through a float32 kernel take steps that vanish in its rounding,
+and stop at the start point). The default method solves every problem of a
+batch together (:mod:`principled_brdf._solver`: one pass of the kernels per
+iteration, reduced per problem to the normal equations); ``method="scipy"``
+solves one problem at a time by ``scipy.optimize.least_squares``
+(trust-region reflective) with :func:`principled_brdf.eval_grad`'s Jacobian.
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import math
 import threading
+import time
 
 from collections.abc import Mapping as _Mapping
 from dataclasses import dataclass
@@ -19,9 +23,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _gradient, _inert, _validate
-from ._loss_scale import log_scale
-from ._batch import eval_grad
+from . import _gradient, _inert, _solver, _validate
+from ._loss_scale import log_scale, log_scales
+from ._batch import eval, eval_grad
 from ._gradient import GRADIENT_NAMES
 from .material import PARAMETERS, Material
 from . import reference
@@ -34,12 +38,26 @@ if TYPE_CHECKING:
 
     from ._typing import Float64Array, Model, RealArrayLike
 
-__all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES"]
+    # fitted slots, costs, iterations, success, messages, residuals: per problem
+    # and per problem the parameters set back to their start (module _inert)
+    _FitArrays = tuple[Float64Array, Float64Array, NDArray[np.int64], NDArray[np.bool_], list[str], Float64Array,
+                       list[list[str]]]
+
+__all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES", "METHODS"]
 
 # Default bounds for fitting: the domains, with the unbounded parameters held
 # to [0, 1] as the BRDF Explorer's sliders are (pass bounds= to widen them).
 FIT_BOUNDS = {name: (max(info.lower, 0.0), min(info.upper, 1.0)) for name, info in PARAMETERS.items()}
 LOSSES = ("scaled_log", "log", "relative", "linear")
+METHODS = ("batched", "scipy")
+# The batched solver stops when a taken step lowers the cost by less than this
+# fraction: the float32 kernels' cost is exact to about 1e-7 of itself.
+_FTOL = {"float32": 1e-7, "float64": 1e-10}
+
+
+def _batch_problems(pairs: int) -> int:
+    """Problems the batched solver takes together: about 4 million samples' worth."""
+    return max(1, (1 << 22) // max(1, pairs))
 # The "relative" loss divides by max(m, _RELATIVE_FLOOR_FRACTION * max m, _RELATIVE_FLOOR) (1/sr):
 # the absolute floor keeps a black problem (every m = 0) finite; it then fits f towards 0.
 _RELATIVE_FLOOR_FRACTION = 1e-3
@@ -60,9 +78,9 @@ class FitResult:
     slots: Float64Array  # (..., 13) its values in the parameter slots (GRADIENT_NAMES' order)
     cost: np.float64 | Float64Array  # 0.5 * sum of squared (weighted) residuals, per problem
     residuals: Float64Array  # (..., N, 3) unweighted, at the fitted material; NaN where measured is NaN
-    iterations: np.int64 | NDArray[np.int64]  # Jacobian evaluations, per problem
-    success: np.bool_ | NDArray[np.bool_]  # scipy's convergence flag, per problem (False: no data)
-    message: str | tuple[str, ...]  # scipy's message, per problem, or why it was not fitted
+    iterations: np.int64 | NDArray[np.int64]  # evaluations of the derivatives, per problem
+    success: np.bool_ | NDArray[np.bool_]  # converged, per problem (False: no data, or max_iterations reached)
+    message: str | tuple[str, ...]  # why the solver stopped, per problem, or why it was not fitted
     names: tuple[str, ...]  # the fitted parameters (slot names, base_color as three)
     notes: tuple[str, ...] = ()  # what the fit decided by itself (e.g. a parameter the data cannot determine)
 
@@ -170,6 +188,8 @@ def _residual_and_jacobian(value: Float64Array, jacobian: Float64Array, measured
 _blas_lock = threading.Lock()
 _blas_users = 0
 _blas_limiter: Any = None
+_blas_original: dict[str, int] = {}
+_BLAS_RESTORE_TRIES = 5
 
 
 @contextlib.contextmanager
@@ -178,7 +198,7 @@ def _one_blas_thread() -> Iterator[None]:
     the SVD of the tall (N, P) Jacobian, which threads slow down (a 20,000-pair fit on
     two cores: 12.6 s with OpenBLAS's threads, 4.1 s with one). Calls that overlap (from
     several threads) share the limit, and the last one out restores the previous limits."""
-    global _blas_users, _blas_limiter
+    global _blas_users, _blas_limiter, _blas_original
     try:
         from threadpoolctl import threadpool_limits  # type: ignore[import-untyped]  # it ships no type hints
     except ImportError:  # pragma: no cover - in the fit and test extras
@@ -186,6 +206,7 @@ def _one_blas_thread() -> Iterator[None]:
         return
     with _blas_lock:
         if _blas_users == 0:
+            _blas_original = _blas_thread_counts()
             _blas_limiter = threadpool_limits(1, user_api="blas")
         _blas_users += 1
     try:
@@ -195,7 +216,28 @@ def _one_blas_thread() -> Iterator[None]:
             _blas_users -= 1
             if _blas_users == 0:
                 limiter, _blas_limiter = _blas_limiter, None
-                limiter.restore_original_limits()
+                _restore_blas_threads(limiter, _blas_original)
+
+
+def _blas_thread_counts() -> dict[str, int]:
+    from threadpoolctl import threadpool_info
+
+    return {info["filepath"]: info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas"}
+
+
+def _restore_blas_threads(limiter: Any, original: dict[str, int]) -> None:
+    """Undo a threadpoolctl limit, checked against the counts before it: OpenBLAS
+    (0.3.30 and 0.3.31 seen) now and then keeps its count of 1 when it is set back
+    right after BLAS calls of two threads, then takes the same setting a few
+    milliseconds later. Left unchecked, BLAS stayed on one thread for the rest of
+    the process."""
+    for attempt in range(_BLAS_RESTORE_TRIES):
+        if attempt:
+            time.sleep(1e-3 * 2**attempt)
+        limiter.restore_original_limits()
+        now = _blas_thread_counts()
+        if all(now.get(path) == count for path, count in original.items()):
+            return
 
 
 def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
@@ -203,7 +245,8 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
         loss: Literal["scaled_log", "log", "relative", "linear"] = "scaled_log", weights: RealArrayLike | None = None,
         bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None = None, model: Model = "disney2014",
         cosine: bool = True, precision: Literal["float32", "float64"] = "float32",
-        max_iterations: SupportsIndex = 200) -> FitResult:
+        max_iterations: SupportsIndex = 200, method: Literal["batched", "scipy"] = "batched",
+        threads: SupportsIndex | None = None) -> FitResult:
     """The material that best matches ``measured`` values of f (1/sr) at the pairs (wi, wo).
 
     ``wi``, ``wo``: unit directions ``(N, 3)``; ``measured``: ``(N, 3)``, or
@@ -232,6 +275,14 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     ``"float64"`` (the reference). ``max_iterations``: an integer >= 1, the
     most evaluations of the model per problem.
 
+    ``method``: ``"batched"`` (default) solves all problems together by
+    Levenberg-Marquardt with the bounds (docs/fitting.md): each iteration
+    evaluates every unfinished problem in one pass of the kernels, reduced per
+    problem to its normal equations in C++; a problem's result is the same
+    bits whichever problems share its batch and whatever ``threads`` (default
+    all cores). ``"scipy"``: ``scipy.optimize.least_squares`` (trust-region
+    reflective) one problem after another.
+
     A problem without data (every sample NaN) is not fitted and does not stop
     the others: its result is the start (``init`` clipped to ``bounds``), cost
     0.0 (the sum over no samples), iterations 0, success False and a message
@@ -239,10 +290,13 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     every parameter of ``fit``, each problem's result is the start, evaluated
     (cost and residuals), with iterations 0 and success True.
     """
-    try:
-        from scipy.optimize import least_squares
-    except ImportError as error:  # pragma: no cover - scipy is in the test and fit extras
-        raise ImportError("pb.fit needs scipy: pip install 'principled-brdf[fit]'") from error
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"method: expected one of {', '.join(METHODS)}, got {method!r}")
+    thread_count = 0  # all cores
+    if threads is not None:
+        thread_count = _validate.integer("threads", threads)
+        if not 1 <= thread_count <= 2**31 - 1:
+            raise ValueError(f"threads: expected an integer from 1 to 2**31 - 1, got {thread_count}")
     if not isinstance(loss, str) or loss not in LOSSES:
         raise ValueError(f"loss: expected one of {', '.join(LOSSES)}, got {loss!r}")
     if not isinstance(precision, str) or precision not in ("float32", "float64"):
@@ -296,6 +350,43 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     slots = [k for k in requested if lower[k] < upper[k]]  # equal bounds hold a parameter (clipped to it above)
     _validate.model_index(model)  # checked before any work; eval_grad takes the name
 
+    if method == "batched":
+        if wi.ndim != wo.ndim:  # one of them per problem: both
+            wi, wo = np.ascontiguousarray(wi_rows), np.ascontiguousarray(wo_rows)
+        # a few million samples at a time: the solver's arrays stay small whatever the texture
+        # (a problem's result does not depend on the problems solved with it)
+        parts = [_fit_batched(wi[rows] if wi.ndim == 3 else wi, wo[rows] if wo.ndim == 3 else wo, problems[rows],
+                              None if weights is None else weights[rows], start, lower, upper, slots, loss, cosine,
+                              model, precision, max_iterations, thread_count)
+                 for begin in range(0, max(count, 1), _batch_problems(n))
+                 for rows in [slice(begin, min(count, begin + _batch_problems(n)))]]
+        fitted, costs, iterations, success = (np.concatenate([part[k] for part in parts]) for k in range(4))
+        messages = [message for part in parts for message in part[4]]
+        residuals_out = np.concatenate([part[5] for part in parts])
+        reset_names = [names for part in parts for names in part[6]]
+    else:
+        fitted, costs, iterations, success, messages, residuals_out, reset_names = _fit_scipy(
+            wi_rows, wo_rows, problems, weights, start, lower, upper, slots, loss, cosine, model, precision,
+            max_iterations)
+    if (note := _inert.note(reset_names, count)) is not None:
+        notes.append(note)
+
+    take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
+    return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
+                     residuals=take(residuals_out), iterations=take(iterations), success=take(success),
+                     message=tuple(messages) if batched else messages[0], names=tuple(GRADIENT_NAMES[k] for k in slots),
+                     notes=tuple(notes))
+
+
+def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[Any], weights: Float64Array | None,
+               start: Float64Array, lower: Float64Array, upper: Float64Array, slots: list[int], loss: str,
+               cosine: bool, model: Model, precision: str, max_iterations: int) -> _FitArrays:
+    """One problem after another by scipy's trust-region reflective least squares."""
+    try:
+        from scipy.optimize import least_squares
+    except ImportError as error:  # pragma: no cover - scipy is in the test and fit extras
+        raise ImportError("pb.fit(method='scipy') needs scipy: pip install 'principled-brdf[fit]'") from error
+    count = problems.shape[0]
     fitted = np.empty((count, len(GRADIENT_NAMES)))
     costs, iterations, success, messages = np.empty(count), np.empty(count, np.int64), np.empty(count, bool), []
     residuals_out = np.full(problems.shape, np.nan)
@@ -355,14 +446,139 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
             success[row] = solution.success
             messages.append(solution.message)
             residuals_out[row][present] = evaluate(values[slots].copy())[0]
+    return fitted, costs, iterations, success, messages, residuals_out, reset_names
 
-    if (note := _inert.note(reset_names, count)) is not None:
-        notes.append(note)
-    take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
-    return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
-                     residuals=take(residuals_out), iterations=take(iterations), success=take(success),
-                     message=tuple(messages) if batched else messages[0], names=tuple(GRADIENT_NAMES[k] for k in slots),
-                     notes=tuple(notes))
+
+def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], weights: Float64Array | None,
+                 start: Float64Array, lower: Float64Array, upper: Float64Array, slots: list[int], loss: str,
+                 cosine: bool, model: Model, precision: str, max_iterations: int, threads: int) -> _FitArrays:
+    """Every problem together by the batched solver (module _solver)."""
+    count, n = problems.shape[:2]
+    present: NDArray[np.bool_] = ~np.any(np.isnan(problems), axis=-1)  # (B, N)
+    has_data = np.any(present, axis=1)
+    m = np.where(present[..., None], problems, 0.0)
+    cos_theta = np.maximum(wi[..., 2], 0.0) if cosine else np.ones(wi.shape[:-1])
+    cos_theta = np.broadcast_to(cos_theta, (count, n))[..., None]
+    root_weight = (np.sqrt(weights) if weights is not None else np.ones((count, n)))[..., None]
+    floor = np.maximum(_RELATIVE_FLOOR_FRACTION * m.max(axis=(1, 2)), _RELATIVE_FLOOR)[:, None, None]
+    # the log losses' s per problem (1/sr for "log")
+    level = np.ones(count)
+    if loss == "scaled_log":
+        complete = np.all(present, axis=1)
+        level[complete] = log_scales(m[complete], cos_theta[complete, :, 0])
+        for row in np.flatnonzero(has_data & ~complete):
+            here = present[row]
+            level[row] = log_scale(m[row][here], cos_theta[row, :, 0][here])
+    # r = (u(g f) - target) scale: the loss folded into the gain g, target and scale (docs/fitting.md)
+    gain = np.ones(count)
+    if loss == "relative":
+        target, scale, kernel_cosine, loss_code = m, root_weight / np.maximum(m, floor), False, 0
+    elif loss in ("log", "scaled_log"):
+        target, scale, kernel_cosine, loss_code = np.log1p(m * cos_theta / level[:, None, None]), root_weight, cosine, 1
+        gain = 1.0 / level
+    else:
+        target, scale, kernel_cosine, loss_code = m * cos_theta, root_weight, cosine, 0
+    scale = np.where(present[..., None], np.broadcast_to(scale, problems.shape), 0.0)
+    # each problem's scale divided by its largest (the same minimum; float32 sums stay in range)
+    top = scale.max(axis=(1, 2))
+    scale = scale / np.where(top > 0.0, top, 1.0)[:, None, None]
+    full_start = np.broadcast_to(start, (count, len(GRADIENT_NAMES))).copy()
+    solved = np.flatnonzero(has_data).astype(np.int64)
+    slot_index = np.asarray(slots, dtype=np.int64)
+    fitted = full_start.copy()
+    iterations = np.zeros(count, np.int64)
+    success = np.zeros(count, bool)
+    messages = [_NO_DATA] * count
+    reset_names: list[list[str]] = []
+    if slots and len(solved):
+        if precision == "float32":
+            equations = _solver.float32_equations(
+                np.ascontiguousarray(wi, dtype=np.float32), np.ascontiguousarray(wo, dtype=np.float32),
+                np.ascontiguousarray(target, dtype=np.float32), np.ascontiguousarray(scale, dtype=np.float32),
+                np.ascontiguousarray(gain, dtype=np.float32), full_start, slots, solved, loss_code, kernel_cosine,
+                _validate.model_index(model), threads)
+        else:
+            equations = _solver.float64_equations(_material_of, wi, wo, np.broadcast_to(target, problems.shape),
+                                                  scale, gain, full_start, slots, solved, loss_code, kernel_cosine,
+                                                  model)
+        solution = _solver.levenberg_marquardt(equations, full_start[np.ix_(solved, slot_index)], lower[slots],
+                                               upper[slots], max_iterations, _FTOL[precision])
+        fitted[np.ix_(solved, slot_index)] = solution.x
+        iterations[solved] = solution.iterations
+        success[solved] = solution.success
+        for j, row in enumerate(solved):
+            messages[row] = solution.message[j]
+        reset_names = _reset_inert(fitted, full_start, slots, solved, wi, wo, present, model, precision, threads)
+    elif len(solved):
+        success[solved] = True
+        for row in solved:
+            messages[row] = _NOTHING_FITTED
+    residuals_out, costs = _residuals_at(fitted, wi, wo, problems, present, m, cos_theta, root_weight, floor, level,
+                                         loss, model, precision, threads)
+    return fitted, costs, iterations, success, messages, residuals_out, reset_names
+
+
+def _reset_inert(fitted: Float64Array, start: Float64Array, slots: list[int], solved: NDArray[np.int64],
+                 wi: NDArray[Any], wo: NDArray[Any], present: NDArray[np.bool_], model: Model, precision: str,
+                 threads: int) -> list[list[str]]:
+    """_inert.reset for each solved problem, in place in ``fitted``: f and its Jacobian of a few
+    problems at a time in one call, then the check of each problem that may have a
+    parameter without effect (_inert.candidates), on its present samples."""
+    n = present.shape[1]
+    chunk = max(1, (1 << 22) // max(1, n * 3 * len(GRADIENT_NAMES)))
+    names: list[list[str]] = []
+    for begin in range(0, len(solved), chunk):
+        rows = solved[begin:begin + chunk]
+        wi_part, wo_part = (wi[rows], wo[rows]) if wi.ndim == 3 else (wi, wo)
+        material = _material_of(fitted[rows]).reshape(-1, 1)
+        if precision == "float32":
+            g = eval_grad(material, wi_part.astype(np.float32), wo_part.astype(np.float32), model=model, check=False,
+                          threads=threads or None)
+        else:
+            g = reference.eval_grad(material, wi_part, wo_part, model=model)
+        maybe = _inert.candidates(g.value, g.jacobian, present[rows], fitted[rows], start[rows], slots)
+        names.extend([] for _ in range(int(np.count_nonzero(~maybe))))
+        for j, row in zip(np.flatnonzero(maybe), rows[maybe]):
+            here = present[row]
+            value, jacobian = g.value[j][here].astype(np.float64), g.jacobian[j][here].astype(np.float64)
+            _, evaluate_value = _evaluators(wi[row][here] if wi.ndim == 3 else wi[here],
+                                            wo[row][here] if wo.ndim == 3 else wo[here], model, precision)
+            moved = _inert.reset(fitted[row], start[row], slots, lambda values: (value, jacobian), evaluate_value)
+            names.append(moved or [])
+    return names
+
+
+def _residuals_at(fitted: Float64Array, wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any],
+                  present: NDArray[np.bool_], m: Float64Array, cos_theta: Float64Array, root_weight: Float64Array,
+                  floor: Float64Array, level: Float64Array, loss: str, model: Model, precision: str,
+                  threads: int) -> tuple[Float64Array, Float64Array]:
+    """The unweighted residuals (NaN where a sample is missing) and ½ Σ (weighted residual)² of every
+    problem at its fitted material, a few problems at a time."""
+    count, n = problems.shape[:2]
+    residuals = np.full(problems.shape, np.nan)
+    costs = np.zeros(count)
+    chunk = max(1, (1 << 20) // max(1, n))
+    for begin in range(0, count, chunk):
+        rows = slice(begin, min(count, begin + chunk))
+        material = _material_of(fitted[rows]).reshape(-1, 1)
+        wi_part, wo_part = (wi[rows], wo[rows]) if wi.ndim == 3 else (wi, wo)
+        if precision == "float32":
+            value = eval(material, wi_part.astype(np.float32), wo_part.astype(np.float32), model=model, check=False,
+                         threads=threads or None).astype(np.float64)
+        else:
+            value = reference.eval(material, wi_part, wo_part, model=model)
+        c, mm = cos_theta[rows], m[rows]
+        if loss in ("log", "scaled_log"):
+            s = level[rows][:, None, None]
+            r = np.log1p(value * c / s) - np.log1p(mm * c / s)
+        elif loss == "relative":
+            r = (value - mm) / np.maximum(mm, floor[rows])
+        else:
+            r = (value - mm) * c
+        here = present[rows][..., None]
+        residuals[rows] = np.where(here, r, np.nan)
+        costs[rows] = 0.5 * np.sum(np.where(here, r * root_weight[rows], 0.0) ** 2, axis=(1, 2))
+    return residuals, costs
 
 
 def _evaluators(wi: Float64Array, wo: Float64Array, model: Model, precision: str) -> tuple[

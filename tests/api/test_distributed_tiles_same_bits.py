@@ -88,6 +88,24 @@ def test_a_tiled_fit_is_the_fit_of_each_texel():
     assert result.material().shape == (3, 4)
 
 
+def test_a_tiled_fit_on_dasks_threads_leaves_the_blas_threads_as_it_found_them():
+    """The default (batched) fit takes no BLAS call that needs limiting: run on dask's threaded
+    scheduler, it leaves every BLAS library's thread count as it was."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    dask = pytest.importorskip("dask")
+    wi, wo, measured = fit_inputs()
+
+    def blas_threads():
+        return [info["num_threads"] for info in threadpoolctl.threadpool_info() if info["user_api"] == "blas"]
+
+    before = blas_threads()
+    with dask.config.set(scheduler="threads"):
+        result = pbd.fit(wi, wo, da.from_array(measured, chunks=(1, 2, 48, 3)), fit=["roughness"],
+                         init={"metallic": 1.0, "base_color": (0.8, 0.5, 0.3)})
+        pbd.compute(result.slots, progress=False)
+    assert blas_threads() == before
+
+
 def test_a_cluster_of_worker_processes_gives_the_same_bits():
     distributed = pytest.importorskip("distributed")
     pytest.importorskip("scipy")

@@ -107,8 +107,8 @@ def _kind(annotation: str) -> str | None:
         return "tuple"
     if text.startswith("dict") or text == "_CpuInfo":  # the stub's TypedDict of cpu_info
         return "dict"
-    for dtype in ("float32", "float64", "int32"):
-        if re.search(rf"\b(numpy|np)\.{dtype}\b", text):
+    for dtype in ("float32", "float64", "int32", "int64", "bool"):
+        if re.search(rf"\b(numpy|np)\.{dtype}_?\b", text):
             return f"{dtype} array"
     assert text in ("bool", "str", "int", "float", "None"), f"unexpected annotation {annotation!r}"
     return text

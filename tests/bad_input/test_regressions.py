@@ -655,7 +655,8 @@ def test_fit_wrongly_shaped_weights_name_weights(shape):
 
 
 def test_concurrent_fits_restore_the_blas_threads(monkeypatch):
-    """Two fits that overlap, the first one in leaving first: the BLAS limit afterwards is the one before."""
+    """Two fits by scipy (the method that limits BLAS to one thread) that overlap, the first one
+    in leaving first: the BLAS limit afterwards is the one before."""
     threadpoolctl = pytest.importorskip("threadpoolctl")
     import scipy.optimize
 
@@ -681,7 +682,7 @@ def test_concurrent_fits_restore_the_blas_threads(monkeypatch):
 
     def run(name):
         try:
-            pb.fit(wi, wo, measured, fit=["roughness"], max_iterations=5)
+            pb.fit(wi, wo, measured, fit=["roughness"], max_iterations=5, method="scipy")
         except BaseException as error:  # reported below
             errors.append(error)
         finally:

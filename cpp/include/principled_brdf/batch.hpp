@@ -50,6 +50,33 @@ enum class Output : int {
     kPdf = 2,    // the sampling pdf of (wi, wo)
     kGradient = 3,  // f and its Jacobian in the parameter slots
     kValuePdf = 4,  // f and the sampling pdf of (wi, wo), in one pass
+    kVjp = 5,       // Σ_c g_c ∂f_c/∂p per element for a cotangent g (no f, no Jacobian)
+    // f and its Jacobian in the directions' components wi_x, wi_y, wi_z, wo_x,
+    // wo_y, wo_z (docs/gradients.md, "Derivatives in the directions")
+    kDirectionGradient = 6,
+    kDirectionVjp = 7,  // Σ_c g_c ∂f_c/∂w per element for the six components (no f, no Jacobian)
+};
+
+// The direction components the derivatives in the directions are taken by:
+// wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.
+inline constexpr int kDirectionComponents = 6;
+
+// The parameter slots a derivative is taken by, in the table's order: column
+// k of the outputs is the k-th wanted slot; position[p] is slot p's column, or -1.
+struct Columns {
+    int count = kParamSlots;
+    std::int8_t position[kParamSlots];
+
+    Columns() {
+        for (int p = 0; p < kParamSlots; ++p) position[p] = static_cast<std::int8_t>(p);
+    }
+    // `slots`: count distinct slot indices in increasing order (the caller checked them)
+    Columns(const int* slots, int slot_count) : count(slot_count) {
+        for (int p = 0; p < kParamSlots; ++p) position[p] = -1;
+        for (int k = 0; k < slot_count; ++k) position[slots[k]] = static_cast<std::int8_t>(k);
+    }
+    bool wants(int p) const { return position[p] >= 0; }
+    bool all() const { return count == kParamSlots; }
 };
 
 // The Jacobian's values per element: ∂f_c/∂p for the 3 channels c and the kParamSlots slots p.
@@ -96,12 +123,20 @@ struct EvalJob {
     bool energy_compensation = false;
     // out[0] is f; with Output::kLobes, out[0..4] are the lobes of kLobeNames.
     MutableVec3Array out[kLobeCount];
-    // Output::kGradient: out[0] is f, and element i's ∂f_c/∂p is at
-    // jacobian[kJacobianWidth i + kParamSlots c + p] (an (N, 3, 13) array) or,
-    // with jacobian_row_stride > 0, at jacobian[(kParamSlots c + p) jacobian_row_stride + i]
-    // (a (3, 13, N) array).
+    // Output::kGradient: out[0] is f, and element i's ∂f_c/∂p for the P =
+    // columns.count wanted slots p is at jacobian[3 P i + P c + k] (an (N, 3, P)
+    // array, k = columns.position[p]) or, with jacobian_row_stride > 0, at
+    // jacobian[(P c + k) jacobian_row_stride + i] (a (3, P, N) array).
+    // Output::kVjp: element i's Σ_c g_c ∂f_c/∂p, g the cotangent's element i,
+    // is at jacobian[P i + k] (an (N, P) array) or, with jacobian_row_stride > 0,
+    // at jacobian[k jacobian_row_stride + i] (a (P, N) array).
+    // Output::kDirectionGradient and kDirectionVjp: as kGradient and kVjp with
+    // the P = 6 direction components wi_x, wi_y, wi_z, wo_x, wo_y, wo_z for
+    // columns (`columns` is not read).
     float* jacobian = nullptr;
     std::int64_t jacobian_row_stride = 0;
+    Columns columns;
+    Vec3Array cotangent;  // Output::kVjp and kDirectionVjp
     // Output::kPdf and kValuePdf: one float per element, for this specular sampler.
     float* pdf = nullptr;
     SpecularSampler sampler = SpecularSampler::kVisibleNormals;
@@ -110,6 +145,41 @@ struct EvalJob {
     DirectionCheck check;
 
     bool uniform_material() const { return principled_brdf::uniform_material(params); }
+};
+
+// The normal equations of least-squares problems (docs/fitting.md), for the
+// fitting solver: problem b's residuals over its pairs n and channels c are
+//     r = (u(g f) - t) s,  u(x) = x (Loss::kLinear) or log(1 + x) (Loss::kLog),
+// with f = f_c(wi_n, wo_n) of the problem's material (times cos θl with
+// `cosine`), g = gain[b] (1 without gains), t = target[b, n, c] and
+// s = scale[b, n, c] (the caller folds the loss, its per-problem level, the
+// weights and missing samples, s = 0, into g, t and s). Per problem,
+// over the wanted columns k <= l (P = columns.count of them):
+//     cost = Σ r²,  gradient_k = Σ r ∂r/∂p_k,  normal_kl = Σ ∂r/∂p_k ∂r/∂p_l,
+// the upper triangle by rows, P (P + 1) / 2 numbers; no per-pair value is
+// written. Each problem is summed by one thread in one order, so its sums do
+// not depend on the other problems of the call nor on the thread count.
+enum class Loss : int { kLinear = 0, kLog = 1 };
+
+inline constexpr int kNormalWidth = kParamSlots * (kParamSlots + 1) / 2;
+
+struct NormalEquationsJob {
+    const float* wi = nullptr;  // (N, 3) shared by every problem, or (B, N, 3) with per_problem_directions
+    const float* wo = nullptr;
+    bool per_problem_directions = false;
+    std::int64_t pairs = 0;               // N
+    const float* slots = nullptr;         // (B, kParamSlots): each problem's material
+    const float* target = nullptr;        // (B, N, 3)
+    const float* scale = nullptr;         // (B, N, 3)
+    const float* gain = nullptr;          // (B,), or null for 1
+    const std::int64_t* problems = nullptr;  // the `count` problems b to sum, result j for problems[j]
+    Model model = Model::kDisney2014;
+    Loss loss = Loss::kLinear;
+    bool cosine = false;
+    Columns columns;
+    double* normal = nullptr;    // (count, P (P + 1) / 2)
+    double* gradient = nullptr;  // (count, P)
+    double* cost = nullptr;      // (count,)
 };
 
 // sample(material, wo, u): wi, pdf, weight = f cos θl / pdf and lobe per element.
@@ -145,13 +215,9 @@ int float_lanes(const std::string& isa);
 // first element whose wi or wo fails it (then some elements are unwritten).
 std::int64_t eval(const EvalJob& job, std::int64_t n, int threads, const std::string& isa = "");
 
-// The derivatives of f (times cos θl if job.cosine) in the directions
-// (docs/gradients.md): element i's ∂f_c/∂w_k, k = wi_x, wi_y, wi_z, wo_x,
-// wo_y, wo_z, at job.jacobian[18 i + 6 c + k] (an (N, 3, 6) array) or, with
-// job.jacobian_row_stride > 0, at job.jacobian[(6 c + k) jacobian_row_stride + i]
-// (a (3, 6, N) array). job.out and job.check are not used: the caller checks
-// the directions (eval_grad does in its pass for f).
-void eval_direction_grad(const EvalJob& job, std::int64_t n, int threads, const std::string& isa = "");
+// The normal equations of job.problems[0 .. count - 1] (directions unchecked:
+// the caller checked them), on `threads` threads and `isa` as eval.
+void normal_equations(const NormalEquationsJob& job, std::int64_t count, int threads, const std::string& isa = "");
 
 // As eval, for sampling; returns -1 or an element whose wo is bad.
 std::int64_t sample(const SampleJob& job, std::int64_t n, int threads, const std::string& isa = "");

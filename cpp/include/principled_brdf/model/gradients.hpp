@@ -112,35 +112,68 @@ PB_MODEL_INLINE F one_minus_schlick_weight(const Geometry<F>& g) {
     return min(max(g.cos_theta_d, zero), one) * mul_add(m, mul_add(m, mul_add(m, m + one, one), one), one);
 }
 
+// Whether a sink takes slot p's column: a sink with a wants(p) method says
+// which (the kernels' column selections); any other sink takes them all.
+template <class Sink, class = void>
+struct SelectsColumns : std::false_type {};
+template <class Sink>
+struct SelectsColumns<Sink, std::void_t<decltype(std::declval<const Sink&>().wants(0))>> : std::true_type {};
+
+template <class Sink>
+PB_MODEL_INLINE bool sink_wants(const Sink& sink, int p) {
+    if constexpr (SelectsColumns<std::decay_t<Sink>>::value) {
+        return sink.wants(p);
+    } else {
+        return true;
+    }
+}
+
 // f (per channel, as eval_lobes(...).total), returned, and its Jacobian, given
-// to `jacobian(c, p, value)` for every channel c and slot p: the kernels store
-// each value as it comes instead of holding 39 of them. Every Jacobian entry
+// to `jacobian(c, p, value)` for every channel c and every slot p the sink
+// wants (sink_wants): the kernels store or reduce each value as it comes
+// instead of holding 39 of them, and the scalars only unwanted columns need
+// (the diffuse, specular and clearcoat partials) are not computed. A column's
+// value is the same expression whichever others are wanted, so its bits do not
+// depend on the selection. Every Jacobian entry
 // is a sum of products of a per-material constant with one of nine scalars of
 // the pair; `weigh` is applied to those scalars (the kernels: times cos θl
-// if asked, 0 below the surface, where they may not be finite), so the 39
+// if asked, 0 below the surface, where they may not be finite), so the
 // entries need no masking of their own.
 template <Model model, class F, class Weigh, class Sink>
 PB_MODEL_INLINE Rgb<F> eval_gradient(const Geometry<F>& g, const Shading<F>& s, const View<F>& view,
                                      const MaterialPartials<F>& d, const Weigh& weigh, Sink&& jacobian) {
+    auto wanted = [&](int p) { return sink_wants(jacobian, p); };
     LobeValues<F> lobes = eval_lobes<model>(g, s, view);
     F fh = lobes.fh, one_minus_fh = one_minus_schlick_weight(g);
-    // D, S, C per unit clearcoat, with their partials
-    DiffusePartials<F> diffuse = diffuse_partials(s.diffuse, g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
-    LogAlphaPartials<F> log_specular = s.specular.template log_value_partials<model>(g);
-    F log_specular_roughness = mul_add(log_specular.sum, d.roughness_sum, log_specular.difference * d.roughness_difference);
-    if constexpr (model == Model::kDisney2012)
-        log_specular_roughness = mul_add(s.specular.log_value_partial_alpha_g2(g), d.alpha_g2_roughness, log_specular_roughness);
-    F log_specular_anisotropic =
-            mul_add(log_specular.sum, d.anisotropic_sum, log_specular.difference * d.anisotropic_difference);
-    F clearcoat_unit_raw = s.clearcoat.unit_value(g, fh);
-    F clearcoat_gloss = weigh(F(4.0) * s.clearcoat.lobe_weight * clearcoat_unit_raw *
+    F zero(0.0);
+    // D, S, C per unit clearcoat, with their partials, where a wanted column reads them
+    F diffuse_roughness = zero, diffuse_subsurface = zero;
+    if (wanted(kRoughness) || wanted(kSubsurface)) {
+        DiffusePartials<F> diffuse = diffuse_partials(s.diffuse, g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
+        diffuse_roughness = weigh(diffuse.roughness);
+        diffuse_subsurface = weigh(diffuse.subsurface);
+    }
+    F specular_roughness = zero, specular_anisotropic = zero;
+    if (wanted(kRoughness) || wanted(kAnisotropic)) {
+        LogAlphaPartials<F> log_specular = s.specular.template log_value_partials<model>(g);
+        F log_specular_roughness = mul_add(log_specular.sum, d.roughness_sum, log_specular.difference * d.roughness_difference);
+        if constexpr (model == Model::kDisney2012)
+            log_specular_roughness = mul_add(s.specular.log_value_partial_alpha_g2(g), d.alpha_g2_roughness, log_specular_roughness);
+        F log_specular_anisotropic =
+                mul_add(log_specular.sum, d.anisotropic_sum, log_specular.difference * d.anisotropic_difference);
+        specular_roughness = weigh(lobes.specular * log_specular_roughness);
+        specular_anisotropic = weigh(lobes.specular * log_specular_anisotropic);
+    }
+    F clearcoat_unit = zero, clearcoat_gloss = zero;
+    if (wanted(kClearcoat) || wanted(kClearcoatGloss)) {
+        F clearcoat_unit_raw = s.clearcoat.unit_value(g, fh);
+        clearcoat_unit = weigh(clearcoat_unit_raw);
+        if (wanted(kClearcoatGloss))
+            clearcoat_gloss = weigh(F(4.0) * s.clearcoat.lobe_weight * clearcoat_unit_raw *
                                     s.clearcoat.gtr1.log_d_partial_alpha2(g) * d.clearcoat_alpha2_gloss);
+    }
     // the weighed scalars (fh and 1 - fh stay as they are inside specular_factor, a finite factor)
-    F specular_roughness = weigh(lobes.specular * log_specular_roughness);
-    F specular_anisotropic = weigh(lobes.specular * log_specular_anisotropic);
-    F clearcoat_unit = weigh(clearcoat_unit_raw);
-    F diffuse_value = weigh(lobes.diffuse), diffuse_roughness = weigh(diffuse.roughness);
-    F diffuse_subsurface = weigh(diffuse.subsurface), fh_weighed = weigh(fh);
+    F diffuse_value = weigh(lobes.diffuse), fh_weighed = weigh(fh);
     F specular_tinted = weigh(lobes.specular * one_minus_fh);  // T
 
     // base_color: ∂f_c/∂base_k = δ_ck (D (1 - metallic)/π + T metallic) + (FH sheen_tint_scale + T specular_tint_scale) ∂Ctint_c/∂base_k
@@ -149,22 +182,24 @@ PB_MODEL_INLINE Rgb<F> eval_gradient(const Geometry<F>& g, const Shading<F>& s, 
     for (int c = 0; c < 3; ++c) {
         F dc = channel_of(s.diffuse.color, c), f0 = channel_of(s.specular.f0, c);
         for (int k = 0; k < 3; ++k) {
+            if (!wanted(kBaseColorR + k)) continue;
             F tinted = through_tint * d.tint_base[c][k];
             jacobian(c, kBaseColorR + k, c == k ? own_channel + tinted : tinted);
         }
-        jacobian(c, kMetallic,
-                 mul_add(diffuse_value, channel_of(d.diffuse_metallic, c),
-                         mul_add(fh_weighed, channel_of(d.sheen_metallic, c), specular_tinted * channel_of(d.f0_metallic, c))));
-        jacobian(c, kSubsurface, diffuse_subsurface * dc);
-        jacobian(c, kSpecular, specular_tinted * channel_of(d.f0_specular, c));
-        jacobian(c, kSpecularTint, specular_tinted * channel_of(d.f0_specular_tint, c));
+        if (wanted(kMetallic))
+            jacobian(c, kMetallic,
+                     mul_add(diffuse_value, channel_of(d.diffuse_metallic, c),
+                             mul_add(fh_weighed, channel_of(d.sheen_metallic, c), specular_tinted * channel_of(d.f0_metallic, c))));
+        if (wanted(kSubsurface)) jacobian(c, kSubsurface, diffuse_subsurface * dc);
+        if (wanted(kSpecular)) jacobian(c, kSpecular, specular_tinted * channel_of(d.f0_specular, c));
+        if (wanted(kSpecularTint)) jacobian(c, kSpecularTint, specular_tinted * channel_of(d.f0_specular_tint, c));
         F specular_factor = mul_add(one_minus_fh, f0, fh);  // ∂f_c/∂S = (1 - FH) f0_c + FH
-        jacobian(c, kRoughness, mul_add(diffuse_roughness, dc, specular_roughness * specular_factor));
-        jacobian(c, kAnisotropic, specular_anisotropic * specular_factor);
-        jacobian(c, kSheen, fh_weighed * channel_of(d.sheen_sheen, c));
-        jacobian(c, kSheenTint, fh_weighed * channel_of(d.sheen_sheen_tint, c));
-        jacobian(c, kClearcoat, clearcoat_unit);
-        jacobian(c, kClearcoatGloss, clearcoat_gloss);
+        if (wanted(kRoughness)) jacobian(c, kRoughness, mul_add(diffuse_roughness, dc, specular_roughness * specular_factor));
+        if (wanted(kAnisotropic)) jacobian(c, kAnisotropic, specular_anisotropic * specular_factor);
+        if (wanted(kSheen)) jacobian(c, kSheen, fh_weighed * channel_of(d.sheen_sheen, c));
+        if (wanted(kSheenTint)) jacobian(c, kSheenTint, fh_weighed * channel_of(d.sheen_sheen_tint, c));
+        if (wanted(kClearcoat)) jacobian(c, kClearcoat, clearcoat_unit);
+        if (wanted(kClearcoatGloss)) jacobian(c, kClearcoatGloss, clearcoat_gloss);
     }
     return lobes.total(s);
 }
