@@ -126,8 +126,8 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, wrt: 
     return Gradient(value, np.ascontiguousarray(jacobian), _names(parameters, directions))
 
 
-def vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent: FloatArray, *, model: Model,
-        cosine: bool, threads: Any = None, isa: str | None = None) -> tuple[FloatArray, FloatArray]:
+def vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent: FloatArray, *,
+        model: Model = "disney2014", cosine: bool = False, threads: Any = None, isa: str | None = None) -> tuple[FloatArray, FloatArray]:
     """``Σ_c g_c ∂f_c/∂wi`` and ``∂f_c/∂wo`` per element (float32 kernels), each ``(..., 3)`` at the
     call's broadcast shape, for a finite float32 cotangent ``(..., 3)`` broadcasting with it."""
     require_direction_model(model)
