@@ -151,12 +151,12 @@ def reference_eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike
     require_direction_model(model)
     _refuse_energy_compensation(energy_compensation)
     soa = reference._layout(layout)
-    options = dict(model=model, cosine=cosine, layout=layout)
     if parameters:
-        first = reference.eval_grad(material, wi, wo, wrt=[GRADIENT_NAMES[k] for k in parameters], **options)
+        first = reference.eval_grad(material, wi, wo, wrt=[GRADIENT_NAMES[k] for k in parameters], model=model,
+                                    cosine=cosine, layout=layout)
         value, parts = first.value, [first.jacobian]
     else:
-        value, parts = reference.eval(material, wi, wo, **options), []
+        value, parts = reference.eval(material, wi, wo, model=model, cosine=cosine, layout=layout), []
     shape, wi_rows, wo_rows, params, model_id = reference._prepare(
         material, reference._as_aos("wi", wi, soa), reference._as_aos("wo", wo, soa), model)
     by_direction = _core.reference_eval_direction_grad(wi_rows, wo_rows, params, model_id, flag("cosine", cosine))
