@@ -316,6 +316,49 @@ std::int64_t batch_eval_vjp(const Float32Array& wi, int wi_layout, const Float32
     return eval(job, tables.segments, options.threads, options.isa);
 }
 
+// f (out) and its Jacobian in the six direction components wi_x ... wo_z:
+// (N, 3) and (N, 3, 6) arrays, or (3, N) and (3, 6, N) with out_layout rows.
+std::int64_t batch_eval_direction_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                                       const py::sequence& params, Float32Array out, Float32Array jacobian,
+                                       int out_layout, std::int64_t n, const EvalOptions options,
+                                       const py::object& segments) {
+    if (options.energy_compensation)
+        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
+    py::list keep_alive;
+    const SegmentTables tables = segments_from(segments, n);
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kDirectionGradient, options, keep_alive,
+                           tables);
+    job.out[0] = output_view(out, out_layout, n, "out");
+    const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
+    job.jacobian = derivative_output(jacobian, {3, kDirectionComponents}, rows, n, "jacobian",
+                                     "a writeable (N, 3, 6) array, or (3, 6, N) for the rows layout");
+    job.jacobian_row_stride = rows ? n : 0;
+    if (n == 0) return -1;
+    py::gil_scoped_release release;
+    return eval(job, tables.segments, options.threads, options.isa);
+}
+
+// Σ_c g_c ∂f_c/∂w per element for the cotangent g (as batch_eval_vjp's) and
+// the six direction components: into vjp, (N, 6), or (6, N) with out_layout rows.
+std::int64_t batch_eval_direction_vjp(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
+                                      const py::sequence& params, const Float32Array& cotangent, int cotangent_layout,
+                                      Float32Array vjp, int out_layout, std::int64_t n, const EvalOptions options,
+                                      const py::object& segments) {
+    if (options.energy_compensation)
+        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
+    py::list keep_alive;
+    const SegmentTables tables = segments_from(segments, n);
+    EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kDirectionVjp, options, keep_alive, tables);
+    job.cotangent = input_view(cotangent, cotangent_layout, n, "cotangent", tables, kSegmentThird);
+    const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
+    job.jacobian = derivative_output(vjp, {kDirectionComponents}, rows, n, "vjp",
+                                     "a writeable (N, 6) array, or (6, N) for the rows layout");
+    job.jacobian_row_stride = rows ? n : 0;
+    if (n == 0) return -1;
+    py::gil_scoped_release release;
+    return eval(job, tables.segments, options.threads, options.isa);
+}
+
 template <class T>
 T* scalar_output(py::array_t<T, py::array::c_style>& a, std::int64_t n, const char* name) {
     if (a.ndim() != 1 || a.shape(0) != n || !a.writeable())
@@ -508,6 +551,14 @@ void bind_batch(py::module_& m) {
           py::arg("wo_layout"), py::arg("params"), py::arg("cotangent"), py::arg("cotangent_layout"), py::arg("vjp"),
           py::arg("out_layout"), py::arg("n"), py::arg("options"), py::arg("columns") = py::none(),
           py::arg("segments") = py::none(), "SIMD vector-Jacobian product Σ_c g_c ∂f_c/∂p per element into a preallocated float32 output.");
+    m.def("batch_eval_direction_grad", &batch_eval_direction_grad, py::kw_only(), py::arg("wi"), py::arg("wi_layout"),
+          py::arg("wo"), py::arg("wo_layout"), py::arg("params"), py::arg("out"), py::arg("jacobian"),
+          py::arg("out_layout"), py::arg("n"), py::arg("options"), py::arg("segments") = py::none(),
+          "SIMD f and its Jacobian in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z into preallocated float32 outputs.");
+    m.def("batch_eval_direction_vjp", &batch_eval_direction_vjp, py::kw_only(), py::arg("wi"), py::arg("wi_layout"),
+          py::arg("wo"), py::arg("wo_layout"), py::arg("params"), py::arg("cotangent"), py::arg("cotangent_layout"),
+          py::arg("vjp"), py::arg("out_layout"), py::arg("n"), py::arg("options"), py::arg("segments") = py::none(),
+          "SIMD Σ_c g_c ∂f_c/∂w per element for the six direction components into a preallocated float32 output.");
     m.def("batch_pdf", &batch_pdf, py::kw_only(), py::arg("wi"), py::arg("wi_layout"), py::arg("wo"),
           py::arg("wo_layout"), py::arg("params"), py::arg("pdf"), py::arg("out") = py::none(),
           py::arg("out_layout") = 0, py::arg("n"), py::arg("options"), py::arg("segments") = py::none(),

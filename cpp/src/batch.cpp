@@ -101,18 +101,28 @@ void advance_input(Vec3Array& in, const Segments& segments, int input, std::int6
     if (in.data != nullptr) in.data += segment_offset(segments, input, s);
 }
 
+// Floats per element in the derivative output of an interleaved (element-major) job.
+std::int64_t jacobian_width(const EvalJob& job) {
+    switch (job.output) {
+        case Output::kVjp: return job.columns.count;
+        case Output::kDirectionGradient: return 3 * kDirectionComponents;
+        case Output::kDirectionVjp: return kDirectionComponents;
+        default: return 3 * job.columns.count;
+    }
+}
+
 EvalJob segment_job(const EvalJob& job, const Segments& segments, std::int64_t s) {
     EvalJob part = job;
     const std::int64_t first = s * segments.length;
     advance_input(part.wi, segments, kSegmentWi, s);
     advance_input(part.wo, segments, kSegmentWo, s);
-    if (job.output == Output::kVjp) advance_input(part.cotangent, segments, kSegmentThird, s);
+    if (job.output == Output::kVjp || job.output == Output::kDirectionVjp)
+        advance_input(part.cotangent, segments, kSegmentThird, s);
     advance_params(job, part, segments, s);
     for (MutableVec3Array& out : part.out) advance_output(out, first);
     if (part.pdf != nullptr) part.pdf += first;
     if (part.jacobian != nullptr) {
-        const std::int64_t width = job.output == Output::kVjp ? job.columns.count : 3 * job.columns.count;
-        part.jacobian += job.jacobian_row_stride > 0 ? first : width * first;
+        part.jacobian += job.jacobian_row_stride > 0 ? first : jacobian_width(job) * first;
     }
     return part;
 }

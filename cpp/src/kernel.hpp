@@ -47,6 +47,7 @@ constexpr std::int64_t kLanes = static_cast<std::int64_t>(Floats::size);
 #include "kernel_material.hpp"
 #include "kernel_memory.hpp"
 #include "kernel_sampling.hpp"
+#include "kernel_direction_gradient.hpp"
 #include "kernel_eval.hpp"
 #include "kernel_normal.hpp"
 #include "kernel_sample.hpp"

@@ -3,15 +3,20 @@
 #pragma once  // (per translation unit)
 
 // What a batch needs of its material: the lobes' constants and, for the
-// Jacobian, their partials (nothing otherwise).
+// Jacobian in the parameters, their partials, or for the derivatives in the
+// directions, the constants over dual numbers (nothing otherwise).
 struct NoPartials {};
 
-// The outputs that take derivatives: the Jacobian and the vector-Jacobian product.
+// The outputs that take derivatives in the parameters: the Jacobian and the vector-Jacobian product.
 constexpr bool differentiates(Output output) { return output == Output::kGradient || output == Output::kVjp; }
+// The outputs with a Jacobian or a product in `jacobian` (in the parameters or in the directions).
+constexpr bool has_jacobian(Output output) { return differentiates(output) || in_directions(output); }
+// The outputs that read a cotangent.
+constexpr bool is_vjp(Output output) { return output == Output::kVjp || output == Output::kDirectionVjp; }
 
 template <Output output>
 struct Prepared {
-    Shading<Floats> shading;
+    std::conditional_t<in_directions(output), DirectionShading, Shading<Floats>> shading;
     std::conditional_t<differentiates(output), MaterialPartials<Floats>, NoPartials> partials;
 };
 
@@ -20,8 +25,26 @@ PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
     // built in place: assigning into a default-constructed one would copy the whole Shading per batch
     if constexpr (differentiates(output)) {
         return {shading_of(m), material_partials_of(m.slot)};
+    } else if constexpr (in_directions(output)) {
+        return {direction_shading_of(m.slot), NoPartials{}};
     } else {
         return {shading_of(m), NoPartials{}};
+    }
+}
+
+// The f values an element of `output` writes to job.out (0 to kLobeCount).
+constexpr int value_outputs(Output output) {
+    return output == Output::kLobes ? kLobeCount : output == Output::kPdf || is_vjp(output) ? 0 : 1;
+}
+
+// The floats an element of `job`'s output writes to job.jacobian.
+inline int jacobian_width(const EvalJob& job) {
+    switch (job.output) {
+        case Output::kGradient: return 3 * job.columns.count;
+        case Output::kVjp: return job.columns.count;
+        case Output::kDirectionGradient: return kDirectionJacobianWidth;
+        case Output::kDirectionVjp: return kDirectionSlots;
+        default: return 0;
     }
 }
 
@@ -47,12 +70,6 @@ PB_KERNEL_INLINE PreparedOf<output, compensated> prepare_for(const RawMaterial& 
 }
 
 // `width` rows of kLanes values as kLanes elements of `width` values each,
-// element-major (the selections of fewer columns than the table's).
-PB_KERNEL_INLINE void store_lanes_by_element(const float (*rows)[kLanes], int width, float* out) {
-    for (std::int64_t lane = 0; lane < kLanes; ++lane)
-        for (int r = 0; r < width; ++r) out[width * lane + r] = rows[r][lane];
-}
-
 // Where a batch's Jacobian goes (eval_gradient's sink), row r = P c + k
 // holding ∂f_c/∂p of every lane for the k-th of the P wanted slots: straight
 // to memory by rows (the (3, P, N) layout), or through the stack, transposed
@@ -136,7 +153,7 @@ template <Model model, Output output, Layouts layouts, LobeSet lobes = LobeSet::
 PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi,
                                              const Vec3<Floats>& wo, const Shading<Floats>& s,
                                              const MultipleScatteringLobe<Floats>& ms) {
-    static_assert(!differentiates(output), "the energy compensation has no derivatives");
+    static_assert(!has_jacobian(output), "the energy compensation has no derivatives");
     Geometry<Floats> g = geometry_of(wi, wo);
     Mask above = above_surface(g);
     View<Floats> view = view_of<model, lobes>(wo, s);
@@ -164,8 +181,8 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
 }
 
 template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes = LobeSet::kAll>
-PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
-                                 const PreparedOf<output, compensated>& material) {
+PB_KERNEL_INLINE void eval_values_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
+                                        const PreparedOf<output, compensated>& material) {
     if constexpr (compensated) {
         eval_compensated_batch<model, output, layouts, lobes>(job, i, wi, wo, material.shading, material.ms);
         return;
@@ -211,6 +228,17 @@ PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<
         } else {
             store_rgb<layouts, true>(job.out[0], i, masked(values.template total<lobes>(s)));
         }
+    }
+}
+
+// One batch at i of any output.
+template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes = LobeSet::kAll>
+PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
+                                 const PreparedOf<output, compensated>& material) {
+    if constexpr (in_directions(output)) {
+        eval_direction_batch<model, output, layouts>(job, i, wi, wo, material.shading);
+    } else {
+        eval_values_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, material);
     }
 }
 
@@ -310,13 +338,14 @@ template <Model model, Output output, bool per_element, bool compensated, LobeSe
 bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, compensated>& uniform) {
     alignas(64) PadBuffer wi, wo, cotangent, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
-    alignas(64) float jacobian[differentiates(output) ? kJacobianWidth * kLanes : 1];
+    alignas(64) float jacobian[has_jacobian(output) ? kJacobianWidth * kLanes : 1];
+    static_assert(kJacobianWidth >= kDirectionJacobianWidth, "the directions' Jacobian fits the buffer");
     EvalJob padded = job;
     padded.wi = pad_vec3(job.wi, pad, wi);
     padded.wo = pad_vec3(job.wo, pad, wo);
-    if constexpr (output == Output::kVjp) padded.cotangent = pad_vec3(job.cotangent, pad, cotangent);
+    if constexpr (is_vjp(output)) padded.cotangent = pad_vec3(job.cotangent, pad, cotangent);
     pad_params(job.params, padded.params, pad, params);
-    const int outputs = output == Output::kLobes ? kLobeCount : output == Output::kPdf || output == Output::kVjp ? 0 : 1;
+    constexpr int outputs = value_outputs(output);
     for (int k = 0; k < outputs; ++k) padded.out[k] = MutableVec3Array{out[k], Vec3Layout::kInterleaved, 0};
     padded.pdf = pdf;
     padded.jacobian = jacobian;
@@ -326,8 +355,8 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, 
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf || output == Output::kValuePdf) unpad_scalars(job.pdf, pad, pdf);
-    if constexpr (differentiates(output)) {
-        const int width = output == Output::kVjp ? job.columns.count : 3 * job.columns.count;  // values an element
+    if constexpr (has_jacobian(output)) {
+        const int width = jacobian_width(job);  // values an element
         for (std::int64_t j = 0; j < pad.count; ++j)
             for (int r = 0; r < width; ++r) {
                 const std::int64_t e = pad.begin + j;
@@ -349,7 +378,7 @@ std::int64_t eval_batches(const EvalJob& job, std::int64_t begin, std::int64_t e
         if constexpr (compensated) row.template use_for<model>(uniform.ms);
     }
     std::int64_t i = begin;
-    if constexpr (!per_element) {
+    if constexpr (!per_element && !in_directions(output)) {  // (the directions' batches are long enough alone)
         for (; i + 2 * kLanes <= end; i += 2 * kLanes) {
             const std::int64_t stopped = eval_two_batches<model, output, layouts, compensated, lobes>(job, i, uniform);
             if (stopped >= 0) return stopped;
@@ -393,12 +422,12 @@ std::int64_t eval_loop(const EvalJob& job, std::int64_t begin, std::int64_t end)
 }
 
 inline Layouts layouts_of(const EvalJob& job) {
-    const int outputs = job.output == Output::kLobes ? kLobeCount : job.output == Output::kPdf || job.output == Output::kVjp ? 0 : 1;
+    int outputs = value_outputs(job.output);
     for (Vec3Layout layout : {Vec3Layout::kInterleaved, Vec3Layout::kRows}) {
         bool all = job.wi.layout == layout && job.wo.layout == layout;
         for (int k = 0; k < outputs; ++k) all = all && job.out[k].layout == layout;
-        if (job.output == Output::kVjp) all = all && job.cotangent.layout == layout;
-        if (differentiates(job.output)) all = all && (job.jacobian_row_stride > 0) == (layout == Vec3Layout::kRows);
+        if (is_vjp(job.output)) all = all && job.cotangent.layout == layout;
+        if (has_jacobian(job.output)) all = all && (job.jacobian_row_stride > 0) == (layout == Vec3Layout::kRows);
         if (all) return layout == Vec3Layout::kInterleaved ? Layouts::kInterleaved : Layouts::kRows;
     }
     return Layouts::kMixed;
@@ -417,6 +446,9 @@ std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t
         return layouts_of(job) == Layouts::kInterleaved
                        ? eval_checked<model, output, per_element, Layouts::kInterleaved, true, lobes>(job, begin, end)
                        : eval_checked<model, output, per_element, Layouts::kMixed, true, lobes>(job, begin, end);
+    }
+    if constexpr (in_directions(output)) {  // one loop for every layout: the loads are a small part of a batch
+        return eval_checked<model, output, per_element, Layouts::kMixed, false, lobes>(job, begin, end);
     }
     switch (layouts_of(job)) {
         case Layouts::kInterleaved:
@@ -451,7 +483,7 @@ std::int64_t eval_compensated_range(const EvalJob& job, std::int64_t begin, std:
 }
 
 inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    if (job.energy_compensation && !differentiates(job.output)) {
+    if (job.energy_compensation && !has_jacobian(job.output)) {
         switch (job.output) {
             case Output::kPdf: return eval_compensated_range<Output::kPdf>(job, begin, end);
             case Output::kValuePdf: return eval_compensated_range<Output::kValuePdf>(job, begin, end);
@@ -471,6 +503,12 @@ inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int6
         case Output::kVjp:
             return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kVjp>(job, begin, end)
                                                    : eval_range_for<Model::kDisney2014, Output::kVjp>(job, begin, end);
+        case Output::kDirectionGradient:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kDirectionGradient>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kDirectionGradient>(job, begin, end);
+        case Output::kDirectionVjp:
+            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kDirectionVjp>(job, begin, end)
+                                                   : eval_range_for<Model::kDisney2014, Output::kDirectionVjp>(job, begin, end);
         case Output::kLobes:
             return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kLobes>(job, begin, end)
                                                    : eval_range_for<Model::kDisney2014, Output::kLobes>(job, begin, end);

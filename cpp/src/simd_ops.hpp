@@ -374,6 +374,13 @@ PB_KERNEL_INLINE void store_rows_by_element(const float (*rows)[kLanes], float* 
 
 constexpr int padded_rows(int width) { return (width + kTransposeBlock - 1) / kTransposeBlock * kTransposeBlock; }
 
+// `width` rows of kLanes values as kLanes elements of `width` values each,
+// element-major (for widths the transposes above are not compiled for).
+PB_KERNEL_INLINE void store_lanes_by_element(const float (*rows)[kLanes], int width, float* out) {
+    for (std::int64_t lane = 0; lane < kLanes; ++lane)
+        for (int r = 0; r < width; ++r) out[width * lane + r] = rows[r][lane];
+}
+
 // ---------------------------------------------------------------- what the model calls
 // (docs/model.md: the same names for double are in model/scalar_ops.hpp)
 

@@ -8,6 +8,7 @@ from . import (environment, frames, measured, microfacet, piecewise, plot, prese
 from .fit import FitResult, fit
 from ._batch import Lobes, Sample, ValuePdf, cpu_info, eval, eval_grad, eval_lobes, eval_vjp, eval_pdf, pdf, random_uniforms, sample
 from ._gradient import GRADIENT_NAMES, Gradient
+from ._direction_grad import DIRECTION_NAMES
 from .albedo import Albedo, albedo
 from .material import PARAMETERS, BrightColorWarning, Material, gamma22_to_linear, linear_to_srgb, srgb_to_linear
 
@@ -15,7 +16,7 @@ __all__ = [
     "Material", "PARAMETERS", "BrightColorWarning", "srgb_to_linear", "linear_to_srgb", "gamma22_to_linear",
     "eval", "eval_lobes", "eval_pdf", "pdf", "sample", "random_uniforms", "cpu_info",
     "Lobes", "Sample", "ValuePdf", "Albedo", "albedo",
-    "eval_grad", "eval_vjp", "Gradient", "GRADIENT_NAMES", "fit", "FitResult",
+    "eval_grad", "eval_vjp", "Gradient", "GRADIENT_NAMES", "DIRECTION_NAMES", "fit", "FitResult",
     "reference", "microfacet", "measured", "synthetic", "frames", "presets", "render", "plot",
     "environment", "procedural_environments", "piecewise",
 ]

@@ -36,7 +36,7 @@ from ._validate import (
     seed_value,
     unit_length,
 )
-from . import _gradient
+from . import _direction_grad, _gradient
 from ._segments import choose_split, compact, leading_of, part, unexpanded
 from ._gradient import GRADIENT_NAMES, Gradient
 from .material import PARAMETERS, Material
@@ -369,15 +369,16 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
               threads: SupportsIndex | None, check: bool, isa: str | None,
               outputs_for_shape: Callable[[tuple[int, ...], str], list[Float32Array]], pdf_sampler: int | None = None,
               gradient: bool = False, energy_compensation: bool = False, columns: list[int] | None = None,
-              cotangent: Float32Array | None = None) -> list[Float32Array]:
+              cotangent: Float32Array | None = None, directions: bool = False) -> list[Float32Array]:
     """eval / eval_lobes / pdf / eval_grad / eval_vjp: validated arguments in, outputs written.
     ``columns``: the slots a derivative is taken by (None: all). ``cotangent``
     (float32, f's layout, broadcasting to the call's shape): the output is
-    the vector-Jacobian product."""
+    the vector-Jacobian product. ``directions``: the derivatives in the six
+    direction components instead of the slots."""
     vjp = cotangent is not None
     _require_material(material)
     energy_compensation = flag("energy_compensation", energy_compensation)
-    if (gradient or vjp) and energy_compensation:
+    if (gradient or vjp or directions) and energy_compensation:
         raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
                                   "multiple-scattering lobe is not implemented); evaluate f with pb.eval")
     layout = _layout(layout)
@@ -416,6 +417,19 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
         bad = _core.batch_pdf(wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
                               pdf=outputs[0].reshape(n), out=f, out_layout=out_layout, n=n, options=options,
                               segments=segments)
+    elif directions and vjp:
+        (product,) = outputs
+        bad = _core.batch_eval_direction_vjp(
+            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+            cotangent=cotangent_flat, cotangent_layout=cotangent_code,
+            vjp=product.reshape((n, 6) if layout == "aos" else (6, n)), out_layout=out_layout, n=n,
+            options=options, segments=segments)
+    elif directions:
+        value, jacobian = outputs
+        bad = _core.batch_eval_direction_grad(
+            wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
+            out=_flat_vec3(value, layout)[0], jacobian=jacobian.reshape((n, 3, 6) if layout == "aos" else (3, 6, n)),
+            out_layout=out_layout, n=n, options=options, segments=segments)
     elif gradient:
         width = len(GRADIENT_NAMES) if columns is None else len(columns)
         value, jacobian = outputs
@@ -517,8 +531,15 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     parameter still gets a per-element derivative. ``out=(value, jacobian)``
     writes into preallocated float32 arrays of exactly those shapes. The other
     arguments are :func:`eval`'s; ``energy_compensation=True`` raises
-    NotImplementedError.
+    NotImplementedError. ``wrt`` may also name ``"wi"`` and ``"wo"``: three
+    columns each (``wi_x, wi_y, wi_z``, ``wo_x, wo_y, wo_z``) after the
+    parameters', the derivatives of f in the 3-vectors as given
+    (docs/gradients.md, "Derivatives in the directions").
     """
+    if _direction_grad.asks_for_directions(wrt):
+        return _direction_grad.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
+                                         threads=threads, out=out, check=check, isa=isa,
+                                         energy_compensation=energy_compensation)
     wanted = _gradient.columns(wrt)
     full = len(wanted) == len(GRADIENT_NAMES)
     _require_pair(out, "jacobian")

@@ -58,6 +58,11 @@ def reference_eval_grad(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Float64 reference f (N,3) and its Jacobian (N,3,13) over the parameter slots, for packed validated rows."""
 
+def reference_eval_direction_grad(
+    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, cosine: bool = False
+) -> NDArray[np.float64]:
+    """Float64 reference derivatives (N,3,6) of f (times cos θl if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z."""
+
 def reference_sample(
     wo: _Float64In, u: _Float64In, params: _Float64In, model: _Int, sampler: _Int, energy_compensation: bool = False
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32]]:
@@ -188,6 +193,39 @@ def batch_eval_vjp(
     segments: _Segments | None = None,
 ) -> int:
     """SIMD vector-Jacobian product Σ_c g_c ∂f_c/∂p per element into a preallocated float32 output."""
+
+def batch_eval_direction_grad(
+    *,
+    wi: _Float32In,
+    wi_layout: _Int,
+    wo: _Float32In,
+    wo_layout: _Int,
+    params: _Params,
+    out: _Float32Out,
+    jacobian: _Float32Out,
+    out_layout: _Int,
+    n: _Int,
+    options: EvalOptions,
+    segments: _Segments | None = None,
+) -> int:
+    """SIMD f and its Jacobian in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z into preallocated float32 outputs."""
+
+def batch_eval_direction_vjp(
+    *,
+    wi: _Float32In,
+    wi_layout: _Int,
+    wo: _Float32In,
+    wo_layout: _Int,
+    params: _Params,
+    cotangent: _Float32In,
+    cotangent_layout: _Int,
+    vjp: _Float32Out,
+    out_layout: _Int,
+    n: _Int,
+    options: EvalOptions,
+    segments: _Segments | None = None,
+) -> int:
+    """SIMD Σ_c g_c ∂f_c/∂w per element for the six direction components into a preallocated float32 output."""
 
 def normal_equations(
     *,

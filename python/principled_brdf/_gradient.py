@@ -34,7 +34,7 @@ class Gradient(NamedTuple):
 
     value: FloatArray  # (..., 3) as eval returns it
     jacobian: FloatArray  # (..., 3, P)
-    names: tuple[str, ...]  # the P parameters, in the table's order
+    names: tuple[str, ...]  # the P parameters in the table's order, then any direction components
 
 
 def columns(wrt: object, argument: str = "wrt") -> list[int]:

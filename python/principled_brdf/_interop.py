@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _batch, reference
+from . import _batch, _direction_grad, reference
 from .material import PARAMETERS, Material
 
 if TYPE_CHECKING:
@@ -95,24 +95,25 @@ def vjp(names: list[str], values: list[np.ndarray], wi: np.ndarray, wo: np.ndarr
         shape = values[index].shape if shapes is None else shapes[index]
         result[index] = sum_to_shape(np.asarray(part), shape).astype(values[index].dtype, copy=False)
     return result
+
+
+def direction_vjp(names: list[str], values: list[np.ndarray], wi: np.ndarray, wo: np.ndarray, cotangent: np.ndarray,
+                  double: bool, options: Mapping[str, Any],
+                  shapes: tuple[tuple[int, ...], tuple[int, ...]] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``Σ_c cotangent_c ∂f_c/∂wi`` and ``∂f_c/∂wo``, the derivatives of f in the 3-vectors as given
+    (docs/gradients.md, "Derivatives in the directions"), each summed to that direction's shape
+    (or to ``shapes``)."""
     material = material_of(names, values)
+    # a cotangent with axes the inputs lack (vmap over it): the directions broadcast to them
+    full = np.broadcast_shapes(wi.shape, wo.shape, cotangent.shape)
+    wi_call, wo_call = np.broadcast_to(wi, full), np.broadcast_to(wo, full)
     if double:
-        gradient = reference.eval_grad(material, wi, wo, wrt=asked, **options)
+        gradient = reference.eval_grad(material, wi_call, wo_call, wrt=["wi", "wo"], **options)
+        products = np.einsum("...c,...ck->...k", cotangent.astype(np.float64, copy=False), gradient.jacobian)
+        by_wi, by_wo = products[..., :3], products[..., 3:]
     else:
-        gradient = _batch.eval_grad(material, np.asarray(wi, np.float32), np.asarray(wo, np.float32), wrt=asked,
-                                    **options)
-    # (..., 3, P) contracted with the cotangent over the colour axis
-    per_element = np.einsum("...c,...ck->...k", cotangent.astype(gradient.jacobian.dtype, copy=False),
-                            gradient.jacobian)
-    column = 0
-    for index, (name, want) in enumerate(zip(names, wanted)):
-        if not want:
-            continue
-        slots = PARAMETERS[name].slots
-        part = per_element[..., column:column + slots]
-        column += slots
-        if slots == 1:
-            part = part[..., 0]
-        shape = values[index].shape if shapes is None else shapes[index]
-        result[index] = sum_to_shape(part, shape).astype(values[index].dtype, copy=False)
-    return result
+        by_wi, by_wo = _direction_grad.vjp(material, np.asarray(wi_call, np.float32), np.asarray(wo_call, np.float32),
+                                           np.asarray(cotangent, np.float32), **options)
+    wi_shape, wo_shape = (wi.shape, wo.shape) if shapes is None else shapes
+    return (sum_to_shape(np.broadcast_to(by_wi, np.broadcast_shapes(by_wi.shape, wi_shape)), wi_shape).astype(wi.dtype, copy=False),
+            sum_to_shape(np.broadcast_to(by_wo, np.broadcast_shapes(by_wo.shape, wo_shape)), wo_shape).astype(wo.dtype, copy=False))

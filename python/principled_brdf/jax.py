@@ -2,7 +2,8 @@
 
 ``eval`` is a ``jax.custom_vjp`` function over host callbacks
 (``jax.pure_callback``): it runs under ``jit`` and ``vmap``, and its backward
-pass is the library's vector-Jacobian product. float32 inputs go through the
+pass is the library's vector-Jacobian product, in the parameters and in
+``wi`` and ``wo``. float32 inputs go through the
 SIMD kernels; float64 inputs (with ``jax_enable_x64``) through the float64
 reference.
 
@@ -25,7 +26,7 @@ try:
 except ImportError as error:  # pragma: no cover - the test extra installs jax
     raise ImportError("principled_brdf.jax needs JAX: pip install 'principled-brdf[jax]'") from error
 
-from . import _interop
+from . import _direction_grad, _interop
 
 if TYPE_CHECKING:
     from collections.abc import Mapping
@@ -61,7 +62,10 @@ def _operation(names: tuple[str, ...], options: tuple[tuple[str, Any], ...]) -> 
         shapes = [mapped + v.shape[len(mapped):] for v in arrays]
         gradients = _interop.vjp(names_list, arrays, np.asarray(wi), np.asarray(wo), np.asarray(cotangent),
                                  [True] * len(arrays), double, keywords, shapes)
-        return tuple(np.asarray(g, dtype=v.dtype) for g, v in zip(gradients, arrays))
+        by_wi, by_wo = _interop.direction_vjp(names_list, arrays, np.asarray(wi), np.asarray(wo), np.asarray(cotangent),
+                                              double, keywords, (mapped + wi.shape[k:], mapped + wo.shape[k:]))
+        return (np.asarray(by_wi, wi.dtype), np.asarray(by_wo, wo.dtype),
+                *(np.asarray(g, dtype=v.dtype) for g, v in zip(gradients, arrays)))
 
     def value_shape(wi: jax.Array, wo: jax.Array, values: tuple[jax.Array, ...]) -> jax.ShapeDtypeStruct:
         leading = jnp.broadcast_shapes(wi.shape[:-1], wo.shape[:-1],
@@ -77,11 +81,10 @@ def _operation(names: tuple[str, ...], options: tuple[tuple[str, Any], ...]) -> 
 
     def backward(residuals: tuple[jax.Array, ...], cotangent: jax.Array) -> tuple[Any, ...]:
         wi, wo, *values = residuals
-        shapes = tuple(jax.ShapeDtypeStruct(v.shape, v.dtype) for v in values)  # type: ignore[no-untyped-call]
-        gradients = jax.pure_callback(functools.partial(host_vjp, cotangent.ndim - 1), shapes, wi, wo, cotangent, *values,
-                                      vmap_method="expand_dims")
-        # the directions' derivatives are not available yet: NaN says so rather than a silent 0
-        return (jnp.full_like(wi, jnp.nan), jnp.full_like(wo, jnp.nan), *gradients)
+        shapes = tuple(jax.ShapeDtypeStruct(v.shape, v.dtype) for v in (wi, wo, *values))  # type: ignore[no-untyped-call]
+        # the directions' derivatives in the 3-vectors as given (docs/gradients.md)
+        return tuple(jax.pure_callback(functools.partial(host_vjp, cotangent.ndim - 1), shapes, wi, wo, cotangent,
+                                       *values, vmap_method="expand_dims"))
 
     operation.defvjp(forward, backward)
     return operation
@@ -100,6 +103,7 @@ def eval(material: Mapping[str, Any], wi: Any, wo: Any, **options: Any) -> jax.A
         raise TypeError(f"material: expected a mapping of parameter names to arrays, got {type(material).__name__}")
     names = _interop.parameter_names(material)
     options = _interop.check_options(options)
+    _direction_grad.require_direction_model(options.get("model", "disney2014"))
     wi, wo = jnp.asarray(wi), jnp.asarray(wo)
     dtype = jnp.float64 if wi.dtype == jnp.float64 else jnp.float32
     wi, wo = wi.astype(dtype), wo.astype(dtype)

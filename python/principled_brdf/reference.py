@@ -7,7 +7,7 @@ import typing
 import numpy as np
 
 from . import _core
-from . import _gradient
+from . import _direction_grad, _gradient
 from . import _validate
 from ._gradient import Gradient
 from ._batch import Lobes, Sample
@@ -89,7 +89,12 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     ``jacobian[..., c, k] = ∂f_c/∂names[k]``, ``names`` the P parameters ``wrt``
     selects (default all 13, ``base_color`` as three channels). A uniform
     parameter still gets a per-element derivative. ``layout="soa"``: ``(3, ...)``
-    and ``(3, P, ...)``. ``energy_compensation=True`` raises NotImplementedError."""
+    and ``(3, P, ...)``. ``energy_compensation=True`` raises NotImplementedError.
+    ``wrt`` may also name ``"wi"`` and ``"wo"`` (three columns each, after the
+    parameters'; docs/gradients.md, "Derivatives in the directions")."""
+    if _direction_grad.asks_for_directions(wrt):
+        return _direction_grad.reference_eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
+                                                   energy_compensation=energy_compensation)
     if _validate.flag("energy_compensation", energy_compensation):
         raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
                                   "multiple-scattering lobe is not implemented)")

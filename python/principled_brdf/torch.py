@@ -1,7 +1,7 @@
 """The kernels as PyTorch operations on CPU tensors (docs/interop.md).
 
-``eval`` is differentiable in the material's parameters: its backward pass is
-the library's vector-Jacobian product (float32 kernels for float32 inputs, the
+``eval`` is differentiable in the material's parameters and in ``wi`` and
+``wo``: its backward pass is the library's vector-Jacobian product (float32 kernels for float32 inputs, the
 float64 reference when any input is float64). ``pdf`` and ``sample`` take and
 return tensors without gradients.
 
@@ -23,7 +23,7 @@ try:
 except ImportError as error:  # pragma: no cover - the test extra installs torch
     raise ImportError("principled_brdf.torch needs PyTorch: pip install 'principled-brdf[torch]'") from error
 
-from . import _batch, _interop, reference
+from . import _batch, _direction_grad, _interop, reference
 from .material import Material
 
 if TYPE_CHECKING:
@@ -70,10 +70,15 @@ class _Eval(torch.autograd.Function):
         wi, wo, *values = ctx.saved_tensors
         arrays = [_numpy(name, v) for name, v in zip(ctx.names, values)]
         wanted = list(ctx.needs_input_grad[5:])
-        gradients = _interop.vjp(ctx.names, arrays, _numpy("wi", wi), _numpy("wo", wo),
-                                 _numpy("grad_output", grad_output), wanted, ctx.double, ctx.options)
+        wi_array, wo_array, g = _numpy("wi", wi), _numpy("wo", wo), _numpy("grad_output", grad_output)
+        gradients = _interop.vjp(ctx.names, arrays, wi_array, wo_array, g, wanted, ctx.double, ctx.options)
         as_tensors = [None if g is None else torch.from_numpy(np.ascontiguousarray(g)) for g in gradients]
-        return (None, None, None, None, None, *as_tensors)
+        by_wi = by_wo = None
+        if ctx.needs_input_grad[3] or ctx.needs_input_grad[4]:
+            by_wi, by_wo = (torch.from_numpy(np.ascontiguousarray(d)) for d in
+                            _interop.direction_vjp(ctx.names, arrays, wi_array, wo_array, g, ctx.double, ctx.options))
+        return (None, None, None, by_wi if ctx.needs_input_grad[3] else None,
+                by_wo if ctx.needs_input_grad[4] else None, *as_tensors)
 
 
 def _material_items(material: Mapping[str, Any] | Material) -> tuple[list[str], list[Any]]:
@@ -95,15 +100,14 @@ def eval(material: Mapping[str, Any] | Material, wi: torch.Tensor, wo: torch.Ten
     directions broadcast as in :func:`principled_brdf.eval`. ``options``:
     ``model``, ``cosine``. Float64 inputs are evaluated by the float64
     reference, float32 ones by the SIMD kernels (the result has that dtype).
-    Gradients flow to every parameter tensor that requires them; a gradient of
-    ``wi`` or ``wo`` raises (not yet available).
+    Gradients flow to every parameter tensor and direction that requires them;
+    a direction's is the derivative of f in the 3-vector as given (project it
+    onto the tangent plane of the unit sphere yourself; docs/gradients.md).
     """
     names, values = _material_items(material)
     options = _interop.check_options(options)
-    for name, direction in (("wi", wi), ("wo", wo)):
-        if isinstance(direction, torch.Tensor) and direction.requires_grad:
-            raise NotImplementedError(f"{name}: gradients with respect to the directions are not available yet; "
-                                      f"pass {name}.detach()")
+    if any(isinstance(d, torch.Tensor) and d.requires_grad for d in (wi, wo)):
+        _direction_grad.require_direction_model(options.get("model", "disney2014"))
     double = _is_double(wi, wo, *values)
     dtype = torch.float64 if double else torch.float32
     wi, wo, *values = (_tensor(name, v, dtype) for name, v in zip(["wi", "wo", *names], [wi, wo, *values]))

@@ -78,10 +78,30 @@ def test_the_gradient_is_eval_grads_contraction():
                                    err_msg=name)
 
 
-def test_the_directions_derivative_is_not_a_silent_zero():
-    wi = np.float32([0.0, 0.6, 0.8])
-    g = jax.grad(lambda w: jnp.sum(pbj.eval({}, w, wi)))(wi)
-    assert np.isnan(g).all()
+def test_check_grads_of_the_directions_on_the_float64_path():
+    """The derivatives in wi and wo, the 3-vectors moved as given (within the length check's tolerance)."""
+    wi, wo, material = split(interior_inputs(seeded_rng("jax check_grads directions"), 10))
+    with enable_x64(True):
+        check_grads(lambda a, b: pbj.eval(material, a, b, cosine=True), (jnp.asarray(wi), jnp.asarray(wo)), order=1,
+                    modes=["rev"], eps=1e-6)
+        check_grads(lambda b: pbj.eval(material, wi, b), (jnp.asarray(wo[0]),), order=1, modes=["rev"], eps=1e-6)
+
+
+def test_the_directions_gradients_are_eval_grads_contraction_under_jit_and_vmap():
+    rng = seeded_rng("jax direction contraction")
+    wi, wo, material = split(interior_inputs(rng, 64))
+    wi, wo = wi.astype(np.float32), wo.astype(np.float32)
+    material = {n: v.astype(np.float32) for n, v in material.items()}
+    cotangent = rng.normal(size=(64, 3)).astype(np.float32)
+    _, vjp = jax.vjp(lambda a, b: pbj.eval(material, a, b), wi, wo)
+    by_wi, by_wo = vjp(jnp.asarray(cotangent))
+    g = pb.eval_grad(pb.Material(**material), wi, wo, wrt=["wi", "wo"])
+    expected = np.einsum("nc,nck->nk", cotangent, g.jacobian)
+    scale = np.abs(expected).max()
+    np.testing.assert_allclose(np.concatenate([by_wi, by_wo], -1), expected, rtol=1e-5, atol=1e-6 * scale)
+    loss = jax.jit(jax.vmap(jax.grad(lambda a, b: jnp.sum(pbj.eval(material, a, b))), in_axes=(0, None)))
+    rows = loss(jnp.stack([wi, wi[::-1]]), wo)
+    np.testing.assert_array_equal(rows[0], jax.grad(lambda a: jnp.sum(pbj.eval(material, a, wo)))(wi))
 
 
 def test_bad_calls_are_named():

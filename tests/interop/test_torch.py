@@ -37,6 +37,39 @@ def test_gradcheck_on_the_float64_path():
     assert torch.autograd.gradcheck(f, tuple(t[n] for n in names), eps=1e-6, atol=1e-7, rtol=1e-5)
 
 
+def test_gradcheck_of_the_directions_on_the_float64_path():
+    """The derivatives in wi and wo, the 3-vectors moved as given (within the length check's tolerance)."""
+    t = tensors(interior_inputs(seeded_rng("torch gradcheck directions"), 12), torch.float64, grad=("roughness",))
+    wi, wo = (t[n].detach().requires_grad_() for n in ("wi", "wo"))
+
+    def f(wi, wo, roughness):
+        return pbt.eval(material_of(t) | {"roughness": roughness}, wi, wo, cosine=True)
+
+    assert torch.autograd.gradcheck(f, (wi, wo, t["roughness"]), eps=1e-6, atol=1e-7, rtol=1e-5)
+    one_wo = wo[0].detach().clone().requires_grad_()  # one vector for every element: its gradient summed
+    assert torch.autograd.gradcheck(lambda w: pbt.eval(material_of(t), wi.detach(), w), (one_wo,), eps=1e-6,
+                                    atol=1e-7, rtol=1e-5)
+
+
+@pytest.mark.parametrize("model", ["disney2014", "disney2012"])
+def test_the_directions_gradients_are_eval_grads_contraction_and_float32_agrees(model):
+    rng = seeded_rng("torch direction contraction", model)
+    inputs = interior_inputs(rng, 257)
+    cotangent = rng.normal(size=(257, 3))
+    gradients = {}
+    for dtype in (torch.float32, torch.float64):
+        t = tensors(inputs, dtype, grad=("wi", "wo"))
+        pbt.eval(material_of(t), t["wi"], t["wo"], model=model).backward(torch.from_numpy(cotangent).to(dtype))
+        gradients[dtype] = np.concatenate([t["wi"].grad.numpy(), t["wo"].grad.numpy()], axis=-1)
+    material = pb.Material(**{n: v.astype(np.float32) for n, v in inputs.items() if n not in ("wi", "wo")})
+    g = pb.eval_grad(material, inputs["wi"].astype(np.float32), inputs["wo"].astype(np.float32), wrt=["wi", "wo"],
+                     model=model)
+    expected = np.einsum("nc,nck->nk", cotangent.astype(np.float32), g.jacobian)
+    np.testing.assert_allclose(gradients[torch.float32], expected, rtol=1e-5, atol=1e-5 * np.abs(expected).max())
+    scale = np.abs(gradients[torch.float64]).max()
+    np.testing.assert_allclose(gradients[torch.float32], gradients[torch.float64], rtol=1e-3, atol=1e-4 * scale)
+
+
 @pytest.mark.parametrize("model", ["disney2014", "disney2012"])
 def test_the_gradient_is_eval_grads_contraction(model):
     rng = seeded_rng("torch contraction", model)
@@ -121,8 +154,6 @@ def test_bad_calls_are_named():
         pbt.eval({}, wi, wi, threads=2)
     with pytest.raises(TypeError, match="roughness: expected a real floating-point tensor"):
         pbt.eval({"roughness": torch.tensor(1)}, wi, wi)
-    with pytest.raises(NotImplementedError, match="wi: gradients with respect to the directions"):
-        pbt.eval({}, wi.clone().requires_grad_(), wi)
     with pytest.raises(ValueError, match="roughness"):  # the library's domain check
         pbt.eval({"roughness": torch.tensor(-1.0)}, wi, wi)
     with pytest.raises(TypeError, match="material: expected a principled_brdf.Material or a mapping"):

@@ -51,7 +51,15 @@ enum class Output : int {
     kGradient = 3,  // f and its Jacobian in the parameter slots
     kValuePdf = 4,  // f and the sampling pdf of (wi, wo), in one pass
     kVjp = 5,       // Σ_c g_c ∂f_c/∂p per element for a cotangent g (no f, no Jacobian)
+    // f and its Jacobian in the directions' components wi_x, wi_y, wi_z, wo_x,
+    // wo_y, wo_z (docs/gradients.md, "Derivatives in the directions")
+    kDirectionGradient = 6,
+    kDirectionVjp = 7,  // Σ_c g_c ∂f_c/∂w per element for the six components (no f, no Jacobian)
 };
+
+// The direction components the derivatives in the directions are taken by:
+// wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.
+inline constexpr int kDirectionComponents = 6;
 
 // The parameter slots a derivative is taken by, in the table's order: column
 // k of the outputs is the k-th wanted slot; position[p] is slot p's column, or -1.
@@ -122,10 +130,13 @@ struct EvalJob {
     // Output::kVjp: element i's Σ_c g_c ∂f_c/∂p, g the cotangent's element i,
     // is at jacobian[P i + k] (an (N, P) array) or, with jacobian_row_stride > 0,
     // at jacobian[k jacobian_row_stride + i] (a (P, N) array).
+    // Output::kDirectionGradient and kDirectionVjp: as kGradient and kVjp with
+    // the P = 6 direction components wi_x, wi_y, wi_z, wo_x, wo_y, wo_z for
+    // columns (`columns` is not read).
     float* jacobian = nullptr;
     std::int64_t jacobian_row_stride = 0;
     Columns columns;
-    Vec3Array cotangent;  // Output::kVjp
+    Vec3Array cotangent;  // Output::kVjp and kDirectionVjp
     // Output::kPdf and kValuePdf: one float per element, for this specular sampler.
     float* pdf = nullptr;
     SpecularSampler sampler = SpecularSampler::kVisibleNormals;

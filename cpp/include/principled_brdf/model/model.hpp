@@ -25,3 +25,5 @@
 #include "principled.hpp"
 #include "energy.hpp"
 #include "gradients.hpp"
+#include "dual.hpp"
+#include "direction_gradient.hpp"
