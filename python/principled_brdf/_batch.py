@@ -224,10 +224,13 @@ def _parameter_views(material: Material, depth: int) -> list[float | tuple[float
     return entries
 
 
+_ABSENT = np.empty((0, 3), np.float32)  # the vector of an argument a call does not take
+
+
 class _Segmented(NamedTuple):
     """A call's arguments as the segmented batch layer reads them."""
 
-    vectors: list[tuple[Float32Array | None, int]]  # (array, layout code) of each direction argument
+    vectors: list[tuple[Float32Array, int]]  # (array, layout code) of each direction argument
     params: list[float | tuple[float, ...] | Float32Array]
     segments: tuple[int, int, list[NDArray[np.int64] | None], list[bool]] | None  # _core's segments= (None: one run)
 
@@ -238,10 +241,10 @@ def _unsegmented(leading: tuple[int, ...], layout: str, directions: list[_Direct
     number, or C-contiguous of the call's shape), or None: the common cases,
     without the segments' bookkeeping."""
     n = _size(leading)
-    vectors: list[tuple[Float32Array | None, int]] = []
+    vectors: list[tuple[Float32Array, int]] = []
     for direction in directions:
         if direction is None:
-            vectors.append((None, 0))
+            vectors.append((_ABSENT, 0))
         elif not direction.array.flags.c_contiguous:
             return None
         elif _size(direction.leading) == 1:  # () or (1, ...): one vector
@@ -278,10 +281,10 @@ def _segmented(leading: tuple[int, ...], layout: str, directions: list[_Directio
     shapes += [leading_of(p, a) for p, a in zip(params, param_axes) if isinstance(p, np.ndarray)]
     split = choose_split(leading, shapes)
     offsets: list[NDArray[np.int64] | None] = []
-    vectors: list[tuple[Float32Array | None, int]] = []
+    vectors: list[tuple[Float32Array, int]] = []
     for view in views:
         if view is None:
-            vectors.append((None, 0))
+            vectors.append((_ABSENT, 0))
             offsets.append(None)
             continue
         piece = part(view, leading, split, axis)
@@ -761,7 +764,7 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
                                   check_tolerance=DIRECTION_LENGTH_TOLERANCE if check else 0.0,
                                   threads=thread_count, isa=isa_name)
     bad = _core.batch_sample(
-        wo=wo_flat, wo_layout=wo_code, u=u_flat, u_layout=u_code, params=call.params,
+        wo=wo_flat, wo_layout=wo_code, u=None if uniforms is None else u_flat, u_layout=u_code, params=call.params,
         wi=_flat_vec3(wi_out, layout)[0], weight=_flat_vec3(weight_out, layout)[0], pdf=pdf_out.reshape(n),
         lobe=lobe_out.reshape(n), lobe_weights=None if shares is None else [_flat_vec3(s, layout)[0] for s in shares],
         out_layout=_INTERLEAVED if layout == "aos" else _ROWS, n=n, options=options, segments=call.segments,

@@ -78,7 +78,7 @@ class Material:
     clearcoat: Float64Array
     clearcoat_gloss: Float64Array
     _shape: tuple[int, ...]
-    _float32_cache: dict[tuple[str, tuple[int, ...]], Float32Array]
+    _float32_cache: dict[tuple[str, tuple[int, ...] | None], Float32Array]
     # the SIMD kernels' per-parameter entry (a number, base_color's three, or None
     # when per element), set by the first SIMD call after its float32 range check
     _kernel_numbers: list[float | tuple[float, ...] | None] | None
