@@ -8,8 +8,9 @@ synthetic measurements of the model with 2 % noise), with the instruction set.
 
 ``--texels T`` fits T x T texels; the 1024² texture of docs/fitting.md is
 measured as a slice (e.g. ``--texels 128 --pairs 256``) and extrapolated by
-the texel count. ``--eval-subsets`` times eval_grad with one column, a few and
-all 13, and eval_vjp, against eval in cache (``--subset-pairs`` a call).
+the texel count. ``--eval-subsets`` times eval_grad with one column, a few,
+all 13 and the six direction components, and eval_vjp (and the directions'
+product), against eval in cache (``--subset-pairs`` a call).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import time
 import numpy as np
 
 import principled_brdf as pb
-from principled_brdf import _core
+from principled_brdf import _core, _direction_grad
 from principled_brdf._gradient import GRADIENT_NAMES
 
 
@@ -54,18 +55,23 @@ def eval_subsets(repeats: int, threads: int, pairs: int) -> None:
     f = np.empty((n, 3), np.float32)  # outputs allocated once: the kernels' time, not the page faults'
     base = best_of(repeats, lambda: [pb.eval(m, wi, wo, threads=threads, out=f) for _ in range(inner)])
     print(f"eval_grad / eval at {n} pairs in cache, uniform material ({threads} threads, out= preallocated):")
-    for wrt in (["roughness"], ["clearcoat_gloss"], ["base_color"], ["base_color", "roughness", "metallic"], None):
+    every = list(GRADIENT_NAMES) + list(pb.DIRECTION_NAMES)
+    for wrt in (["roughness"], ["clearcoat_gloss"], ["base_color"], ["base_color", "roughness", "metallic"], None,
+                ["wi", "wo"], every):
         columns = len(GRADIENT_NAMES) if wrt is None else len(pb.eval_grad(m, wi[:1], wo[:1], wrt=wrt).names)
         jacobian = np.empty((n, 3, columns), np.float32)
         t = best_of(repeats, lambda: [pb.eval_grad(m, wi, wo, wrt=wrt, threads=threads, out=(f, jacobian))
                                       for _ in range(inner)])
-        label = "all 13" if wrt is None else ", ".join(wrt)
+        label = "all 13" if wrt is None else "all 19 (13 slots, 6 directions)" if wrt is every else ", ".join(wrt)
         print(f"  {label:40s} {base / t:.2f}x  ({n * inner / t / 1e6:.1f} M pairs/s)")
     g = rng.normal(size=(n, 3)).astype(np.float32)
     for wrt in (["roughness"], None):
         t = best_of(repeats, lambda: [pb.eval_vjp(m, wi, wo, g, wrt=wrt, threads=threads) for _ in range(inner)])
         label = "eval_vjp " + ("all 13" if wrt is None else ", ".join(wrt))
         print(f"  {label:40s} {base / t:.2f}x  ({n * inner / t / 1e6:.1f} M pairs/s)")
+    # the directions' product, as principled_brdf.torch and .jax call it in their backward passes
+    t = best_of(repeats, lambda: [_direction_grad.vjp(m, wi, wo, g, threads=threads) for _ in range(inner)])
+    print(f"  {'direction vjp (wi, wo)':40s} {base / t:.2f}x  ({n * inner / t / 1e6:.1f} M pairs/s)")
 
 
 def main() -> None:

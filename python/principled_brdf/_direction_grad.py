@@ -67,11 +67,6 @@ def _names(parameters: list[int], directions: list[int]) -> tuple[str, ...]:
     return tuple(GRADIENT_NAMES[k] for k in parameters) + tuple(DIRECTION_NAMES[k] for k in directions)
 
 
-def _joined(parts: list[FloatArray], soa: bool) -> FloatArray:
-    """The parameter and direction columns side by side: the last axis, or axis 1 for layout="soa"."""
-    return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1 if soa else -1)
-
-
 def _refuse_energy_compensation(energy_compensation: object) -> None:
     if flag("energy_compensation", energy_compensation):
         raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
@@ -117,13 +112,16 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, wrt: 
         value = first.value
     parts.append(by_direction if len(directions) == len(DIRECTION_NAMES) else
                  by_direction[:, directions] if soa else by_direction[..., directions])
-    jacobian = _joined(parts, soa)
-    if out is not None:
-        pair = _batch._output_pair(out, value.shape, jacobian.shape, "jacobian")
-        pair[0][...] = value
-        pair[1][...] = jacobian
-        value, jacobian = pair
-    return Gradient(value, np.ascontiguousarray(jacobian), _names(parameters, directions))
+    axis = 1 if soa else -1
+    if out is None and len(parts) == 1 and parts[0] is by_direction:
+        return Gradient(value, by_direction, _names(parameters, directions))
+    shape = list(parts[0].shape)
+    shape[axis] = sum(part.shape[axis] for part in parts)
+    result, jacobian = _batch._output_pair(out, value.shape, tuple(shape), "jacobian")
+    if result is not value:
+        result[...] = value
+    np.concatenate(parts, axis=axis, out=jacobian)  # the columns side by side, written once
+    return Gradient(result, jacobian, _names(parameters, directions))
 
 
 def vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent: FloatArray, *,
@@ -161,4 +159,4 @@ def reference_eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike
     by_direction = _core.reference_eval_direction_grad(wi_rows, wo_rows, params, model_id, flag("cosine", cosine))
     selected = by_direction[..., directions].reshape(shape + (3, len(directions)))
     parts.append(reference._as_layout(selected, soa, trailing=2))
-    return Gradient(value, _joined(parts, soa), _names(parameters, directions))
+    return Gradient(value, np.concatenate(parts, axis=1 if soa else -1), _names(parameters, directions))
