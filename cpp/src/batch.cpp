@@ -101,16 +101,6 @@ void advance_input(Vec3Array& in, const Segments& segments, int input, std::int6
     if (in.data != nullptr) in.data += segment_offset(segments, input, s);
 }
 
-// Floats per element in the derivative output of an interleaved (element-major) job.
-std::int64_t jacobian_width(const EvalJob& job) {
-    switch (job.output) {
-        case Output::kVjp: return job.columns.count;
-        case Output::kDirectionGradient: return 3 * kDirectionComponents;
-        case Output::kDirectionVjp: return kDirectionComponents;
-        default: return 3 * job.columns.count;
-    }
-}
-
 EvalJob segment_job(const EvalJob& job, const Segments& segments, std::int64_t s) {
     EvalJob part = job;
     const std::int64_t first = s * segments.length;
@@ -122,7 +112,7 @@ EvalJob segment_job(const EvalJob& job, const Segments& segments, std::int64_t s
     for (MutableVec3Array& out : part.out) advance_output(out, first);
     if (part.pdf != nullptr) part.pdf += first;
     if (part.jacobian != nullptr) {
-        part.jacobian += job.jacobian_row_stride > 0 ? first : jacobian_width(job) * first;
+        part.jacobian += job.jacobian_row_stride > 0 ? first : job.jacobian_width() * first;
     }
     return part;
 }

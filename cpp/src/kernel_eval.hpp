@@ -37,17 +37,6 @@ constexpr int value_outputs(Output output) {
     return output == Output::kLobes ? kLobeCount : output == Output::kPdf || is_vjp(output) ? 0 : 1;
 }
 
-// The floats an element of `job`'s output writes to job.jacobian.
-inline int jacobian_width(const EvalJob& job) {
-    switch (job.output) {
-        case Output::kGradient: return 3 * job.columns.count;
-        case Output::kVjp: return job.columns.count;
-        case Output::kDirectionGradient: return kDirectionJacobianWidth;
-        case Output::kDirectionVjp: return kDirectionSlots;
-        default: return 0;
-    }
-}
-
 // With the energy compensation (model/energy.hpp): the multiple-scattering
 // lobe's constants as well (its own type, so that the loops without the
 // option hold none of its code).
@@ -356,7 +345,7 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf || output == Output::kValuePdf) unpad_scalars(job.pdf, pad, pdf);
     if constexpr (has_jacobian(output)) {
-        const int width = jacobian_width(job);  // values an element
+        const int width = job.jacobian_width();  // values an element
         for (std::int64_t j = 0; j < pad.count; ++j)
             for (int r = 0; r < width; ++r) {
                 const std::int64_t e = pad.begin + j;

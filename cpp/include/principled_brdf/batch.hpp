@@ -148,6 +148,16 @@ struct EvalJob {
     bool per_element_material = false;
 
     bool uniform_material() const { return !per_element_material && principled_brdf::uniform_material(params); }
+    // The floats an element of this job's output writes to `jacobian`.
+    int jacobian_width() const {
+        switch (output) {
+            case Output::kGradient: return 3 * columns.count;
+            case Output::kVjp: return columns.count;
+            case Output::kDirectionGradient: return 3 * kDirectionComponents;
+            case Output::kDirectionVjp: return kDirectionComponents;
+            default: return 0;
+        }
+    }
 };
 
 // The normal equations of least-squares problems (docs/fitting.md), for the
