@@ -9,6 +9,14 @@ Gauss-Legendre cubature (below), and the below-horizon cell expects the rest,
 pooled into one; Pearson's statistic is referred to ``scipy.stats.chi2`` with
 (cells - 1) degrees of freedom.
 
+Whole sphere. With ``sphere=True`` (for samplers whose directions may lie
+anywhere, e.g. with transmission) the ``n_cos`` rows cover cos θ in [-1, 1]
+instead, so every cell has solid angle ``4π / (n_phi n_cos)`` (with ``n_cos``
+even a row boundary lies on the horizon). There is no horizon to fall below:
+the extra cell holds the invalid samples, those the caller flags in the mask
+``invalid`` (e.g. returned with pdf 0) and those whose direction is zero or not
+finite, and it expects ``N (1 - ∫_sphere pdf dω)``.
+
 Cubature. Each cell starts as one region of the ``(φ, cos θ)`` plane. A region's
 integral is estimated with an ``order x order`` Gauss-Legendre rule and with the
 same rule on its two halves along each axis; where the halves disagree with the
@@ -50,19 +58,34 @@ def spherical_to_direction(phi: np.ndarray, cos_theta: np.ndarray) -> np.ndarray
     return np.stack([sin_theta * np.cos(phi), sin_theta * np.sin(phi), cos_theta], axis=-1)
 
 
-def cell_counts(directions: np.ndarray, n_phi: int, n_cos: int, below=None):
+def cell_counts(directions: np.ndarray, n_phi: int, n_cos: int, below=None, *, sphere: bool = False,
+                invalid=None):
     """``(counts (n_cos, n_phi), below_count)``: how many directions fall in each cell.
 
-    A direction with ``z <= 0`` (or flagged in the boolean mask ``below``) counts as below the horizon.
+    A direction with ``z <= 0`` (or flagged in the boolean mask ``below`` or
+    ``invalid``) counts as below the horizon. With ``sphere`` the rows cover
+    cos θ in [-1, 1] and the second number counts the invalid samples: those
+    flagged in ``invalid`` and those whose direction is zero or not finite
+    (``below`` is then an error: there is no horizon).
     """
     w = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
-    is_below = w[:, 2] <= 0.0
-    if below is not None:
-        is_below |= np.asarray(below, dtype=bool).reshape(-1)
+    if sphere:
+        if below is not None:
+            raise ValueError("below: no horizon on the whole sphere; flag samples with invalid=")
+        is_below = ~np.all(np.isfinite(w), axis=1) | ~np.any(w != 0.0, axis=1)
+    else:
+        is_below = w[:, 2] <= 0.0
+        if below is not None:
+            is_below |= np.asarray(below, dtype=bool).reshape(-1)
+    if invalid is not None:
+        is_below |= np.asarray(invalid, dtype=bool).reshape(-1)
     above = w[~is_below]
     phi = np.mod(np.arctan2(above[:, 1], above[:, 0]), 2.0 * np.pi)
     i_phi = np.minimum((phi * (n_phi / (2.0 * np.pi))).astype(np.int64), n_phi - 1)
-    i_cos = np.minimum((above[:, 2] * n_cos).astype(np.int64), n_cos - 1)
+    if sphere:
+        i_cos = np.clip(np.floor((above[:, 2] + 1.0) * (0.5 * n_cos)).astype(np.int64), 0, n_cos - 1)
+    else:
+        i_cos = np.minimum((above[:, 2] * n_cos).astype(np.int64), n_cos - 1)
     counts = np.bincount(i_cos * n_phi + i_phi, minlength=n_phi * n_cos).reshape(n_cos, n_phi)
     return counts, int(is_below.sum())
 
@@ -124,6 +147,7 @@ def integrate_cells(
     n_phi: int = GRID[0],
     n_cos: int = GRID[1],
     *,
+    sphere: bool = False,
     peaks=(),
     peak_width: float | None = None,
     order: int = 4,
@@ -134,19 +158,21 @@ def integrate_cells(
 ):
     """``∫ pdf dω`` over each cell of the grid, ``(n_cos, n_phi)`` (row = cos θ bin).
 
-    ``pdf_fn`` maps unit directions ``(M, 3)`` (all with ``z`` in (0, 1)) to
+    ``pdf_fn`` maps unit directions ``(M, 3)`` (all with ``z`` in (0, 1), or in
+    (-1, 1) with ``sphere``: the rows then cover the whole sphere) to
     densities ``(M,)`` or values ``(M, k)`` (then the result is ``(n_cos, n_phi, k)``
     and the tolerance applies to the largest component). A region is accepted
     when its two-halves estimates agree with the whole within
-    ``max(atol, rtol |I|)``; ``peaks`` (unit vectors) with ``peak_width`` (radians)
-    force refinement around narrow peaks (module docstring).
+    ``max(atol, rtol |I|)``; ``peaks`` (unit vectors, in either hemisphere with
+    ``sphere``) with ``peak_width`` (radians) force refinement around narrow
+    peaks (module docstring).
     """
     rule = _Rule(pdf_fn, order)
     peaks = np.asarray(peaks, dtype=np.float64).reshape(-1, 3)
     if len(peaks) and not peak_width:
         raise ValueError("peak_width: required with peaks")
     phi_edges = np.linspace(0.0, 2.0 * np.pi, n_phi + 1)
-    cos_edges = np.linspace(0.0, 1.0, n_cos + 1)
+    cos_edges = np.linspace(-1.0 if sphere else 0.0, 1.0, n_cos + 1)
     i_cos, i_phi = (a.ravel() for a in np.meshgrid(np.arange(n_cos), np.arange(n_phi), indexing="ij"))
     phi0, phi1 = phi_edges[i_phi], phi_edges[i_phi + 1]
     cos0, cos1 = cos_edges[i_cos], cos_edges[i_cos + 1]
@@ -180,9 +206,11 @@ def integrate_cells(
         np.add.at(total, cell[done], 0.5 * (by_phi[done] + by_cos[done]))
 
         # Split along the axis whose halves disagree most; a forced split takes the
-        # axis of larger angular extent (radius of the φ extent at the lowest cos θ).
+        # axis of larger angular extent (the φ extent on the region's widest circle of
+        # latitude, at its cos θ nearest 0: cos0 on the upper hemisphere).
         along_phi = error_phi > error_cos
-        extent_phi = (phi1 - phi0) * np.sqrt(np.maximum(0.0, 1.0 - cos0 * cos0))
+        cos_widest = np.where((cos0 < 0.0) & (cos1 > 0.0), 0.0, np.minimum(np.abs(cos0), np.abs(cos1)))
+        extent_phi = (phi1 - phi0) * np.sqrt(np.maximum(0.0, 1.0 - cos_widest * cos_widest))
         extent_cos = np.arccos(np.clip(cos0, -1.0, 1.0)) - np.arccos(np.clip(cos1, -1.0, 1.0))
         along_phi = np.where(forced, extent_phi > extent_cos, along_phi)[split]
         s = split
@@ -215,26 +243,29 @@ class ChiSquareResult:
     statistic: float
     dof: int
     samples: int
-    integral: float  # ∫ pdf over the upper hemisphere (cubature)
+    integral: float  # ∫ pdf over the upper hemisphere, or the sphere (cubature)
     observed: np.ndarray  # (n_cos, n_phi)
     expected: np.ndarray  # (n_cos, n_phi)
-    observed_below: int
+    observed_below: int  # with sphere: the invalid samples
     expected_below: float
     pooled_cells: int
+    sphere: bool = False
 
     def describe(self, worst: int = 5) -> str:
         """A summary with the cells that contribute most, for assertion messages."""
         contribution = (self.observed - self.expected) ** 2 / np.maximum(self.expected, 1e-300)
         order = np.argsort(contribution.ravel())[::-1][:worst]
         n_cos, n_phi = self.expected.shape
+        cos_low, cos_step = (-1.0, 2.0 / n_cos) if self.sphere else (0.0, 1.0 / n_cos)
         cells = ", ".join(
-            f"(cos {(k // n_phi) / n_cos:.2f}.., phi {2 * np.pi * (k % n_phi) / n_phi:.2f}..): "
+            f"(cos {cos_low + (k // n_phi) * cos_step:.2f}.., phi {2 * np.pi * (k % n_phi) / n_phi:.2f}..): "
             f"{self.observed.ravel()[k]} vs {self.expected.ravel()[k]:.1f}"
             for k in order
         )
+        catch_all = "invalid" if self.sphere else "below horizon"
         return (
             f"p = {self.p_value:.3g}, chi2 = {self.statistic:.1f} on {self.dof} dof, N = {self.samples}, "
-            f"∫pdf = {self.integral:.6f}, below horizon {self.observed_below} vs {self.expected_below:.1f}, "
+            f"∫pdf = {self.integral:.6f}, {catch_all} {self.observed_below} vs {self.expected_below:.1f}, "
             f"{self.pooled_cells} cells pooled; worst cells: {cells}"
         )
 
@@ -268,18 +299,24 @@ def chi_square_test(
     below=None,
     peaks=(),
     peak_width: float | None = None,
+    sphere: bool = False,
+    invalid=None,
     **cubature,
 ) -> ChiSquareResult:
     """Pearson's test of sampled ``directions`` ``(N, 3)`` against ``pdf_fn`` (module docstring).
 
-    ``below`` optionally flags samples to count as below the horizon whatever
-    their ``z`` (e.g. those the sampler returned with pdf 0); ``peaks`` and
-    ``peak_width`` and further keywords go to :func:`integrate_cells`.
+    ``below`` (or ``invalid``) optionally flags samples to count as below the
+    horizon whatever their ``z`` (e.g. those the sampler returned with pdf 0); ``peaks`` and
+    ``peak_width`` and further keywords go to :func:`integrate_cells`. With
+    ``sphere`` the grid covers the whole sphere and the extra cell holds the
+    invalid samples: those flagged in ``invalid`` (``below`` is then an error)
+    and those with a zero or non-finite direction (:func:`cell_counts`).
     """
     directions = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
     n = len(directions)
-    observed, observed_below = cell_counts(directions, n_phi, n_cos, below)
-    probability = integrate_cells(pdf_fn, n_phi, n_cos, peaks=peaks, peak_width=peak_width, **cubature)
+    observed, observed_below = cell_counts(directions, n_phi, n_cos, below, sphere=sphere, invalid=invalid)
+    probability = integrate_cells(pdf_fn, n_phi, n_cos, sphere=sphere, peaks=peaks, peak_width=peak_width,
+                                  **cubature)
     integral = float(probability.sum())
     expected = n * probability
     expected_below = max(0.0, n * (1.0 - integral))
@@ -296,6 +333,7 @@ def chi_square_test(
         observed_below=observed_below,
         expected_below=expected_below,
         pooled_cells=pooled,
+        sphere=sphere,
     )
 
 
