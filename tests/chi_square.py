@@ -17,7 +17,7 @@ the extra cell holds the invalid samples, those the caller flags in the mask
 ``invalid`` (e.g. returned with pdf 0) and those whose direction is zero or not
 finite, and it expects ``N (1 - ∫_sphere pdf dω)``.
 
-Cubature. Each cell starts as one region of the ``(φ, cos θ)`` plane. A region's
+Cubature. Each cell starts as one region of the ``(φ, cos θ)`` plane (or two, below). A region's
 integral is estimated with an ``order x order`` Gauss-Legendre rule and with the
 same rule on its two halves along each axis; where the halves disagree with the
 whole by more than the tolerance, the region is split along the axis that
@@ -25,11 +25,22 @@ disagrees most, and so on. Peaks much narrower than a region can fall between
 the nodes of both estimates and go unseen, so the caller names them: every
 region within a few ``peak_width`` of a peak direction is split until its
 angular radius is below ``peak_width / 4``, whatever the estimates say.
+Likewise a jump of the density along a circle of latitude can hide in a thin
+band at a region's edge that no node reaches; the caller names such circles
+by their cos θ (``cos_breaks``) and the cells they cross are cut there. On the
+upper hemisphere the one jump of a reflection lobe is the horizon, a cell
+boundary; on the whole sphere, microfacet lobes jump where the microfacet
+horizon (``h_z = 0``) sends them: cos θ = ``-cos θo`` for reflection and
+``-cos θo / η`` for refraction into a medium of relative index ``η``.
 
 Usage::
 
     result = chi_square_test(wi, lambda w: pdf_of(w), peaks=[mirror], peak_width=alpha)
     assert result.p_value > sidak_threshold(cases), result.describe()
+
+    # a BSDF sampler, over the whole sphere
+    result = chi_square_test(wi, pdf_of, sphere=True, invalid=pdf == 0, peaks=[mirror, refracted],
+                             peak_width=alpha, cos_breaks=[-wo[2], -wo[2] / eta])
 """
 
 from __future__ import annotations
@@ -150,6 +161,7 @@ def integrate_cells(
     sphere: bool = False,
     peaks=(),
     peak_width: float | None = None,
+    cos_breaks=(),
     order: int = 4,
     atol: float = 1e-10,
     rtol: float = 1e-6,
@@ -165,7 +177,8 @@ def integrate_cells(
     when its two-halves estimates agree with the whole within
     ``max(atol, rtol |I|)``; ``peaks`` (unit vectors, in either hemisphere with
     ``sphere``) with ``peak_width`` (radians) force refinement around narrow
-    peaks (module docstring).
+    peaks, and ``cos_breaks`` (values of cos θ where the density may jump) cut
+    the cells they cross before the cubature starts (module docstring).
     """
     rule = _Rule(pdf_fn, order)
     peaks = np.asarray(peaks, dtype=np.float64).reshape(-1, 3)
@@ -173,10 +186,14 @@ def integrate_cells(
         raise ValueError("peak_width: required with peaks")
     phi_edges = np.linspace(0.0, 2.0 * np.pi, n_phi + 1)
     cos_edges = np.linspace(-1.0 if sphere else 0.0, 1.0, n_cos + 1)
-    i_cos, i_phi = (a.ravel() for a in np.meshgrid(np.arange(n_cos), np.arange(n_phi), indexing="ij"))
+    # The rows cut at the breaks: band k spans bounds[k]..bounds[k + 1] of row row_of[k].
+    breaks = np.asarray(cos_breaks, dtype=np.float64).ravel()
+    bounds = np.union1d(cos_edges, breaks[(breaks > cos_edges[0]) & (breaks < cos_edges[-1])])
+    row_of = np.searchsorted(cos_edges, bounds[:-1], side="right") - 1
+    band, i_phi = (a.ravel() for a in np.meshgrid(np.arange(len(row_of)), np.arange(n_phi), indexing="ij"))
     phi0, phi1 = phi_edges[i_phi], phi_edges[i_phi + 1]
-    cos0, cos1 = cos_edges[i_cos], cos_edges[i_cos + 1]
-    cell = i_cos * n_phi + i_phi
+    cos0, cos1 = bounds[band], bounds[band + 1]
+    cell = row_of[band] * n_phi + i_phi
     whole = rule(phi0, phi1, cos0, cos1)
     total = np.zeros((n_cos * n_phi,) + whole.shape[1:])
 
