@@ -12,6 +12,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "materials.hpp"
@@ -26,17 +27,17 @@ namespace {
 constexpr std::int64_t kSizes[] = {4096, 65536, 16 << 20};
 constexpr std::int64_t kGradientInCache = 1024;
 
-// Random pairs in the upper hemisphere and random per-element materials, in
-// both layouts, made once per size.
+// Random pairs in the upper hemisphere (or, sphere, over the whole sphere)
+// and random per-element materials, in both layouts, made once per size.
 struct Data {
     std::int64_t n;
     std::vector<float> wi_aos, wo_aos, wi_soa, wo_soa, out, jacobian;
     std::vector<float> params[pb::kParamSlots];  // per-element, base_color interleaved in slot 0
 };
 
-Data& data_for(std::int64_t n) {
-    static std::map<std::int64_t, std::unique_ptr<Data>> cache;
-    auto& slot = cache[n];
+Data& data_for(std::int64_t n, bool sphere = false) {
+    static std::map<std::pair<std::int64_t, bool>, std::unique_ptr<Data>> cache;
+    auto& slot = cache[{n, sphere}];
     if (slot) return *slot;
     slot = std::make_unique<Data>();
     Data& d = *slot;
@@ -48,7 +49,7 @@ Data& data_for(std::int64_t n) {
         aos.resize(3 * n);
         soa.resize(3 * n);
         for (std::int64_t i = 0; i < n; ++i) {
-            float x = normal(rng), y = normal(rng), z = std::abs(normal(rng)) + 1e-3f;
+            float x = normal(rng), y = normal(rng), z = sphere ? normal(rng) : std::abs(normal(rng)) + 1e-3f;
             const float inv = 1.0f / std::sqrt(x * x + y * y + z * z);
             x *= inv, y *= inv, z *= inv;
             aos[3 * i] = soa[i] = x;
@@ -141,9 +142,11 @@ void simd_eval_material(benchmark::State& state, std::string isa, int index, boo
 }
 
 // Importance sampling with the counter-based generator: wi, pdf, weight, lobe per element.
-void simd_sample_job(benchmark::State& state, const std::string& isa, const pb::EvalJob& eval_job) {
+void simd_sample_job(benchmark::State& state, const std::string& isa, const pb::EvalJob& eval_job,
+                     pb::Model model = pb::Model::kDisney2014) {
     Data& d = data_for(state.range(0));
     pb::SampleJob job;
+    job.model = model;
     job.wo = eval_job.wo;
     job.seed = 7;
     for (int s = 0; s < pb::kParamSlots; ++s) job.params[s] = eval_job.params[s];
@@ -168,6 +171,50 @@ void simd_sample(benchmark::State& state, std::string isa, bool soa, bool per_el
 // The material set's samples.
 void simd_sample_material(benchmark::State& state, std::string isa, int index) {
     simd_sample_job(state, isa, make_material_job(data_for(state.range(0)), index));
+}
+
+// The models over their domains (bench/RESULTS.md, "The 2015 BSDF"): a rough
+// glass-like uniform material (the benchmark material's base color, roughness
+// 0.3, specular 0.5) with spec_trans 0, 0.5 or 1, on pairs over the upper
+// hemisphere or the whole sphere; one thread.
+struct ModelCase {
+    const char* name;
+    pb::Model model;
+    float spec_trans;
+    bool sphere;
+};
+constexpr ModelCase kModelCases[] = {
+    {"disney2014/upper", pb::Model::kDisney2014, 0.0f, false},
+    {"disney2015/upper/spec_trans_0", pb::Model::kDisney2015, 0.0f, false},
+    {"disney2015/sphere/spec_trans_0", pb::Model::kDisney2015, 0.0f, true},
+    {"disney2015/sphere/spec_trans_0.5", pb::Model::kDisney2015, 0.5f, true},
+    {"disney2015/sphere/spec_trans_1", pb::Model::kDisney2015, 1.0f, true},
+};
+
+pb::EvalJob make_model_job(Data& d, const ModelCase& c) {
+    pb::EvalJob job = make_job(d, false, false);
+    job.model = c.model;
+    job.params[pb::kSubsurface].value = 0.0f;  // (the 2015 models read flatness instead)
+    job.params[pb::kRoughness].value = 0.3f;
+    job.params[pb::kSpecTrans].value = c.spec_trans;
+    return job;
+}
+
+void eval_model(benchmark::State& state, std::string isa, int index) {
+    const ModelCase& c = kModelCases[index];
+    Data& d = data_for(state.range(0), c.sphere);
+    pb::EvalJob job = make_model_job(d, c);
+    for (auto _ : state) {
+        pb::eval(job, d.n, 1, isa);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * d.n);
+}
+
+void sample_model(benchmark::State& state, std::string isa, int index) {
+    const ModelCase& c = kModelCases[index];
+    pb::EvalJob job = make_model_job(data_for(state.range(0), c.sphere), c);
+    simd_sample_job(state, isa, job, c.model);
 }
 
 void reference_eval(benchmark::State& state) {
@@ -313,6 +360,19 @@ void register_all() {
                 ->Args({kSizes[2], all})
                 ->UseRealTime()
                 ->Unit(benchmark::kMicrosecond);
+        }
+    }
+    for (const std::string& isa : pb::available_isas()) {
+        for (std::int64_t n : kSizes) {
+            for (int index = 0; index < static_cast<int>(std::size(kModelCases)); ++index) {
+                const std::string name = isa + "/" + kModelCases[index].name;
+                benchmark::RegisterBenchmark(("eval_model/" + name).c_str(), eval_model, isa, index)
+                    ->Args({n, 1})
+                    ->Unit(benchmark::kMicrosecond);
+                benchmark::RegisterBenchmark(("sample_model/" + name).c_str(), sample_model, isa, index)
+                    ->Args({n, 1})
+                    ->Unit(benchmark::kMicrosecond);
+            }
         }
     }
     for (std::int64_t n : kSizes) {

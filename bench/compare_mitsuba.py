@@ -13,8 +13,10 @@ compiles Mitsuba's kernel) and a pause that lets the other library's threads sle
 Dr.Jit runs asynchronously, so its timer stops after `dr.sync_thread()`.
 "One core" pins the process to CPU 0 (sched_setaffinity) and runs both on
 one thread; "all" uses every core. `--material` takes a preset instead of
-the benchmark material. Prints a Markdown table (M pairs/s and ratios); not a
-test dependency.
+the benchmark material. `--model disney2015` compares the 2015 BSDF (Mitsuba's
+`principled` with `spec_trans`, `--spec-trans`, default 1) on pairs over the
+whole sphere. Prints a Markdown table (M pairs/s and ratios); not a test
+dependency.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ MATERIAL = dict(base_color=(0.82, 0.67, 0.16), metallic=0.2, roughness=0.4, shee
 # this library's names for Mitsuba's `principled` parameters (it has no subsurface)
 MITSUBA_NAMES = {"metallic": "metallic", "specular": "specular", "specular_tint": "spec_tint", "roughness": "roughness",
                  "anisotropic": "anisotropic", "sheen": "sheen", "sheen_tint": "sheen_tint", "clearcoat": "clearcoat",
-                 "clearcoat_gloss": "clearcoat_gloss"}
+                 "clearcoat_gloss": "clearcoat_gloss", "spec_trans": "spec_trans", "flatness": "flatness"}
 
 
 def material_named(name: str) -> pb.Material:
@@ -56,15 +58,17 @@ def best_seconds(run, repeats: int, min_seconds: float = 0.2) -> float:
     return best
 
 
-def random_pairs(n: int, seed: int = 1):
+def random_pairs(n: int, seed: int = 1, sphere: bool = False):
+    """wi, wo over the upper hemisphere (or the whole sphere) and the uniforms."""
     rng = np.random.default_rng(seed)
 
-    def upper(size):
+    def directions(size):
         v = rng.normal(size=(size, 3))
-        v[:, 2] = np.abs(v[:, 2]) + 1e-3
+        if not sphere:
+            v[:, 2] = np.abs(v[:, 2]) + 1e-3
         return (v / np.linalg.norm(v, axis=1, keepdims=True)).astype(np.float32)
 
-    return upper(n), upper(n), rng.random((n, 3), dtype=np.float32)
+    return directions(n), directions(n), rng.random((n, 3), dtype=np.float32)
 
 
 def mitsuba_timers(material: pb.Material, n: int, wi, wo, u, repeats: int):
@@ -97,16 +101,15 @@ def mitsuba_timers(material: pb.Material, n: int, wi, wo, u, repeats: int):
     return {"eval": best_seconds(evaluate, repeats), "sample": best_seconds(sample, repeats)}
 
 
-def library_timers(m: pb.Material, n: int, wi, wo, u, threads, repeats: int):
+def library_timers(m: pb.Material, n: int, wi, wo, u, threads, repeats: int, model: str):
     out = np.empty_like(wi)
+    options = dict(threads=threads, model=model)
     return {
         "eval, out=, check=False": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, out=out, check=False,
-                                                                threads=threads), repeats),
-        "eval, out= (checked)": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, out=out, threads=threads),
-                                             repeats),
-        "eval, fresh output (checked)": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, threads=threads),
-                                                     repeats),
-        "sample, u given": best_seconds(lambda: pb.sample(m, wo, u=u, threads=threads), repeats),
+                                                                **options), repeats),
+        "eval, out= (checked)": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, out=out, **options), repeats),
+        "eval, fresh output (checked)": best_seconds(lambda: pb.eval(m, wi, wo, cosine=True, **options), repeats),
+        "sample, u given": best_seconds(lambda: pb.sample(m, wo, u=u, **options), repeats),
     }
 
 
@@ -116,21 +119,27 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--material", default="benchmark", choices=["benchmark", *pb.presets.names()],
                         help="the benchmark material (every lobe but subsurface on) or a preset")
+    parser.add_argument("--model", default="disney2014", choices=["disney2014", "disney2015"])
+    parser.add_argument("--spec-trans", type=float, default=1.0, help="the material's spec_trans with disney2015")
     args = parser.parse_args()
     import drjit as dr
 
     material = material_named(args.material)
+    sphere = args.model == "disney2015"
+    if sphere:
+        material = material.replace(spec_trans=args.spec_trans)
 
     cores = sorted(os.sched_getaffinity(0))
-    print(f"principled-brdf {pb.__version__}, {pb.cpu_info()['isa']}; Mitsuba 3 llvm_ad_rgb; material {args.material}\n")
+    print(f"principled-brdf {pb.__version__}, {pb.cpu_info()['isa']}; Mitsuba 3 llvm_ad_rgb; material {args.material}; "
+          f"model {args.model}" + (f", spec_trans {args.spec_trans:g}, pairs over the sphere" if sphere else "") + "\n")
     print("| pairs | cores | call | pb M pairs/s | Mitsuba M pairs/s | pb / Mitsuba |\n|---:|---|---|---:|---:|---:|")
     for label, affinity, threads in (("one (pinned)", {cores[0]}, 1), ("all", set(cores), None)):
         os.sched_setaffinity(0, affinity)
         dr.set_thread_count(len(affinity))
         for n in args.sizes:
-            wi, wo, u = random_pairs(n)
+            wi, wo, u = random_pairs(n, sphere=sphere)
             theirs = mitsuba_timers(material, n, wi, wo, u, args.repeats)
-            ours = library_timers(material, n, wi, wo, u, threads, args.repeats)
+            ours = library_timers(material, n, wi, wo, u, threads, args.repeats, args.model)
             for call, seconds in ours.items():
                 peer = theirs["sample" if call.startswith("sample") else "eval"]
                 print(f"| {n:,} | {label} | {call} | {n / seconds / 1e6:.0f} | {n / peer / 1e6:.0f} | "

@@ -68,8 +68,12 @@ TABLE_DOMAINS = {
     "sheen_tint": (0.0, 1.0),
     "clearcoat": (0.0, np.inf),
     "clearcoat_gloss": (0.0, 1.0),
+    "spec_trans": (0.0, 1.0),  # docs/model-2015.md
+    "flatness": (0.0, 1.0),
+    "diff_trans": (0.0, 2.0),
 }
-BOUNDED_PARAMETERS = ("metallic", "subsurface", "specular_tint", "anisotropic", "sheen_tint", "clearcoat_gloss")
+BOUNDED_PARAMETERS = ("metallic", "subsurface", "specular_tint", "anisotropic", "sheen_tint", "clearcoat_gloss",
+                      "spec_trans", "flatness", "diff_trans")
 NON_NEGATIVE_PARAMETERS = ("base_color", "specular", "roughness", "sheen", "clearcoat")
 
 

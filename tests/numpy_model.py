@@ -67,7 +67,9 @@ def _as_float(x) -> np.ndarray:
 
 def _params(material) -> dict:
     if hasattr(material, "as_dict"):
-        material = material.as_dict()
+        # (the 2015 models' parameters, which this model does not read, at their defaults 0)
+        material = {k: v for k, v in material.as_dict().items()
+                    if not (k in ("spec_trans", "flatness", "diff_trans") and not np.any(v))}
     unknown = set(material) - set(DEFAULTS)
     if unknown:
         raise KeyError(f"unknown parameters {sorted(unknown)}")

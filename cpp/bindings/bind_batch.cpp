@@ -64,9 +64,9 @@ void output_views(const py::sequence& arrays, int count, int layout, std::int64_
 
 // The segments of a call (Segments in batch.hpp), from Python: None, one
 // segment of n elements; or (count, length, offsets, single) with count
-// length = n, offsets 3 + 11 entries (wi, wo, the cotangent or u, then the
+// length = n, offsets 3 + one entry a parameter (wi, wo, the cotangent or u, then the
 // parameters in the order of kParams), each None or `count` non-negative
-// int64 offsets in floats, and single 11 flags: the parameter is one value a
+// int64 offsets in floats, and single one flag a parameter: the parameter is one value a
 // segment. The inputs are then checked against their own sizes: every
 // segment's elements lie within them.
 struct SegmentTables {
@@ -96,7 +96,8 @@ SegmentTables segments_from(const py::object& value, std::int64_t n) {
     auto offsets = entries[2].cast<py::sequence>();
     auto single = entries[3].cast<std::vector<bool>>();
     if (py::len(offsets) != static_cast<std::size_t>(kTableInputs) || single.size() != kParams.size())
-        throw std::invalid_argument("segments: expected 14 offset tables and 11 flags");
+        throw std::invalid_argument("segments: expected " + std::to_string(kTableInputs) + " offset tables and " +
+                                    std::to_string(kParams.size()) + " flags");
     for (int input = 0; input < kTableInputs; ++input) {
         if (offsets[input].is_none()) continue;
         tables.keep.push_back(py::cast<py::array_t<std::int64_t, py::array::c_style>>(offsets[input]));
@@ -194,6 +195,7 @@ void fill_params(const py::sequence& params, std::int64_t n, ParamSlot* slots, p
 struct BatchOptions {
     int model = 0;                     // index into kModelNames
     bool energy_compensation = false;  // the multiple-scattering lobe
+    int mode = 0;                      // index into kTransportModeNames
     double check_tolerance = 0.0;      // > 0: the direction check of docs/bad-input.md
     int threads = 0;                   // 0: all cores
     std::string isa;                   // "": the active instruction set
@@ -222,8 +224,12 @@ EvalJob eval_job(const Float32Array& wi, int wi_layout, const Float32Array& wo, 
     fill_params(params, n, job.params, keep_alive, tables);
     job.model = model_from(options.model);
     job.output = output;
+    if ((output == Output::kDirectionGradient || output == Output::kDirectionVjp) && is_bsdf(job.model))
+        throw std::invalid_argument(std::string("model: derivatives in the directions are not implemented for model '") +
+                                    kModelNames[options.model] + "'");
     job.cosine = options.cosine;
     job.energy_compensation = options.energy_compensation;
+    job.mode = mode_from(options.mode);
     if (options.check_tolerance > 0.0) job.check = direction_check(options.check_tolerance);
     return job;
 }
@@ -248,14 +254,18 @@ std::int64_t batch_eval(const Float32Array& wi, int wi_layout, const Float32Arra
 
 // The parameter slots of a derivative: None for all of them, or distinct slot
 // indices in increasing order.
-Columns columns_from(const py::object& slots) {
-    if (slots.is_none()) return Columns{};
+Columns columns_from(const py::object& slots, Model model) {
+    const int limit = gradient_slots(model);
+    if (slots.is_none()) {
+        if (is_bsdf(model)) throw std::invalid_argument("columns: the 2015 models take their slot indices");
+        return Columns{};
+    }
     auto list = py::cast<std::vector<int>>(slots);
-    if (list.empty() || static_cast<int>(list.size()) > kParamSlots)
-        throw std::invalid_argument("columns: expected 1 to " + std::to_string(kParamSlots) + " slot indices");
+    if (list.empty() || static_cast<int>(list.size()) > limit)
+        throw std::invalid_argument("columns: expected 1 to " + std::to_string(limit) + " slot indices");
     for (std::size_t k = 0; k < list.size(); ++k)
-        if (list[k] < 0 || list[k] >= kParamSlots || (k > 0 && list[k] <= list[k - 1]))
-            throw std::invalid_argument("columns: expected increasing slot indices below " + std::to_string(kParamSlots));
+        if (list[k] < 0 || list[k] >= limit || (k > 0 && list[k] <= list[k - 1]))
+            throw std::invalid_argument("columns: expected increasing slot indices below " + std::to_string(limit));
     return Columns(list.data(), static_cast<int>(list.size()));
 }
 
@@ -283,7 +293,7 @@ std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float3
     py::list keep_alive;
     const SegmentTables tables = segments_from(segments, n);
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kGradient, options, keep_alive, tables);
-    job.columns = columns_from(columns);
+    job.columns = columns_from(columns, job.model);
     job.out[0] = output_view(out, out_layout, n, "out");
     const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
     job.jacobian = derivative_output(jacobian, {3, job.columns.count}, rows, n, "jacobian",
@@ -305,7 +315,7 @@ std::int64_t batch_eval_vjp(const Float32Array& wi, int wi_layout, const Float32
     py::list keep_alive;
     const SegmentTables tables = segments_from(segments, n);
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kVjp, options, keep_alive, tables);
-    job.columns = columns_from(columns);
+    job.columns = columns_from(columns, job.model);
     job.cotangent = input_view(cotangent, cotangent_layout, n, "cotangent", tables, kSegmentThird);
     const bool rows = out_layout == static_cast<int>(Vec3Layout::kRows);
     job.jacobian = derivative_output(vjp, {job.columns.count}, rows, n, "vjp",
@@ -407,6 +417,7 @@ std::int64_t batch_sample(const Float32Array& wo, int wo_layout, const py::objec
     job.model = model_from(options.model);
     job.sampler = sampler_from(options.sampler);
     job.energy_compensation = options.energy_compensation;
+    job.mode = mode_from(options.mode);
     job.wi = output_view(wi, out_layout, n, "wi");
     job.weight = output_view(weight, out_layout, n, "weight");
     job.pdf = scalar_output(pdf, n, "pdf");
@@ -466,6 +477,7 @@ py::class_<Options> options_class(py::module_& m, const char* name, const char* 
                        "Include the multiple-scattering energy compensation.")
         .def_readwrite("check_tolerance", &Options::check_tolerance,
                        "Above 0: check that directions are unit vectors within this tolerance.")
+        .def_readwrite("mode", &Options::mode, "Index into MODE_NAMES (the 2015 models' transport mode).")
         .def_readwrite("threads", &Options::threads, "Threads to use (0: all cores).")
         .def_readwrite("isa", &Options::isa,
                        "Instruction set: \"\" (the CPU's choice) or one of cpu_info()[\"available\"].")
@@ -483,55 +495,58 @@ py::class_<Options> options_class(py::module_& m, const char* name, const char* 
 
 void bind_batch(py::module_& m) {
     options_class<EvalOptions>(m, "EvalOptions", "The options of batch_eval and batch_eval_grad.",
-                               {"model", "cosine", "energy_compensation", "check_tolerance", "threads", "isa"})
-        .def(py::init([](int model, bool cosine, bool energy_compensation, double check_tolerance, int threads,
+                               {"model", "cosine", "energy_compensation", "mode", "check_tolerance", "threads", "isa"})
+        .def(py::init([](int model, bool cosine, bool energy_compensation, int mode, double check_tolerance, int threads,
                          std::string isa) {
                  EvalOptions options;
                  options.model = model;
                  options.cosine = cosine;
                  options.energy_compensation = energy_compensation;
+                 options.mode = mode;
                  options.check_tolerance = check_tolerance;
                  options.threads = threads;
                  options.isa = std::move(isa);
                  return options;
              }),
-             py::kw_only(), py::arg("model") = 0, py::arg("cosine") = false, py::arg("energy_compensation") = false,
+             py::kw_only(), py::arg("model") = 0, py::arg("cosine") = false, py::arg("energy_compensation") = false, py::arg("mode") = 0,
              py::arg("check_tolerance") = 0.0, py::arg("threads") = 0, py::arg("isa") = "")
         .def_readwrite("cosine", &EvalOptions::cosine, "Multiply by cos θl.");
     options_class<PdfOptions>(m, "PdfOptions", "The options of batch_pdf (model and cosine: of the value, if any).",
-                              {"model", "sampler", "cosine", "energy_compensation", "check_tolerance", "threads", "isa"})
-        .def(py::init([](int model, int sampler, bool cosine, bool energy_compensation, double check_tolerance,
+                              {"model", "sampler", "cosine", "energy_compensation", "mode", "check_tolerance", "threads", "isa"})
+        .def(py::init([](int model, int sampler, bool cosine, bool energy_compensation, int mode, double check_tolerance,
                          int threads, std::string isa) {
                  PdfOptions options;
                  options.model = model;
                  options.sampler = sampler;
                  options.cosine = cosine;
                  options.energy_compensation = energy_compensation;
+                 options.mode = mode;
                  options.check_tolerance = check_tolerance;
                  options.threads = threads;
                  options.isa = std::move(isa);
                  return options;
              }),
              py::kw_only(), py::arg("model") = 0, py::arg("sampler") = 0, py::arg("cosine") = false,
-             py::arg("energy_compensation") = false, py::arg("check_tolerance") = 0.0, py::arg("threads") = 0,
+             py::arg("energy_compensation") = false, py::arg("mode") = 0, py::arg("check_tolerance") = 0.0, py::arg("threads") = 0,
              py::arg("isa") = "")
         .def_readwrite("sampler", &PdfOptions::sampler, "Index into SAMPLER_NAMES.")
         .def_readwrite("cosine", &PdfOptions::cosine, "Multiply the value by cos θl.");
     options_class<SampleOptions>(m, "SampleOptions", "The options of batch_sample.",
-                                 {"model", "sampler", "energy_compensation", "seed", "check_tolerance", "threads", "isa"})
-        .def(py::init([](int model, int sampler, bool energy_compensation, std::uint64_t seed, double check_tolerance,
+                                 {"model", "sampler", "energy_compensation", "mode", "seed", "check_tolerance", "threads", "isa"})
+        .def(py::init([](int model, int sampler, bool energy_compensation, int mode, std::uint64_t seed, double check_tolerance,
                          int threads, std::string isa) {
                  SampleOptions options;
                  options.model = model;
                  options.sampler = sampler;
                  options.energy_compensation = energy_compensation;
+                 options.mode = mode;
                  options.seed = seed;
                  options.check_tolerance = check_tolerance;
                  options.threads = threads;
                  options.isa = std::move(isa);
                  return options;
              }),
-             py::kw_only(), py::arg("model") = 0, py::arg("sampler") = 0, py::arg("energy_compensation") = false,
+             py::kw_only(), py::arg("model") = 0, py::arg("sampler") = 0, py::arg("energy_compensation") = false, py::arg("mode") = 0,
              py::arg("seed") = 0, py::arg("check_tolerance") = 0.0, py::arg("threads") = 0, py::arg("isa") = "")
         .def_readwrite("sampler", &SampleOptions::sampler, "Index into SAMPLER_NAMES.")
         .def_readwrite("seed", &SampleOptions::seed, "Seed of the counter-based uniforms (without u).");

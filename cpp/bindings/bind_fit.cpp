@@ -38,7 +38,7 @@ py::tuple normal_equations(const Float32Array& wi, const Float32Array& wo, const
     if (target.ndim() != 3 || target.shape(2) != 3) throw std::invalid_argument("target: expected a (B, N, 3) array");
     const py::ssize_t count = target.shape(0), pairs = target.shape(1);
     require_shape(scale, {count, pairs, 3}, "scale");
-    require_shape(slots, {count, kParamSlots}, "slots");
+    require_shape(slots, {count, kGradientSlots}, "slots");
     const bool per_problem = wi.ndim() == 3;
     for (const Float32Array* w : {&wi, &wo}) {
         if (per_problem) {
@@ -71,9 +71,10 @@ py::tuple normal_equations(const Float32Array& wi, const Float32Array& wo, const
     job.gain = gain.is_none() ? nullptr : gains.data();
     job.problems = problems.data();
     job.model = model_from(model);
+    if (is_bsdf(job.model)) throw std::invalid_argument("model: the fitting solver takes the 2012 and 2014 models");
     job.loss = static_cast<Loss>(loss);
     job.cosine = cosine;
-    job.columns = columns_from(columns);
+    job.columns = columns_from(columns, job.model);
     const py::ssize_t width = job.columns.count;
     Float64Array normal({n, width * (width + 1) / 2}), gradient({n, width}), cost({n});
     job.normal = normal.mutable_data();

@@ -40,6 +40,8 @@ void bind_params(py::module_& m) {
     m.attr("LOBE_NAMES") = names(kLobeNames);
     m.attr("SAMPLED_LOBE_NAMES") = names(kSampledLobeNames);
     m.attr("SAMPLER_NAMES") = names(kSpecularSamplerNames);
+    m.attr("MODE_NAMES") = names(kTransportModeNames);
+    m.attr("GRADIENT_SLOTS") = kGradientSlots;
 }
 
 namespace {
@@ -88,7 +90,7 @@ void each_compensated(Model model, Function&& f) {
 
 // f or the lobes for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
 py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
-                                   int model, bool lobes, bool energy_compensation) {
+                                   int model, bool lobes, bool energy_compensation, int mode) {
     const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
     require_rows(wi, n, 3, "wi");
     require_rows(wo, n, 3, "wo");
@@ -111,8 +113,21 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
             Eigen::Map<Eigen::Vector3d>(row + 6) = result.specular;
             Eigen::Map<Eigen::Vector3d>(row + 9) = result.clearcoat;
             Eigen::Map<Eigen::Vector3d>(row + 12) = result.multiple_scattering;
+            Eigen::Map<Eigen::Vector3d>(row + 15) = result.transmission;
         };
-        if (energy_compensation) {
+        if (is_bsdf(which_model)) {
+            const TransportMode transport = mode_from(mode);
+            reference::Shading2015Cache shading;
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const auto& material = shading.of(material_rows.row(i));
+                const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+                if (lobes) {
+                    store(i, reference::eval_lobes(material, in, view, transport));
+                } else {
+                    Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, transport);
+                }
+            }
+        } else if (energy_compensation) {
             each_compensated(which_model, [&](auto& cache) {
                 for (py::ssize_t i = 0; i < n; ++i) {
                     const auto& material = cache.of(material_rows.row(i));
@@ -141,25 +156,38 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
 }
 
 // f (N,3) and its Jacobian (N,3,13) for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
-py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, const Float64Array& params, int model) {
+py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, const Float64Array& params, int model,
+                              int mode) {
     const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
     require_rows(wi, n, 3, "wi");
     require_rows(wo, n, 3, "wo");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
     const Model which_model = model_from(model);
-    py::array_t<double> value({n, py::ssize_t(3)}), jacobian({n, py::ssize_t(3), py::ssize_t(kParamSlots)});
+    const TransportMode transport = mode_from(mode);
+    const int slots = gradient_slots(which_model);
+    py::array_t<double> value({n, py::ssize_t(3)}), jacobian({n, py::ssize_t(3), py::ssize_t(slots)});
     const double* wi_data = wi.data();
     const double* wo_data = wo.data();
     double* value_data = value.mutable_data();
     double* jacobian_data = jacobian.mutable_data();
+    auto store = [&](py::ssize_t i, const auto& g) {
+        Eigen::Map<Eigen::Vector3d>(value_data + 3 * i) = g.value;
+        std::copy(g.jacobian.data(), g.jacobian.data() + 3 * slots, jacobian_data + 3 * slots * i);
+    };
     {
         py::gil_scoped_release release;
-        reference::GradientShadingCache prepared;
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
-            const reference::Gradient g = reference::eval_grad(prepared.of(material_rows.row(i)), in, view, which_model);
-            Eigen::Map<Eigen::Vector3d>(value_data + 3 * i) = g.value;
-            std::copy(g.jacobian.data(), g.jacobian.data() + 3 * kParamSlots, jacobian_data + 3 * kParamSlots * i);
+        if (is_bsdf(which_model)) {
+            reference::GradientShading2015Cache prepared;
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+                store(i, reference::eval_grad(prepared.of(material_rows.row(i)), in, view, transport));
+            }
+        } else {
+            reference::GradientShadingCache prepared;
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+                store(i, reference::eval_grad(prepared.of(material_rows.row(i)), in, view, which_model));
+            }
         }
     }
     return py::make_tuple(value, jacobian);
@@ -192,7 +220,7 @@ py::array_t<double> reference_eval_direction_grad(const Float64Array& wi, const 
 
 // docs/sampling.md: wo (N,3), u (N,3) = (u0, u1, u2), params (N,13); each may be one shared row.
 py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const Float64Array& params, int model,
-                           int sampler, bool energy_compensation) {
+                           int sampler, bool energy_compensation, int mode) {
     const py::ssize_t n = common_row_count({&wo, &u, &params});
     const Rows view = shared_or_rows(wo, n, 3, "wo");
     const Rows uniforms = shared_or_rows(u, n, 3, "u");
@@ -208,19 +236,28 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
     std::int32_t* lobe_data = lobe_out.mutable_data();
     {
         py::gil_scoped_release release;
+        auto store = [&](py::ssize_t i, const reference::Sample& s) {
+            Eigen::Map<Eigen::Vector3d>(wi_data + 3 * i) = s.wi;
+            pdf_data[i] = s.pdf;
+            Eigen::Map<Eigen::Vector3d>(weight_data + 3 * i) = s.weight;
+            lobe_data[i] = s.lobe;
+        };
         auto run = [&](auto& cache) {
             for (py::ssize_t i = 0; i < n; ++i) {
-                const auto& material = cache.of(material_rows.row(i));
                 const double* ui = uniforms.row(i);
-                const auto s = reference::sample(material, Eigen::Vector3d(view.row(i)), ui[0], ui[1], ui[2], which_model,
-                                                 which_sampler);
-                Eigen::Map<Eigen::Vector3d>(wi_data + 3 * i) = s.wi;
-                pdf_data[i] = s.pdf;
-                Eigen::Map<Eigen::Vector3d>(weight_data + 3 * i) = s.weight;
-                lobe_data[i] = s.lobe;
+                store(i, reference::sample(cache.of(material_rows.row(i)), Eigen::Vector3d(view.row(i)), ui[0], ui[1], ui[2],
+                                           which_model, which_sampler));
             }
         };
-        if (energy_compensation) {
+        if (is_bsdf(which_model)) {
+            const TransportMode transport = mode_from(mode);
+            reference::Shading2015Cache shading;
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const double* ui = uniforms.row(i);
+                store(i, reference::sample(shading.of(material_rows.row(i)), Eigen::Vector3d(view.row(i)), ui[0], ui[1], ui[2],
+                                           which_sampler, transport));
+            }
+        } else if (energy_compensation) {
             each_compensated(which_model, run);
         } else {
             reference::ShadingCache shading;
@@ -251,7 +288,10 @@ py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo
                                              which_sampler);
             }
         };
-        if (energy_compensation) {
+        if (is_bsdf(which_model)) {
+            reference::Shading2015Cache shading;
+            run(shading);
+        } else if (energy_compensation) {
             each_compensated(which_model, run);
         } else {
             reference::ShadingCache shading;
@@ -267,7 +307,8 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
     const py::ssize_t n = common_row_count({&wo, &params});
     const Rows view = shared_or_rows(wo, n, 3, "wo");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
-    py::array_t<double> out({n, py::ssize_t(3)});
+    const py::ssize_t lobes = is_bsdf(model_from(model)) ? 4 : 3;
+    py::array_t<double> out({n, lobes});
     double* out_data = out.mutable_data();
     {
         py::gil_scoped_release release;
@@ -275,10 +316,13 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
             for (py::ssize_t i = 0; i < n; ++i) {
                 const auto& material = cache.of(material_rows.row(i));
                 const auto p = reference::lobe_probabilities(material, Eigen::Vector3d(view.row(i)));
-                std::copy(p.begin(), p.end(), out_data + 3 * i);
+                std::copy(p.begin(), p.end(), out_data + lobes * i);
             }
         };
-        if (energy_compensation) {
+        if (is_bsdf(model_from(model))) {
+            reference::Shading2015Cache shading;
+            run(shading);
+        } else if (energy_compensation) {
             each_compensated(model_from(model), run);
         } else {
             reference::ShadingCache shading;
@@ -292,21 +336,22 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
 
 void bind_reference(py::module_& m) {
     m.def("reference_eval", &reference_eval, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
-          py::arg("lobes"), py::arg("energy_compensation") = false,
-          "Float64 reference f (N,3) or lobes (N,5,3) for packed, already validated rows.");
+          py::arg("lobes"), py::arg("energy_compensation") = false, py::arg("mode") = 0,
+          "Float64 reference f (N,3) or lobes (N,6,3) for packed, already validated rows.");
     m.def("reference_eval_grad", &reference_eval_grad, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
-          "Float64 reference f (N,3) and its Jacobian (N,3,13) over the parameter slots, for packed validated rows.");
+          py::arg("mode") = 0,
+          "Float64 reference f (N,3) and its Jacobian (N,3,P) over the model's P parameter slots, for packed validated rows.");
     m.def("reference_eval_direction_grad", &reference_eval_direction_grad, py::arg("wi"), py::arg("wo"), py::arg("params"),
           py::arg("model"), py::arg("cosine") = false,
           "Float64 reference derivatives (N,3,6) of f (times cos θl if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.");
     m.def("reference_sample", &reference_sample, py::arg("wo"), py::arg("u"), py::arg("params"), py::arg("model"),
-          py::arg("sampler"), py::arg("energy_compensation") = false,
+          py::arg("sampler"), py::arg("energy_compensation") = false, py::arg("mode") = 0,
           "Float64 reference samples (wi (N,3), pdf (N,), weight (N,3), lobe (N,) int32) for validated rows;\n"
           "each input is N rows or one shared row.");
     m.def("reference_pdf", &reference_pdf, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
           py::arg("sampler"), py::arg("energy_compensation") = false, "Float64 reference mixture pdf (N,) for validated rows (N or one shared row each).");
     m.def("reference_lobe_probabilities", &reference_lobe_probabilities, py::arg("wo"), py::arg("params"),
-          py::arg("model") = 0, py::arg("energy_compensation") = false, "Lobe probabilities (N,3) at wo for validated rows (N or one shared row each).");
+          py::arg("model") = 0, py::arg("energy_compensation") = false, "Lobe probabilities (N,3), (N,4) for the 2015 models, at wo for validated rows (N or one shared row each).");
 }
 
 }  // namespace principled_brdf::bindings

@@ -22,12 +22,13 @@ Enum enum_from(int index, const std::array<const char*, N>& names, const char* w
 }
 
 inline Model model_from(int index) { return enum_from<Model>(index, kModelNames, "model"); }
+inline TransportMode mode_from(int index) { return enum_from<TransportMode>(index, kTransportModeNames, "mode"); }
 inline SpecularSampler sampler_from(int index) {
     return enum_from<SpecularSampler>(index, kSpecularSamplerNames, "specular_sampler");
 }
 
 // The parameter slots of a derivative (Columns): None for all, or increasing slot indices.
-Columns columns_from(const pybind11::object& slots);
+Columns columns_from(const pybind11::object& slots, Model model);
 
 void bind_params(pybind11::module_& m);
 void bind_reference(pybind11::module_& m);

@@ -67,7 +67,7 @@ template <Layouts layouts>
 struct JacobianStore {
     const EvalJob& job;
     std::int64_t i;
-    alignas(64) float lanes[padded_rows(kJacobianWidth)][kLanes];
+    alignas(64) float lanes[padded_rows(kMaxJacobianWidth)][kLanes];
 
     // lanes left uninitialised: brace-initialising the aggregate zeroed 1.3 KB per batch
     JacobianStore(const EvalJob& job_, std::int64_t i_) : job(job_), i(i_) {}
@@ -164,6 +164,7 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
         store_rgb<layouts>(job.out[2], i, masked(values.specular_rgb(s)));
         store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
         store_rgb<layouts>(job.out[4], i, masked(ms.rgb(multiple_scattering)));
+        store_rgb<layouts>(job.out[5], i, zero);
     } else if constexpr (output != Output::kPdf) {
         store_rgb<layouts, true>(job.out[0], i, masked(ms.added_to(values.template total<lobes>(s), multiple_scattering)));
     }
@@ -214,6 +215,7 @@ PB_KERNEL_INLINE void eval_values_batch(const EvalJob& job, std::int64_t i, cons
             store_rgb<layouts>(job.out[2], i, masked(values.specular_rgb(s)));
             store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
             store_rgb<layouts>(job.out[4], i, zero);
+            store_rgb<layouts>(job.out[5], i, zero);
         } else {
             store_rgb<layouts, true>(job.out[0], i, masked(values.template total<lobes>(s)));
         }
@@ -322,13 +324,14 @@ PB_KERNEL_INLINE std::int64_t eval_two_batches(const EvalJob& job, std::int64_t 
     return -1;
 }
 
-// The last pad.count < kLanes elements, as one batch.
-template <Model model, Output output, bool per_element, bool compensated, LobeSet lobes>
-bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, compensated>& uniform) {
+// The last pad.count < kLanes elements, as one batch: one_batch(padded job)
+// runs the batch at element 0 of a job over padded copies (Layouts::kMixed).
+template <Output output, class OneBatch>
+bool eval_tail(const EvalJob& job, const Padding& pad, const OneBatch& one_batch) {
     alignas(64) PadBuffer wi, wo, cotangent, params[kParamSlots], out[kLobeCount];
     alignas(64) float pdf[kLanes];
-    alignas(64) float jacobian[has_jacobian(output) ? kJacobianWidth * kLanes : 1];
-    static_assert(kJacobianWidth >= kDirectionJacobianWidth, "the directions' Jacobian fits the buffer");
+    alignas(64) float jacobian[has_jacobian(output) ? kMaxJacobianWidth * kLanes : 1];
+    static_assert(kMaxJacobianWidth >= kDirectionJacobianWidth, "the directions' Jacobian fits the buffer");
     EvalJob padded = job;
     padded.wi = pad_vec3(job.wi, pad, wi);
     padded.wo = pad_vec3(job.wo, pad, wo);
@@ -340,7 +343,7 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const PreparedOf<output, 
     padded.jacobian = jacobian;
     padded.jacobian_row_stride = 0;
 
-    if (!eval_one_batch<model, output, per_element, Layouts::kMixed, compensated, lobes>(padded, 0, uniform)) return false;
+    if (!one_batch(padded)) return false;
 
     for (int k = 0; k < outputs; ++k) unpad_vec3(job.out[k], pad, out[k]);
     if (output == Output::kPdf || output == Output::kValuePdf) unpad_scalars(job.pdf, pad, pdf);
@@ -375,7 +378,10 @@ std::int64_t eval_batches(const EvalJob& job, std::int64_t begin, std::int64_t e
     }
     for (; i + kLanes <= end; i += kLanes)
         if (!eval_one_batch<model, output, per_element, layouts, compensated, lobes>(job, i, uniform)) return i;
-    if (i < end && !eval_tail<model, output, per_element, compensated, lobes>(job, Padding{i, end - i}, uniform)) return i;
+    auto one_batch = [&](const EvalJob& padded) {
+        return eval_one_batch<model, output, per_element, Layouts::kMixed, compensated, lobes>(padded, 0, uniform);
+    };
+    if (i < end && !eval_tail<output>(job, Padding{i, end - i}, one_batch)) return i;
     return -1;
 }
 
@@ -471,7 +477,11 @@ std::int64_t eval_compensated_range(const EvalJob& job, std::int64_t begin, std:
                                            : eval_range_for<Model::kDisney2014, output, true>(job, begin, end);
 }
 
+// The 2015 solid's loops (kernel_eval2015.hpp).
+inline std::int64_t eval2015_range(const EvalJob& job, std::int64_t begin, std::int64_t end);
+
 inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    if (is_bsdf(job.model)) return eval2015_range(job, begin, end);
     if (job.energy_compensation && !has_jacobian(job.output)) {
         switch (job.output) {
             case Output::kPdf: return eval_compensated_range<Output::kPdf>(job, begin, end);

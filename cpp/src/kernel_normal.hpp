@@ -13,7 +13,7 @@
 constexpr int kNormalTile = 4;
 
 // A batch's wanted columns, by channel and column (eval_gradient's sink writes them).
-using BatchColumns = float[3][kParamSlots][kLanes];
+using BatchColumns = float[3][kGradientSlots][kLanes];
 
 struct NormalSink {
     const Columns& columns;
@@ -27,7 +27,7 @@ struct NormalSink {
 // One problem's per-lane sums.
 struct NormalSums {
     alignas(64) float normal[kNormalWidth][kLanes];
-    alignas(64) float gradient[kParamSlots][kLanes];
+    alignas(64) float gradient[kGradientSlots][kLanes];
     alignas(64) double cost[kLanes];
 
     explicit NormalSums(int width) {
@@ -138,7 +138,8 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
     const std::int64_t b = job.problems[j];
     const std::int64_t n = job.pairs;
     RawMaterial m;
-    for (int s = 0; s < kParamSlots; ++s) m.slot[s] = Floats(job.slots[b * kParamSlots + s]);
+    for (int s = 0; s < kGradientSlots; ++s) m.slot[s] = Floats(job.slots[b * kGradientSlots + s]);
+    for (int s = kGradientSlots; s < kParamSlots; ++s) m.slot[s] = Floats(static_cast<float>(default_of(Param(s))));
     Prepared<Output::kGradient> material = prepare<Output::kGradient>(m);
     Floats gain(job.gain != nullptr ? job.gain[b] : 1.0f);
     const std::int64_t directions = job.per_problem_directions ? 3 * n * b : 0;

@@ -66,6 +66,7 @@ PB_KERNEL_INLINE void store_sample(const SampleJob& job, std::int64_t i, const L
         store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
         store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
         store_rgb<layouts>(job.lobe_weight[4], i, multiple_scattering_share);
+        store_rgb<layouts>(job.lobe_weight[5], i, Rgb<Floats>{Floats(0.0f), Floats(0.0f), Floats(0.0f)});
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
@@ -133,9 +134,10 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
     return true;
 }
 
-template <Model model, bool per_element, bool with_lobes, bool compensated, LobeSet lobes>
-bool sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>& uniform,
-                 const MultipleScatteringLobe<Floats>& uniform_ms, const CounterSeed& seed) {
+// The last pad.count < kLanes elements as one batch: one_batch(padded job)
+// runs the batch at element 0 of a job over padded copies (Layouts::kMixed).
+template <bool with_lobes, class OneBatch>
+bool sample_tail(const SampleJob& job, const Padding& pad, const OneBatch& one_batch) {
     alignas(64) PadBuffer wo, u, params[kParamSlots], wi, weight, lobe_weight[kLobeCount];
     alignas(64) float pdf[kLanes];
     alignas(64) std::int32_t lobe[kLanes];
@@ -151,8 +153,7 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const Shading<Floats>
     padded.lobe = lobe;
     padded.first_index = job.first_index + pad.begin;  // the generator sees the true element indices
 
-    if (!sample_one_batch<model, per_element, Layouts::kMixed, with_lobes, compensated, lobes>(padded, 0, uniform, uniform_ms, seed))
-        return false;
+    if (!one_batch(padded)) return false;
 
     unpad_vec3(job.wi, pad, wi);
     unpad_vec3(job.weight, pad, weight);
@@ -243,8 +244,10 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
         if (!sample_one_batch<model, per_element, layouts, with_lobes, compensated, lobes>(job, at(b), uniform, uniform_ms, seed))
             return at(b);
     const std::int64_t i = begin + batches * kLanes;
-    if (i < end && !sample_tail<model, per_element, with_lobes, compensated, lobes>(job, Padding{i, end - i}, uniform, uniform_ms, seed))
-        return i;
+    auto one_batch = [&](const SampleJob& padded) {
+        return sample_one_batch<model, per_element, Layouts::kMixed, with_lobes, compensated, lobes>(padded, 0, uniform, uniform_ms, seed);
+    };
+    if (i < end && !sample_tail<with_lobes>(job, Padding{i, end - i}, one_batch)) return i;
     return -1;
 }
 
@@ -291,8 +294,14 @@ std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int
     return sample_checked<model, per_element, Layouts::kMixed>(job, begin, end);
 }
 
+// The 2015 solid's loop (kernel_sample2015.hpp).
+template <bool per_element>
+std::int64_t sample2015_checked(const SampleJob& job, std::int64_t begin, std::int64_t end);
+
 inline std::int64_t sample_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     const bool per_element = !job.uniform_material();
+    if (is_bsdf(job.model))
+        return per_element ? sample2015_checked<true>(job, begin, end) : sample2015_checked<false>(job, begin, end);
     if (job.model == Model::kDisney2012)
         return per_element ? sample_range_for<Model::kDisney2012, true>(job, begin, end)
                            : sample_range_for<Model::kDisney2012, false>(job, begin, end);

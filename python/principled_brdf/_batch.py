@@ -21,6 +21,7 @@ import numpy as np
 
 from . import _core
 from ._validate import (
+    BSDF_MODELS,
     DIRECTION_LENGTH_TOLERANCE,
     as_real_array,
     broadcast_leading,
@@ -29,6 +30,7 @@ from ._validate import (
     element_name,
     flag,
     integer,
+    model_and_mode,
     model_index,
     require_float32,
     require_in_domain,
@@ -47,7 +49,7 @@ if TYPE_CHECKING:
 
     from numpy.typing import NDArray
 
-    from ._typing import Float32Array, FloatArray, Layout, Model, RealArrayLike, SpecularSampler
+    from ._typing import Float32Array, FloatArray, Layout, Mode, Model, RealArrayLike, SpecularSampler
 
 __all__ = ["eval", "eval_lobes", "eval_grad", "eval_vjp", "eval_pdf", "ValuePdf", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
 
@@ -61,6 +63,7 @@ if TYPE_CHECKING:  # the fields of LOBE_NAMES (the C++ table), spelled out for t
         specular: FloatArray
         clearcoat: FloatArray
         multiple_scattering: FloatArray
+        transmission: FloatArray
 else:
     _LobeArrays = NamedTuple("LobeArrays", [(name, np.ndarray) for name in LOBE_NAMES])
 
@@ -372,7 +375,7 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
               threads: SupportsIndex | None, check: bool, isa: str | None,
               outputs_for_shape: Callable[[tuple[int, ...], str], list[Float32Array]], pdf_sampler: int | None = None,
               gradient: bool = False, energy_compensation: bool = False, columns: list[int] | None = None,
-              cotangent: Float32Array | None = None, directions: bool = False) -> list[Float32Array]:
+              cotangent: Float32Array | None = None, directions: bool = False, mode_id: int = 0) -> list[Float32Array]:
     """eval / eval_lobes / pdf / eval_grad / eval_vjp: validated arguments in, outputs written.
     ``columns``: the slots a derivative is taken by (None: all). ``cotangent``
     (float32, f's layout, broadcasting to the call's shape): the output is
@@ -400,10 +403,10 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     options: _core.EvalOptions | _core.PdfOptions
     if pdf_sampler is None:
         options = _core.EvalOptions(model=model_id, cosine=cosine, energy_compensation=energy_compensation,
-                                    check_tolerance=tolerance, threads=thread_count, isa=isa_name)
+                                    mode=mode_id, check_tolerance=tolerance, threads=thread_count, isa=isa_name)
     else:
         options = _core.PdfOptions(model=model_id, sampler=pdf_sampler, cosine=cosine,
-                                   energy_compensation=energy_compensation, check_tolerance=tolerance,
+                                   energy_compensation=energy_compensation, mode=mode_id, check_tolerance=tolerance,
                                    threads=thread_count, isa=isa_name)
 
     third = None
@@ -462,7 +465,7 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
 def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
          cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None,
          out: Float32Array | None = None, check: bool = True, isa: str | None = None,
-         energy_compensation: bool = False) -> Float32Array:
+         energy_compensation: bool = False, mode: Mode = "radiance") -> Float32Array:
     """f(wi, wo) in 1/sr as float32, by the SIMD kernel (docs/model.md, "The model").
 
     ``wi``, ``wo``: unit directions, ``(..., 3)`` or with ``layout="soa"``
@@ -475,22 +478,29 @@ def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mod
     picks one of ``cpu_info()["available"]`` (for tests and benchmarks).
     ``energy_compensation=True`` adds the primary specular lobe's multiple
     scattering (Kulla & Conty 2017; docs/energy-compensation.md).
+    ``model="disney2015"``: the 2015 BSDF over the whole sphere
+    (docs/model-2015.md), ``cosine`` then multiplies by ``|cos θl|``, and ``mode``
+    (``"radiance"`` or ``"importance"``) says which way light flows through
+    the interface (the transmission differs by η_t²).
     """
-    (f,) = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
+    model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
+    (f,) = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa,
                      lambda leading, layout: [_output(out, _vec3_shape(leading, layout))],
-                     energy_compensation=energy_compensation)
+                     energy_compensation=energy_compensation, mode_id=mode_id)
     return f
 
 
 def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
                cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None, check: bool = True,
-               isa: str | None = None, energy_compensation: bool = False) -> Lobes:
-    """The lobes (diffuse, sheen, specular, clearcoat, multiple_scattering) as a
-    :class:`Lobes` of float32 arrays, each shaped like :func:`eval`'s result;
-    multiple_scattering is 0 unless ``energy_compensation``."""
-    outputs = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa,
+               isa: str | None = None, energy_compensation: bool = False, mode: Mode = "radiance") -> Lobes:
+    """The lobes (diffuse, sheen, specular, clearcoat, multiple_scattering,
+    transmission) as a :class:`Lobes` of float32 arrays, each shaped like
+    :func:`eval`'s result; multiple_scattering is 0 unless
+    ``energy_compensation``, transmission 0 but for the 2015 models."""
+    model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
+    outputs = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa,
                         lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in LOBE_NAMES],
-                        energy_compensation=energy_compensation)
+                        energy_compensation=energy_compensation, mode_id=mode_id)
     return Lobes(*outputs)
 
 
@@ -522,14 +532,15 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
               wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014", cosine: bool = False,
               layout: Layout = "aos", threads: SupportsIndex | None = None,
               out: tuple[Float32Array, Float32Array] | None = None, check: bool = True,
-              isa: str | None = None, energy_compensation: bool = False) -> Gradient:
+              isa: str | None = None, energy_compensation: bool = False, mode: Mode = "radiance") -> Gradient:
     """f and its Jacobian in the material's parameters, by the SIMD kernel in
     float32 (docs/gradients.md).
 
     Returns a :class:`Gradient`: ``value`` as :func:`eval` returns it,
     ``jacobian`` ``(..., 3, P)`` (``(3, P, ...)`` for ``layout="soa"``) with
     ``jacobian[..., c, k] = ∂f_c/∂names[k]``, and ``names``: the P parameters
-    ``wrt`` selects (default all 13 slots of the parameter table,
+    ``wrt`` selects (default all 13 slots of the parameter table the 2012
+    and 2014 models read, all 16 for ``model="disney2015"``,
     ``base_color`` as ``base_color_r/g/b``), in the table's order. A uniform
     parameter still gets a per-element derivative. ``out=(value, jacobian)``
     writes into preallocated float32 arrays of exactly those shapes. The other
@@ -543,8 +554,10 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
         return _direction_grad.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
                                          threads=threads, out=out, check=check, isa=isa,
                                          energy_compensation=energy_compensation)
-    wanted = _gradient.columns(wrt)
-    full = len(wanted) == len(GRADIENT_NAMES)
+    model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
+    names = _gradient.gradient_names(model)
+    wanted = _gradient.columns(wrt, names=names)
+    full = len(wanted) == len(GRADIENT_NAMES) and names is GRADIENT_NAMES  # (the 2015 models name their columns)
     _require_pair(out, "jacobian")
 
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
@@ -553,16 +566,17 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
         return [value, jacobian]
 
     # the kernel computes and writes the wanted columns only
-    value, jacobian = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
+    value, jacobian = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs,
                                 gradient=True, energy_compensation=energy_compensation,
-                                columns=None if full else wanted)
-    return Gradient(value, jacobian, tuple(GRADIENT_NAMES[k] for k in wanted))
+                                columns=None if full else wanted, mode_id=mode_id)
+    return Gradient(value, jacobian, tuple(names[k] for k in wanted))
 
 
 def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent: RealArrayLike, *,
              wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014", cosine: bool = False,
              layout: Layout = "aos", threads: SupportsIndex | None = None, check: bool = True,
-             isa: str | None = None, precision: Literal["float32", "float64"] = "float32") -> dict[str, FloatArray]:
+             isa: str | None = None, precision: Literal["float32", "float64"] = "float32",
+             mode: Mode = "radiance") -> dict[str, FloatArray]:
     """The vector-Jacobian product of f: for a cotangent g shaped like f,
     ``Σ_c g_c ∂f_c/∂p`` for each parameter slot p that ``wrt`` selects (as
     :func:`eval_grad`'s; default all), without forming the Jacobian
@@ -579,7 +593,9 @@ def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent
     :func:`eval_grad`'s.
     """
     _require_material(material)
-    wanted = _gradient.columns(wrt)
+    model_id, mode_id = model_and_mode(material, model, mode)
+    names = _gradient.gradient_names(model)
+    wanted = _gradient.columns(wrt, names=names)
     if not isinstance(precision, str) or precision not in ("float32", "float64"):
         raise ValueError(f"precision: expected 'float32' or 'float64', got {precision!r}")
     soa = _layout(layout) == "soa"
@@ -594,11 +610,11 @@ def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent
     if precision == "float64":
         from . import reference  # (imports this module)
 
-        gradient = reference.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout)
+        gradient = reference.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout, mode=mode)
         jacobian = gradient.jacobian if not soa else np.moveaxis(gradient.jacobian, (0, 1), (-2, -1))
         g_aos = g if not soa else np.moveaxis(g, 0, -1)
         products = np.einsum("...c,...ck->...k", np.broadcast_to(g_aos, jacobian.shape[:-1]), jacobian)
-        return _sum_to_parameters(material, products, wanted, np.float64)
+        return _sum_to_parameters(material, products, wanted, names, np.float64)
     g32 = g.astype(np.float32, copy=False)
     if g32 is not g and np.isinf(g32).any():
         raise ValueError("cotangent: values beyond float32's range")
@@ -606,12 +622,12 @@ def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
         return [np.empty(leading + (len(wanted),) if not soa else (len(wanted),) + leading, np.float32)]
 
-    (product,) = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
-                           energy_compensation=False, columns=wanted, cotangent=g32)
-    return _sum_to_parameters(material, product if not soa else np.moveaxis(product, 0, -1), wanted, np.float32)
+    (product,) = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs,
+                           energy_compensation=False, columns=wanted, cotangent=g32, mode_id=mode_id)
+    return _sum_to_parameters(material, product if not soa else np.moveaxis(product, 0, -1), wanted, names, np.float32)
 
 
-def _sum_to_parameters(material: Material, products: NDArray[Any], wanted: list[int],
+def _sum_to_parameters(material: Material, products: NDArray[Any], wanted: list[int], names: tuple[str, ...],
                        dtype: type[np.floating[Any]]) -> dict[str, FloatArray]:
     """``products`` ``(..., P)`` summed down to each selected parameter's own shape (float64 sums)."""
     result: dict[str, FloatArray] = {}
@@ -623,10 +639,10 @@ def _sum_to_parameters(material: Material, products: NDArray[Any], wanted: list[
         extra = column.ndim - len(own)
         axes = tuple(range(extra)) + tuple(extra + a for a, d in enumerate(own) if d == 1 and column.shape[extra + a] != 1)
         if not axes:  # one product an element: as it is
-            result[GRADIENT_NAMES[slot]] = np.ascontiguousarray(column, dtype=dtype).reshape(own)
+            result[names[slot]] = np.ascontiguousarray(column, dtype=dtype).reshape(own)
             continue
         total = column.sum(axis=axes, dtype=np.float64, keepdims=False)
-        result[GRADIENT_NAMES[slot]] = np.asarray(total, dtype=np.float64).reshape(own).astype(dtype)
+        result[names[slot]] = np.asarray(total, dtype=np.float64).reshape(own).astype(dtype)
     return result
 
 
@@ -638,8 +654,9 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
     either direction is at or below the horizon. It does not depend on the model
     (``model`` is checked and accepted, as every call takes it) unless
     ``energy_compensation``, whose lobe's mixture weight reads the model's tables."""
-    model_id = model_index(model)
-    (density,) = _evaluate(material, wi, wo, model_id if energy_compensation else 0, False, layout, threads, check, isa,
+    model_id = model_and_mode(material, model, energy_compensation=energy_compensation)[0]
+    by_model = energy_compensation or model in BSDF_MODELS  # else the pdf is the 2014 model's
+    (density,) = _evaluate(material, wi, wo, model_id if by_model else 0, False, layout, threads, check, isa,
                            lambda leading, layout: [np.empty(leading, np.float32)],
                            pdf_sampler=sampler_index(specular_sampler), energy_compensation=energy_compensation)
     return density
@@ -655,7 +672,8 @@ class ValuePdf(NamedTuple):
 def eval_pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
              cosine: bool = False, specular_sampler: SpecularSampler = "visible", layout: Layout = "aos",
              threads: SupportsIndex | None = None, out: tuple[Float32Array, Float32Array] | None = None,
-             check: bool = True, isa: str | None = None, energy_compensation: bool = False) -> ValuePdf:
+             check: bool = True, isa: str | None = None, energy_compensation: bool = False,
+             mode: Mode = "radiance") -> ValuePdf:
     """f and the sampling pdf of (wi, wo) in one kernel pass (what multiple importance
     sampling needs): ``value`` as :func:`eval` returns it, ``pdf`` as :func:`pdf` does.
     ``out=(value, pdf)`` writes into preallocated float32 arrays of those shapes."""
@@ -665,8 +683,10 @@ def eval_pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model:
         value, density = _output_pair(out, _vec3_shape(leading, layout), leading, "pdf")
         return [density, value]
 
-    density, value = _evaluate(material, wi, wo, model_index(model), cosine, layout, threads, check, isa, outputs,
-                               pdf_sampler=sampler_index(specular_sampler), energy_compensation=energy_compensation)
+    model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
+    density, value = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs,
+                               pdf_sampler=sampler_index(specular_sampler), energy_compensation=energy_compensation,
+                               mode_id=mode_id)
     return ValuePdf(value, density)
 
 
@@ -693,24 +713,24 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
            seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
            check: bool = True, isa: str | None = None, with_lobes: Literal[False] = False,
-           energy_compensation: bool = False) -> Sample: ...
+           energy_compensation: bool = False, mode: Mode = "radiance") -> Sample: ...
 @overload
 def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
            seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
            check: bool = True, isa: str | None = None, with_lobes: Literal[True],
-           energy_compensation: bool = False) -> tuple[Sample, Lobes]: ...
+           energy_compensation: bool = False, mode: Mode = "radiance") -> tuple[Sample, Lobes]: ...
 @overload
 def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
            seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
            check: bool = True, isa: str | None = None, with_lobes: bool = False,
-           energy_compensation: bool = False) -> Sample | tuple[Sample, Lobes]: ...
+           energy_compensation: bool = False, mode: Mode = "radiance") -> Sample | tuple[Sample, Lobes]: ...
 def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = None,
            seed: SupportsIndex | None = None, n: SupportsIndex | None = None, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
            check: bool = True, isa: str | None = None, with_lobes: bool = False,
-           energy_compensation: bool = False) -> Sample | tuple[Sample, Lobes]:
+           energy_compensation: bool = False, mode: Mode = "radiance") -> Sample | tuple[Sample, Lobes]:
     """Importance-sample ``wi`` for each ``wo`` (docs/sampling.md).
 
     ``u``: three uniforms in [0, 1] per element, ``(..., 3)`` (``(3, ...)`` for
@@ -727,9 +747,12 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     ``f_k(wi, wo) cos θl / pdf``, from the same pass (they sum to ``weight``).
     ``energy_compensation=True``: f includes the multiple-scattering lobe, drawn
     by the cosine lobe (its weight joins that lobe's chance, ``lobe`` 0).
+    ``model="disney2015"``: ``wi`` anywhere on the sphere, ``lobe`` 3 for the
+    transmission; weight ``f |cos θl| / pdf`` with ``f`` in ``mode``; a
+    transmission draw the microfacet reflects totally is no sample (``wi`` 0,
+    pdf and weight 0).
     """
-    _require_material(material)
-    model_id = model_index(model)
+    model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
     sampler = sampler_index(specular_sampler)
     layout = _layout(layout)
     thread_count = _threads(threads)
@@ -760,7 +783,8 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     shares = [np.empty_like(wi_out) for _ in LOBE_NAMES] if with_lobes else None
     call = _segmented(leading, layout, [None, wo_dirs, uniforms], material)
     (wo_flat, wo_code), (u_flat, u_code) = call.vectors[1:]
-    options = _core.SampleOptions(model=model_id, sampler=sampler, energy_compensation=energy_compensation, seed=seed,
+    options = _core.SampleOptions(model=model_id, sampler=sampler, energy_compensation=energy_compensation, mode=mode_id,
+                                  seed=seed,
                                   check_tolerance=DIRECTION_LENGTH_TOLERANCE if check else 0.0,
                                   threads=thread_count, isa=isa_name)
     bad = _core.batch_sample(

@@ -40,6 +40,8 @@ MODEL_NAMES: Final[tuple[str, ...]]
 LOBE_NAMES: Final[tuple[str, ...]]
 SAMPLED_LOBE_NAMES: Final[tuple[str, ...]]
 SAMPLER_NAMES: Final[tuple[str, ...]]
+MODE_NAMES: Final[tuple[str, ...]]
+GRADIENT_SLOTS: Final[int]
 
 @type_check_only
 class _CpuInfo(TypedDict):
@@ -49,14 +51,20 @@ class _CpuInfo(TypedDict):
     threads: int
 
 def reference_eval(
-    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, lobes: bool, energy_compensation: bool = False
+    wi: _Float64In,
+    wo: _Float64In,
+    params: _Float64In,
+    model: _Int,
+    lobes: bool,
+    energy_compensation: bool = False,
+    mode: _Int = 0,
 ) -> NDArray[np.float64]:
-    """Float64 reference f (N,3) or lobes (N,5,3) for packed, already validated rows."""
+    """Float64 reference f (N,3) or lobes (N,6,3) for packed, already validated rows."""
 
 def reference_eval_grad(
-    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int
+    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, mode: _Int = 0
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Float64 reference f (N,3) and its Jacobian (N,3,13) over the parameter slots, for packed validated rows."""
+    """Float64 reference f (N,3) and its Jacobian (N,3,P) over the model's P parameter slots, for packed validated rows."""
 
 def reference_eval_direction_grad(
     wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, cosine: bool = False
@@ -64,7 +72,13 @@ def reference_eval_direction_grad(
     """Float64 reference derivatives (N,3,6) of f (times cos θl if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z."""
 
 def reference_sample(
-    wo: _Float64In, u: _Float64In, params: _Float64In, model: _Int, sampler: _Int, energy_compensation: bool = False
+    wo: _Float64In,
+    u: _Float64In,
+    params: _Float64In,
+    model: _Int,
+    sampler: _Int,
+    energy_compensation: bool = False,
+    mode: _Int = 0,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32]]:
     """Float64 reference samples (wi (N,3), pdf (N,), weight (N,3), lobe (N,) int32) for validated rows;
     each input is N rows or one shared row."""
@@ -77,7 +91,7 @@ def reference_pdf(
 def reference_lobe_probabilities(
     wo: _Float64In, params: _Float64In, model: _Int = 0, energy_compensation: bool = False
 ) -> NDArray[np.float64]:
-    """Lobe probabilities (N,3) at wo for validated rows (N or one shared row each)."""
+    """Lobe probabilities (N,3), (N,4) for the 2015 models, at wo for validated rows (N or one shared row each)."""
 
 class EvalOptions:
     """The options of batch_eval and batch_eval_grad."""
@@ -85,6 +99,7 @@ class EvalOptions:
     model: int
     cosine: bool
     energy_compensation: bool
+    mode: int
     check_tolerance: float
     threads: int
     isa: str
@@ -94,6 +109,7 @@ class EvalOptions:
         model: _Int = 0,
         cosine: bool = False,
         energy_compensation: bool = False,
+        mode: _Int = 0,
         check_tolerance: _Float = 0.0,
         threads: _Int = 0,
         isa: str = "",
@@ -106,6 +122,7 @@ class PdfOptions:
     sampler: int
     cosine: bool
     energy_compensation: bool
+    mode: int
     check_tolerance: float
     threads: int
     isa: str
@@ -116,6 +133,7 @@ class PdfOptions:
         sampler: _Int = 0,
         cosine: bool = False,
         energy_compensation: bool = False,
+        mode: _Int = 0,
         check_tolerance: _Float = 0.0,
         threads: _Int = 0,
         isa: str = "",
@@ -127,6 +145,7 @@ class SampleOptions:
     model: int
     sampler: int
     energy_compensation: bool
+    mode: int
     seed: int
     check_tolerance: float
     threads: int
@@ -137,6 +156,7 @@ class SampleOptions:
         model: _Int = 0,
         sampler: _Int = 0,
         energy_compensation: bool = False,
+        mode: _Int = 0,
         seed: _Int = 0,
         check_tolerance: _Float = 0.0,
         threads: _Int = 0,

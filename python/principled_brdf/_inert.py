@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._gradient import GRADIENT_NAMES
+from ._gradient import DIFFERENTIABLE, GRADIENT_NAMES
 from .material import PARAMETERS
 
 _FIRST_ORDER_CHANGE = 1e-8  # of max |f|: below float32's resolution (6e-8)
@@ -42,7 +42,7 @@ if TYPE_CHECKING:
 def _whole_parameters(slots: Sequence[int]) -> list[list[int]]:
     """The fitted slots grouped by parameter (base_color's three together)."""
     groups = []
-    for info in PARAMETERS.values():
+    for info in DIFFERENTIABLE.values():
         group = [k for k in range(info.first_slot, info.first_slot + info.slots) if k in slots]
         if group:
             groups.append(group)

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from collections.abc import Mapping
 
 # Options the differentiable operations pass on to eval and eval_grad.
-EVAL_OPTIONS = ("model", "cosine")
+EVAL_OPTIONS = ("model", "cosine", "mode")
 
 
 def parameter_names(material: Mapping[str, Any]) -> list[str]:

@@ -17,7 +17,7 @@ from typing import Any, Literal, Protocol, SupportsIndex, Union
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["RealArrayLike", "Index", "Model", "Layout", "SpecularSampler", "Float32Array", "Float64Array",
+__all__ = ["RealArrayLike", "Index", "Model", "Mode", "Layout", "SpecularSampler", "Float32Array", "Float64Array",
            "FloatArray"]
 
 _RealDType = np.dtype[Union[np.bool_, np.integer[Any], np.floating[Any]]]
@@ -40,7 +40,8 @@ RealArrayLike = Union[
 _Key = Union[SupportsIndex, slice, None, NDArray[Union[np.integer[Any], np.bool_]], Sequence[int]]
 Index = Union[_Key, tuple[_Key, ...]]  # what indexes a Material's leading shape, as numpy indexes
 
-Model = Literal["disney2014", "disney2012"]  # _core.MODEL_NAMES
+Model = Literal["disney2014", "disney2012", "disney2015"]  # _core.MODEL_NAMES
+Mode = Literal["radiance", "importance"]  # _core.MODE_NAMES
 SpecularSampler = Literal["visible", "distribution"]  # _core.SAMPLER_NAMES
 Layout = Literal["aos", "soa"]
 

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from numpy.typing import NDArray
 
     from ._typing import Float64Array, FloatArray
+    from .material import Material
 
 DIRECTION_LENGTH_TOLERANCE = 1e-3
 # A direction passes when its float64 squared length, summed as x² + y² + z²,
@@ -234,6 +235,30 @@ def model_index(model: object) -> int:
     if not isinstance(model, str) or model not in MODELS:
         raise ValueError(f"model: expected one of {sorted(MODELS)}, got {model!r}")
     return MODELS[model]
+
+
+MODES = {name: index for index, name in enumerate(_core.MODE_NAMES)}
+# The models of the whole sphere (the 2015 BSDF, docs/model-2015.md); the others are BRDFs.
+BSDF_MODELS = ("disney2015",)
+
+
+def mode_index(mode: object) -> int:
+    if not isinstance(mode, str) or mode not in MODES:
+        raise ValueError(f"mode: expected one of {sorted(MODES)}, got {mode!r}")
+    return MODES[mode]
+
+
+def model_and_mode(material: Material, model: object, mode: object = "radiance",
+                   energy_compensation: object = False) -> tuple[int, int]:
+    """The indices of ``model`` and ``mode``, after the rules a model sets: its
+    unread parameters at their defaults (:meth:`Material.require_read_by`), and
+    for the 2015 models no energy compensation."""
+    model_id, mode_id = model_index(model), mode_index(mode)
+    if hasattr(material, "require_read_by"):  # (else the caller's material check names the argument)
+        material.require_read_by(str(model))
+    if model in BSDF_MODELS and flag("energy_compensation", energy_compensation):
+        raise ValueError(f"energy_compensation: not available for model {model!r} (docs/model-2015.md)")
+    return model_id, mode_id
 
 
 def sampler_index(specular_sampler: object) -> int:

@@ -1,6 +1,8 @@
 """Directional albedo by importance sampling: the fraction of light arriving
-from everywhere that leaves towards wo, ∫ f(wi, wo) cos θl dωi, per lobe and
-in total, with its Monte Carlo standard error."""
+from everywhere that leaves towards wo, ∫ f(wi, wo) |cos θl| dωi, per lobe and
+in total, with its Monte Carlo standard error; for the 2015 models also split
+into the light from wo's side (reflectance) and through the surface
+(transmittance)."""
 
 from __future__ import annotations
 
@@ -9,13 +11,14 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ._batch import Lobes, random_uniforms, sample
-from ._validate import LOBE_NAMES, as_real_array, broadcast_leading, integer_in, require_in_domain, seed_value
+from ._validate import (BSDF_MODELS, LOBE_NAMES, as_real_array, broadcast_leading, integer_in, require_in_domain,
+                        seed_value)
 from .material import PARAMETERS, Material, _require_material
 
 if TYPE_CHECKING:
     from typing import Any, SupportsIndex
 
-    from ._typing import Float64Array, Model, RealArrayLike, SpecularSampler
+    from ._typing import Float64Array, Mode, Model, RealArrayLike, SpecularSampler
 
 __all__ = ["Albedo", "albedo"]
 
@@ -29,9 +32,11 @@ class Albedo(NamedTuple):
     """Directional albedo at each cos θo, RGB ``(..., 3)``, with standard errors."""
 
     total: Float64Array
-    lobes: Lobes  # diffuse, sheen, specular, clearcoat, multiple_scattering
+    lobes: Lobes  # diffuse, sheen, specular, clearcoat, multiple_scattering, transmission
     total_error: Float64Array  # standard error of the mean
     lobe_errors: Lobes
+    reflectance: Float64Array  # the part from wo's side of the surface (the total for a BRDF)
+    transmittance: Float64Array  # the part through the surface (0 for a BRDF)
 
 
 def _with_sample_axis(material: Material, leading: tuple[int, ...]) -> Material:
@@ -48,19 +53,27 @@ def _with_sample_axis(material: Material, leading: tuple[int, ...]) -> Material:
 
 def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsIndex = 1 << 16,
            seed: SupportsIndex = 0, model: Model = "disney2014", specular_sampler: SpecularSampler = "visible",
-           threads: SupportsIndex | None = None, energy_compensation: bool = False) -> Albedo:
-    """Directional albedo ``E(wo) = ∫ f(wi, wo) cos θl dωi`` for ``wo = (sin θo, 0, cos θo)``.
+           threads: SupportsIndex | None = None, energy_compensation: bool = False,
+           mode: Mode = "radiance") -> Albedo:
+    """Directional albedo ``E(wo) = ∫ f(wi, wo) |cos θl| dωi`` for ``wo = (sin θo, 0, cos θo)``.
 
     ``cos_theta_o`` in (0, 1], any shape, broadcast with the material's
-    leading shape. Each albedo is the mean of ``samples`` importance-sampled
-    weights (``pb.sample``, seeded, so the call is reproducible); errors are
-    the standard errors of those means. ``energy_compensation`` as in ``pb.sample``.
+    leading shape; for the 2015 models in [-1, 1] without 0, a negative one
+    a view from inside the solid. Each albedo is the mean of ``samples``
+    importance-sampled weights (``pb.sample``, seeded, so the call is
+    reproducible); errors are the standard errors of those means.
+    ``reflectance`` and ``transmittance`` split the total by the side ``wi``
+    lies on (wo's, or the other one). ``energy_compensation`` and ``mode`` as
+    in ``pb.sample``; in importance mode the albedo of a clear dielectric
+    (``spec_trans=1``, white) is at most 1 from either side.
     """
     _require_material("material", material)
     cos_o = as_real_array("cos_theta_o", cos_theta_o)
-    require_in_domain("cos_theta_o", cos_o, 0.0, 1.0)
+    whole_sphere = model in BSDF_MODELS
+    require_in_domain("cos_theta_o", cos_o, -1.0 if whole_sphere else 0.0, 1.0)
     if np.any(cos_o == 0.0):
-        raise ValueError("cos_theta_o: the albedo is defined for cos θo > 0")
+        raise ValueError("cos_theta_o: the albedo is defined for cos θo != 0" if whole_sphere
+                         else "cos_theta_o: the albedo is defined for cos θo > 0")
     count = integer_in("samples", samples, 2, MAX_SAMPLES)
     seed = seed_value(seed)
     leading = broadcast_leading(cos_theta_o=cos_o.shape, material=material.shape)
@@ -68,7 +81,7 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
     cos_flat = np.broadcast_to(cos_o, leading).reshape(-1)
     m = cos_flat.size
 
-    sums = np.zeros((1 + len(LOBE_NAMES), m, 3))  # total, then the lobes
+    sums = np.zeros((3 + len(LOBE_NAMES), m, 3))  # total, the lobes, reflectance, transmittance
     squares = np.zeros_like(sums)
     per_chunk = max(1, _CHUNK_ELEMENTS // count)
     flat_material = _flatten(expanded, leading)
@@ -82,8 +95,10 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
         # one kernel pass: the weight and each lobe's share of it
         drawn, shares = sample(chunk_material, wo, u=u, model=model, specular_sampler=specular_sampler,
                                threads=threads, check=False, with_lobes=True,
-                               energy_compensation=energy_compensation)
-        for k, weight in enumerate((drawn.weight, *shares)):
+                               energy_compensation=energy_compensation, mode=mode)
+        through = (drawn.wi[..., 2] * wo[..., 2] < 0)[..., None]
+        split = (np.where(through, 0.0, drawn.weight), np.where(through, drawn.weight, 0.0))
+        for k, weight in enumerate((drawn.weight, *shares, *split)):
             weight = weight.astype(np.float64)
             sums[k, start:stop] = weight.sum(axis=1)
             squares[k, start:stop] = np.square(weight).sum(axis=1)
@@ -92,11 +107,14 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
     variance = np.maximum(squares / count - mean * mean, 0.0) * count / (count - 1)
     error = np.sqrt(variance / count)
     shape = leading + (3,)
+    lobes = range(1, 1 + len(LOBE_NAMES))
     return Albedo(
         total=mean[0].reshape(shape),
-        lobes=Lobes(*(mean[k].reshape(shape) for k in range(1, len(sums)))),
+        lobes=Lobes(*(mean[k].reshape(shape) for k in lobes)),
         total_error=error[0].reshape(shape),
-        lobe_errors=Lobes(*(error[k].reshape(shape) for k in range(1, len(sums)))),
+        lobe_errors=Lobes(*(error[k].reshape(shape) for k in lobes)),
+        reflectance=mean[-2].reshape(shape),
+        transmittance=mean[-1].reshape(shape),
     )
 
 

@@ -24,7 +24,7 @@ import numpy as np
 
 from . import _validate
 from ._batch import eval as _eval
-from ._gradient import GRADIENT_NAMES
+from ._gradient import DIFFERENTIABLE as _DIFFERENTIABLE, GRADIENT_NAMES
 from .material import PARAMETERS, Material
 
 if typing.TYPE_CHECKING:
@@ -128,7 +128,7 @@ class TextureFit(typing.NamedTuple):
         """The fitted texture as a per-texel Material (computes the slots)."""
         slots = np.asarray(compute(self.slots, progress=False)[0])
         values = {name: slots[..., info.first_slot:info.first_slot + info.slots] if info.slots == 3
-                  else slots[..., info.first_slot] for name, info in PARAMETERS.items()}
+                  else slots[..., info.first_slot] for name, info in _DIFFERENTIABLE.items()}
         return Material(**values, bright_base_color=True)
 
 

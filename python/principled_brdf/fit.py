@@ -26,7 +26,7 @@ import numpy as np
 from . import _gradient, _inert, _solver, _validate
 from ._loss_scale import log_scale, log_scales
 from ._batch import eval, eval_grad
-from ._gradient import GRADIENT_NAMES
+from ._gradient import DIFFERENTIABLE as _DIFFERENTIABLE, GRADIENT_NAMES
 from .material import PARAMETERS, Material
 from . import reference
 
@@ -47,7 +47,7 @@ __all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES", "METHODS"]
 
 # Default bounds for fitting: the domains, with the unbounded parameters held
 # to [0, 1] as the BRDF Explorer's sliders are (pass bounds= to widen them).
-FIT_BOUNDS = {name: (max(info.lower, 0.0), min(info.upper, 1.0)) for name, info in PARAMETERS.items()}
+FIT_BOUNDS = {name: (max(info.lower, 0.0), min(info.upper, 1.0)) for name, info in _DIFFERENTIABLE.items()}
 LOSSES = ("scaled_log", "log", "relative", "linear")
 METHODS = ("batched", "scipy")
 # The batched solver stops when a taken step lowers the cost by less than this
@@ -94,7 +94,7 @@ class FitResult:
                          f"{int(np.atleast_1d(self.iterations)[row])} iterations, "
                          f"cost {float(np.atleast_1d(self.cost)[row]):.6g}")
             shown = []
-            for name, info in PARAMETERS.items():
+            for name, info in _DIFFERENTIABLE.items():
                 v = values[info.first_slot:info.first_slot + info.slots]
                 shown.append(f"{name}=({', '.join(f'{c:.4g}' for c in v)})" if info.slots == 3 else f"{name}={v[0]:.4g}")
             lines.append("  " + ", ".join(shown))
@@ -130,7 +130,7 @@ def _slot_bounds(
     if bounds is not None and not isinstance(bounds, _Mapping):
         raise TypeError(f"bounds: expected a mapping {{name: (lower, upper)}}, got {type(bounds).__name__}")
     for name, pair in (bounds or {}).items():
-        if name not in PARAMETERS:
+        if name not in _DIFFERENTIABLE:
             raise ValueError(f"bounds: unknown parameter {name!r}")
         low, high = _bound_pair(name, pair)
         info = PARAMETERS[name]
@@ -140,7 +140,7 @@ def _slot_bounds(
         merged[name] = (low, high)
     lower = np.empty(len(GRADIENT_NAMES))
     upper = np.empty(len(GRADIENT_NAMES))
-    for name, info in PARAMETERS.items():
+    for name, info in _DIFFERENTIABLE.items():
         lower[info.first_slot:info.first_slot + info.slots] = merged[name][0]
         upper[info.first_slot:info.first_slot + info.slots] = merged[name][1]
     return lower, upper
@@ -153,13 +153,14 @@ def _initial_slots(init: Material | dict[str, Any] | None) -> Float64Array:
         init = Material(**init)
     if not isinstance(init, Material) or not init.is_uniform:
         raise TypeError("init: expected a uniform principled_brdf.Material or a dict of its parameters")
-    return np.asarray(init.packed(()), dtype=np.float64).reshape(-1)
+    init.require_read_by("disney2014")  # (the fitted models read the same parameters)
+    return np.asarray(init.packed(()), dtype=np.float64).reshape(-1)[:len(GRADIENT_NAMES)]
 
 
 def _material_of(slot_values: Float64Array) -> Material:
     """A material from slot values ``(..., 13)``, uniform when one row."""
     values: dict[str, Any] = {}  # Material's keywords
-    for name, info in PARAMETERS.items():
+    for name, info in _DIFFERENTIABLE.items():
         block = slot_values[..., info.first_slot:info.first_slot + info.slots]
         values[name] = block if info.slots == 3 else block[..., 0]
     return Material(**values)

@@ -95,7 +95,7 @@ def eval(material: Mapping[str, Any], wi: Any, wo: Any, **options: Any) -> jax.A
 
     ``material``: a mapping of parameter names to arrays or numbers (the others
     take their defaults). Parameters and directions broadcast as in
-    :func:`principled_brdf.eval`. ``options``: ``model``, ``cosine``. The
+    :func:`principled_brdf.eval`. ``options``: ``model``, ``cosine``, ``mode``. The
     computation runs in float64 (the reference) when ``wi`` is float64, else in
     float32 (the SIMD kernels); parameters are cast to that dtype.
     """

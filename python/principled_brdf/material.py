@@ -1,4 +1,4 @@
-"""The material: the 11 parameters of docs/model.md, "The model", each uniform or per element."""
+"""The material: the 14 parameters of docs/model.md, "The model", and docs/model-2015.md, each uniform or per element."""
 
 from __future__ import annotations
 
@@ -14,6 +14,8 @@ from ._validate import as_real_array, broadcast_leading, element_name, first_tru
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
     from typing import NoReturn, SupportsIndex
+
+    from numpy.typing import NDArray
 
     from ._typing import Float32Array, Float64Array, Index, RealArrayLike
 
@@ -38,6 +40,11 @@ class _ParamInfo:
 # Names, defaults and domains come from the C++ table (params.hpp), defined once.
 PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
 
+# The parameters each model leaves unread, which must be at their defaults (docs/model-2015.md).
+_READ_BY_2015 = ("spec_trans", "flatness", "diff_trans")
+_READ_BY_2015_MODELS = ("disney2015",)
+_UNREAD_BY = {"disney2014": _READ_BY_2015, "disney2012": _READ_BY_2015, "disney2015": ("subsurface", "diff_trans")}
+
 
 
 def _owned_copy(array: Float64Array) -> Float64Array:
@@ -61,6 +68,10 @@ class Material:
     ``ior=`` (keyword, instead of ``specular``) sets ``specular`` from an index of
     refraction (:func:`specular_of_ior`); :attr:`ior` reads it back. It is not a
     second stored parameter.
+
+    ``spec_trans``, ``flatness`` and ``diff_trans`` are read by the 2015 models
+    only (docs/model-2015.md); a model refuses a parameter it does not read
+    unless it is at its default (:meth:`require_read_by`).
     """
 
     __slots__ = tuple(PARAMETERS) + ("_shape", "_float32_cache", "_kernel_numbers")
@@ -77,6 +88,9 @@ class Material:
     sheen_tint: Float64Array
     clearcoat: Float64Array
     clearcoat_gloss: Float64Array
+    spec_trans: Float64Array
+    flatness: Float64Array
+    diff_trans: Float64Array
     _shape: tuple[int, ...]
     _float32_cache: dict[tuple[str, tuple[int, ...] | None], Float32Array]
     # the SIMD kernels' per-parameter entry (a number, base_color's three, or None
@@ -96,6 +110,9 @@ class Material:
         sheen_tint: RealArrayLike = PARAMETERS["sheen_tint"].default,
         clearcoat: RealArrayLike = PARAMETERS["clearcoat"].default,
         clearcoat_gloss: RealArrayLike = PARAMETERS["clearcoat_gloss"].default,
+        spec_trans: RealArrayLike = PARAMETERS["spec_trans"].default,
+        flatness: RealArrayLike = PARAMETERS["flatness"].default,
+        diff_trans: RealArrayLike = PARAMETERS["diff_trans"].default,
         *,
         ior: RealArrayLike | None = None,
         bright_base_color: bool = False,
@@ -189,6 +206,27 @@ class Material:
         """The same elements in a new leading shape (``m.reshape(-1)`` for flattened directions)."""
         new_shape = np.empty(self.shape, dtype=np.int8).reshape(*shape).shape  # type: ignore[arg-type]  # as numpy's
         return self._per_element(lambda array: array.reshape(new_shape + array.shape[len(self.shape):]))
+
+    def require_read_by(self, model: str) -> None:
+        """A ValueError naming the first parameter ``model`` does not read that is
+        not at its default, or a ``specular`` the 2015 models cannot turn into an
+        index of refraction (docs/model-2015.md, "Parameters")."""
+        for name in _UNREAD_BY.get(model, ()):
+            default = PARAMETERS[name].default
+            self._require_everywhere(name, lambda array: array == default,
+                                     f"model {model!r} does not read it and needs its default {default:g} "
+                                     + ("(use flatness)" if name == "subsurface" else ""))
+        if model in _READ_BY_2015_MODELS:
+            self._require_everywhere("specular", lambda array: array < 12.5,
+                                     f"model {model!r} needs specular < 12.5 (a finite index of refraction)")
+
+    def _require_everywhere(self, name: str, holds: Callable[[Float64Array], NDArray[np.bool_]], rule: str) -> None:
+        array: Float64Array = getattr(self, name)
+        if array.size == 0 or holds(unexpanded(array)).all():
+            return
+        index = first_true(~np.broadcast_to(holds(array), array.shape))
+        value = float(array.reshape(-1)[index])
+        raise ValueError(f"{element_name(name, index, array.shape)}: {rule.strip()}, got {value:g}")
 
     def as_dict(self) -> dict[str, Float64Array]:
         return {name: getattr(self, name) for name in PARAMETERS}

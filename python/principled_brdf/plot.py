@@ -60,8 +60,9 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
 __all__ = ["brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves", "parameter_sweep", "blend_demo",
            "microfacet_family", "slice_directions", "SCALAR_PARAMETERS", "CHANNELS", "ALBEDO_QUADRATURE"]
 
-#: The ten scalar parameters of the model, in the library's order.
-SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items() if info.slots == 1)
+#: The ten scalar parameters of the 2012 and 2014 models, in the library's order.
+SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items()
+                          if info.slots == 1 and name not in ("spec_trans", "flatness", "diff_trans"))
 
 #: Channel names accepted by the scalar plots and their weights on linear RGB.
 CHANNELS = {

@@ -18,7 +18,7 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
 
     from numpy.typing import NDArray
 
-    from ._typing import Float64Array, Layout, Model, RealArrayLike, SpecularSampler
+    from ._typing import Float64Array, Layout, Mode, Model, RealArrayLike, SpecularSampler
 
     _Scalar = typing.TypeVar("_Scalar", bound=np.generic)
 
@@ -56,6 +56,7 @@ def _prepare(material: Material, wi: RealArrayLike, wo: RealArrayLike,
              model: Model) -> tuple[tuple[int, ...], Float64Array, Float64Array, Float64Array, int]:
     _require_material("material", material)
     model_id = _validate.model_index(model)
+    material.require_read_by(model)
     wi = _validate.directions("wi", wi)
     wo = _validate.directions("wo", wo)
     shape = _validate.broadcast_leading(wi=wi.shape[:-1], wo=wo.shape[:-1], material=material.shape)
@@ -69,25 +70,28 @@ def _prepare(material: Material, wi: RealArrayLike, wo: RealArrayLike,
 # reference is one float64 loop, and always checks its directions.
 
 def eval(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
-         cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False) -> Float64Array:
-    """f(wi, wo) in 1/sr as float64 ``(..., 3)`` (``(3, ...)`` for ``layout="soa"``); times cos θl if ``cosine``."""
+         cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False,
+         mode: Mode = "radiance") -> Float64Array:
+    """f(wi, wo) in 1/sr as float64 ``(..., 3)`` (``(3, ...)`` for ``layout="soa"``); times ``|cos θl|`` if ``cosine``."""
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
+    mode_id = _validate.model_and_mode(material, model, mode, energy_compensation)[1]
     cosine = _validate.flag("cosine", cosine)
     f = _core.reference_eval(wi_rows, wo_rows, params, model_id, False,
-                             _validate.flag("energy_compensation", energy_compensation))
+                             _validate.flag("energy_compensation", energy_compensation), mode_id)
     if cosine:
-        f *= np.maximum(wi_rows[:, 2:3], 0.0)
+        f *= _cosine_factor(wi_rows[:, 2:3], model)
     return _as_layout(f.reshape(shape + (3,)), soa)
 
 
 def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
               wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014",
-              cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False) -> Gradient:
+              cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False,
+              mode: Mode = "radiance") -> Gradient:
     """f in float64 and its Jacobian in the material's parameters (docs/gradients.md):
     ``value`` ``(..., 3)`` as :func:`eval`, ``jacobian`` ``(..., 3, P)`` with
     ``jacobian[..., c, k] = ∂f_c/∂names[k]``, ``names`` the P parameters ``wrt``
-    selects (default all 13, ``base_color`` as three channels). A uniform
+    selects (default all 13, 16 for ``model="disney2015"``, ``base_color`` as three channels). A uniform
     parameter still gets a per-element derivative. ``layout="soa"``: ``(3, ...)``
     and ``(3, P, ...)``. ``energy_compensation=True`` raises NotImplementedError.
     ``wrt`` may also name ``"wi"`` and ``"wo"`` (three columns each, after the
@@ -98,31 +102,40 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     if _validate.flag("energy_compensation", energy_compensation):
         raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
                                   "multiple-scattering lobe is not implemented)")
+    mode_id = _validate.model_and_mode(material, model, mode)[1]
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     cosine = _validate.flag("cosine", cosine)
-    wanted = _gradient.columns(wrt)
-    value, jacobian = _core.reference_eval_grad(wi_rows, wo_rows, params, model_id)
+    names = _gradient.gradient_names(model)
+    wanted = _gradient.columns(wrt, names=names)
+    value, jacobian = _core.reference_eval_grad(wi_rows, wo_rows, params, model_id, mode_id)
     if cosine:
-        cos_theta_l = np.maximum(wi_rows[:, 2], 0.0)
+        cos_theta_l = _cosine_factor(wi_rows[:, 2], model)
         value *= cos_theta_l[:, None]
         jacobian *= cos_theta_l[:, None, None]
-    result = _gradient.result(value.reshape(shape + (3,)), jacobian.reshape(shape + jacobian.shape[1:]), wanted)
+    result = _gradient.result(value.reshape(shape + (3,)), jacobian.reshape(shape + jacobian.shape[1:]), wanted, names)
     return Gradient(_as_layout(result.value, soa), _as_layout(result.jacobian, soa, trailing=2), result.names)
 
 
 def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
-               cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False) -> Lobes:
+               cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False,
+               mode: Mode = "radiance") -> Lobes:
     """The lobes as a :class:`Lobes` of float64 ``(..., 3)`` (``(3, ...)``) arrays
-    (multiple_scattering 0 unless ``energy_compensation``)."""
+    (multiple_scattering 0 unless ``energy_compensation``, transmission 0 but for the 2015 models)."""
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
+    mode_id = _validate.model_and_mode(material, model, mode, energy_compensation)[1]
     cosine = _validate.flag("cosine", cosine)
     lobes = _core.reference_eval(wi_rows, wo_rows, params, model_id, True,
-                                 _validate.flag("energy_compensation", energy_compensation))
+                                 _validate.flag("energy_compensation", energy_compensation), mode_id)
     if cosine:
-        lobes *= np.maximum(wi_rows[:, None, 2:3], 0.0)
+        lobes *= _cosine_factor(wi_rows[:, None, 2:3], model)
     return Lobes(*(_as_layout(lobes[:, k, :].reshape(shape + (3,)), soa) for k in range(len(Lobes._fields))))
+
+
+def _cosine_factor(cos_theta_l: Float64Array, model: str) -> Float64Array:
+    """``|cos θl|`` for the 2015 models (directions on the whole sphere), cos θl clamped at 0 for the BRDFs."""
+    return np.abs(cos_theta_l) if model in _validate.BSDF_MODELS else np.maximum(cos_theta_l, 0.0)
 
 
 # --------------------------------------------------------------------------
@@ -160,7 +173,7 @@ def _to_shape(rows: NDArray[_Scalar], shape: tuple[int, ...], trailing: tuple[in
 
 def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Model = "disney2014",
            specular_sampler: SpecularSampler = "visible", layout: Layout = "aos",
-           energy_compensation: bool = False) -> Sample:
+           energy_compensation: bool = False, mode: Mode = "radiance") -> Sample:
     """Draws ``wi`` for each ``wo`` from the three-lobe mixture of docs/sampling.md.
 
     ``u`` holds three uniforms in [0, 1] per element, ``(u0, u1, u2)`` on the last
@@ -169,10 +182,12 @@ def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Mo
     float64 arrays (``lobe`` int32); ``pdf`` is the mixture density, the number
     :func:`pdf` gives for the returned pair, and ``weight = f cos θl / pdf``;
     both are 0 when ``wi`` or ``wo`` is at or below the horizon. ``layout="soa"``:
-    ``wo``, ``u``, ``wi`` and ``weight`` as ``(3, ...)``.
+    ``wo``, ``u``, ``wi`` and ``weight`` as ``(3, ...)``. ``model="disney2015"``:
+    the four-lobe mixture over the whole sphere (lobe 3 the transmission) and
+    ``weight = f |cos θl| / pdf`` in ``mode``.
     """
     _require_material("material", material)
-    model_id = _validate.model_index(model)
+    model_id, mode_id = _validate.model_and_mode(material, model, mode, energy_compensation)
     sampler_id = _validate.sampler_index(specular_sampler)
     soa = _layout(layout)
     wo = _validate.directions("wo", _as_aos("wo", wo, soa))
@@ -183,7 +198,7 @@ def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Mo
         return Sample(empty, np.zeros(shape), empty.copy(), np.zeros(shape, np.int32))
     wi, density, weight, lobe = _core.reference_sample(
         _shared_or_rows(wo, shape, 3), _shared_or_rows(u, shape, 3), _material_rows(material, shape),
-        model_id, sampler_id, _validate.flag("energy_compensation", energy_compensation))
+        model_id, sampler_id, _validate.flag("energy_compensation", energy_compensation), mode_id)
     return Sample(_as_layout(_to_shape(wi, shape, (3,)), soa), _to_shape(density, shape),
                   _as_layout(_to_shape(weight, shape, (3,)), soa), _to_shape(lobe, shape))
 
@@ -198,7 +213,7 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
     unless ``energy_compensation``, whose lobe's weight reads the model's tables.
     """
     _require_material("material", material)
-    model_id = _validate.model_index(model)
+    model_id = _validate.model_and_mode(material, model, energy_compensation=energy_compensation)[0]
     sampler_id = _validate.sampler_index(specular_sampler)
     soa = _layout(layout)
     wi = _validate.directions("wi", _as_aos("wi", wi, soa))
@@ -216,14 +231,16 @@ def lobe_probabilities(material: Material, wo: RealArrayLike, *, model: Model = 
                        energy_compensation: bool = False) -> Float64Array:
     """``(P0, P1, P2)`` on the last axis, ``(..., 3)``: the chances of the cosine, primary
     specular and clearcoat lobes at ``wo`` (docs/sampling.md); with
-    ``energy_compensation`` the cosine lobe's includes the multiple-scattering lobe's."""
+    ``energy_compensation`` the cosine lobe's includes the multiple-scattering lobe's.
+    The 2015 models: ``(..., 4)``, the transmission's last."""
     _require_material("material", material)
-    model_id = _validate.model_index(model)
+    model_id = _validate.model_and_mode(material, model, energy_compensation=energy_compensation)[0]
     compensated = _validate.flag("energy_compensation", energy_compensation)
     wo = _validate.directions("wo", wo)
     shape = _validate.broadcast_leading(wo=wo.shape[:-1], material=material.shape)
+    lobes = 4 if model in _validate.BSDF_MODELS else 3
     if int(np.prod(shape, dtype=np.int64)) == 0:
-        return np.zeros(shape + (3,))
+        return np.zeros(shape + (lobes,))
     p = _core.reference_lobe_probabilities(_shared_or_rows(wo, shape, 3), _material_rows(material, shape), model_id,
                                            compensated)
-    return _to_shape(p, shape, (3,))
+    return _to_shape(p, shape, (lobes,))

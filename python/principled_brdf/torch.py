@@ -98,7 +98,7 @@ def eval(material: Mapping[str, Any] | Material, wi: torch.Tensor, wo: torch.Ten
     ``material``: a mapping of parameter names to tensors or numbers (the others
     take their defaults), or a :class:`principled_brdf.Material`. Parameters and
     directions broadcast as in :func:`principled_brdf.eval`. ``options``:
-    ``model``, ``cosine``. Float64 inputs are evaluated by the float64
+    ``model``, ``cosine``, ``mode``. Float64 inputs are evaluated by the float64
     reference, float32 ones by the SIMD kernels (the result has that dtype).
     Gradients flow to every parameter tensor and direction that requires them;
     a direction's is the derivative of f in the 3-vector as given (project it

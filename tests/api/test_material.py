@@ -7,10 +7,12 @@ import pytest
 
 import principled_brdf as pb
 import numpy_model
+import numpy_model_2015
 from conftest import TABLE_DOMAINS, random_directions, random_material_arrays, random_material_dict, seeded_rng
 
 # docs/model.md, "The model", copied from the table (not from the library)
-TABLE_DEFAULTS = numpy_model.DEFAULTS  # docs/model.md, "The model", restated once in the independent transcription
+# docs/model.md, "The model", and docs/model-2015.md, restated once in the independent transcriptions
+TABLE_DEFAULTS = numpy_model.DEFAULTS | {name: numpy_model_2015.DEFAULTS[name] for name in ("spec_trans", "flatness", "diff_trans")}
 
 
 # --------------------------------------------------------------------------
@@ -129,7 +131,7 @@ def test_replace_changes_only_the_named_parameters():
     a = pb.Material(**params)
     b = a.replace(roughness=0.125, base_color=(0.1, 0.2, 0.3))
     assert a == pb.Material(**params)  # a unchanged
-    for name in TABLE_DEFAULTS:
+    for name in params:  # (the 2015 parameters stay at their defaults)
         expected = {"roughness": 0.125, "base_color": (0.1, 0.2, 0.3)}.get(name, params[name])
         np.testing.assert_array_equal(getattr(b, name), np.asarray(expected), err_msg=name)
     assert a.replace() == a and a.replace() is not a
@@ -179,7 +181,7 @@ def test_mix_interpolates_every_parameter(t):
     pa, pb_ = _two_materials(t)
     mixed = pb.Material.mix(pb.Material(**pa), pb.Material(**pb_), t)
     assert isinstance(mixed, pb.Material)
-    for name in TABLE_DEFAULTS:
+    for name in pa:
         a, b = np.asarray(pa[name]), np.asarray(pb_[name])
         np.testing.assert_allclose(getattr(mixed, name), a + (b - a) * t, rtol=1e-15, atol=1e-300, err_msg=name)
     if t == 0.0:
@@ -203,7 +205,7 @@ def test_mix_with_a_per_element_mask():
     mixed = pb.Material.mix(pb.Material(**pa), pb.Material(**pb_), mask)
     assert mixed.shape == (6, 9)
     assert mixed.base_color.shape == (6, 9, 3)
-    for name in TABLE_DEFAULTS:
+    for name in pa:
         if name == "base_color":
             expected = np.asarray(pa[name]) + (np.asarray(pb_[name]) - np.asarray(pa[name])) * mask[..., None]
         else:

@@ -261,7 +261,7 @@ def test_unknown_parameter_name():
 
 
 @pytest.mark.parametrize("evaluator", EVALUATORS)
-@pytest.mark.parametrize("model", ["disney2015", "Disney2014", "disney", "", "disney2014 "])
+@pytest.mark.parametrize("model", ["disney2016", "Disney2014", "disney", "", "disney2014 "])
 def test_unknown_model(evaluator, model):
     with raises(ValueError, "model", repr(model), "disney2014", "disney2012"):
         call(evaluator, model=model)

@@ -151,7 +151,8 @@ def test_parameter_columns_are_unchanged_and_directions_come_last(path):
     m = pb.Material(**random_material_arrays(rng, 300))
     eval_grad = pb.eval_grad if path == "simd" else pb.reference.eval_grad
     alone = eval_grad(m, wi, wo)
-    both = eval_grad(m, wi, wo, wrt=["wo", *pb.PARAMETERS, "wi"])
+    parameters = [name for name in pb.PARAMETERS if name not in ("spec_trans", "flatness", "diff_trans")]
+    both = eval_grad(m, wi, wo, wrt=["wo", *parameters, "wi"])
     assert both.names == GRADIENT_NAMES + DIRECTIONS
     np.testing.assert_array_equal(both.jacobian[..., :13], alone.jacobian)
     np.testing.assert_array_equal(both.value, alone.value)

@@ -338,7 +338,7 @@ def test_lit_sphere_bad_arguments():
     with pytest.raises(ValueError, match="environment_samples"):
         pbplot.lit_sphere(EVERYTHING, resolution=8, environment=True, environment_samples=0)
     with pytest.raises(ValueError, match="model"):
-        pbplot.lit_sphere(EVERYTHING, resolution=8, model="disney2015")
+        pbplot.lit_sphere(EVERYTHING, resolution=8, model="disney2016")
     assert plt.get_fignums() == []
 
 

@@ -697,7 +697,7 @@ def test_empty_batches():
          ValueError, r"do not broadcast"),
         (lambda: pb.reference.sample(pb.Material(), [0, 0, 1.0], [0.1, 0.2, 0.3], specular_sampler="vndf"),
          ValueError, r"specular_sampler"),
-        (lambda: pb.reference.sample(pb.Material(), [0, 0, 1.0], [0.1, 0.2, 0.3], model="disney2015"),
+        (lambda: pb.reference.sample(pb.Material(), [0, 0, 1.0], [0.1, 0.2, 0.3], model="disney2016"),
          ValueError, r"model"),
         (lambda: pb.reference.sample({"roughness": 0.5}, [0, 0, 1.0], [0.1, 0.2, 0.3]), TypeError, r"material"),
         (lambda: pb.reference.pdf(pb.Material(), [[0, 0, 1.0], [0, 0, 2.0]], [0, 0, 1.0]), ValueError, r"wi\[1\]"),

@@ -61,14 +61,16 @@ enum class Output : int {
 // wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.
 inline constexpr int kDirectionComponents = 6;
 
-// The parameter slots a derivative is taken by, in the table's order: column
-// k of the outputs is the k-th wanted slot; position[p] is slot p's column, or -1.
+// The parameter slots a derivative is taken by (of the model's
+// gradient_slots), in the table's order: column k of the outputs is the k-th
+// wanted slot; position[p] is slot p's column, or -1.
 struct Columns {
-    int count = kParamSlots;
+    int count = kGradientSlots;
     std::int8_t position[kParamSlots];
 
+    // the 2012 and 2014 models' kGradientSlots
     Columns() {
-        for (int p = 0; p < kParamSlots; ++p) position[p] = static_cast<std::int8_t>(p);
+        for (int p = 0; p < kParamSlots; ++p) position[p] = p < kGradientSlots ? static_cast<std::int8_t>(p) : -1;
     }
     // `slots`: count distinct slot indices in increasing order (the caller checked them)
     Columns(const int* slots, int slot_count) : count(slot_count) {
@@ -76,11 +78,13 @@ struct Columns {
         for (int k = 0; k < slot_count; ++k) position[slots[k]] = static_cast<std::int8_t>(k);
     }
     bool wants(int p) const { return position[p] >= 0; }
-    bool all() const { return count == kParamSlots; }
+    bool all() const { return count == kGradientSlots; }
 };
 
-// The Jacobian's values per element: ∂f_c/∂p for the 3 channels c and the kParamSlots slots p.
-inline constexpr int kJacobianWidth = 3 * kParamSlots;
+// The Jacobian's values per element: ∂f_c/∂p for the 3 channels c and the
+// kGradientSlots slots p of the 2012 and 2014 models; at most kMaxJacobianWidth (the 2015 models').
+inline constexpr int kJacobianWidth = 3 * kGradientSlots;
+inline constexpr int kMaxJacobianWidth = 3 * kParamSlots;
 
 inline bool uniform_material(const ParamSlot* params) {
     for (int s = 0; s < kParamSlots; ++s)
@@ -118,10 +122,11 @@ struct EvalJob {
     ParamSlot params[kParamSlots];
     Model model = Model::kDisney2014;
     Output output = Output::kTotal;
-    bool cosine = false;  // multiply by cos θl
+    bool cosine = false;  // multiply by |cos θl|
+    TransportMode mode = TransportMode::kRadiance;  // the 2015 solid's transmission (params.hpp)
     // the multiple-scattering energy compensation (model/energy.hpp); not with Output::kGradient
     bool energy_compensation = false;
-    // out[0] is f; with Output::kLobes, out[0..4] are the lobes of kLobeNames.
+    // out[0] is f; with Output::kLobes, out[0..5] are the lobes of kLobeNames.
     MutableVec3Array out[kLobeCount];
     // Output::kGradient: out[0] is f, and element i's ∂f_c/∂p for the P =
     // columns.count wanted slots p is at jacobian[3 P i + P c + k] (an (N, 3, P)
@@ -174,14 +179,14 @@ struct EvalJob {
 // not depend on the other problems of the call nor on the thread count.
 enum class Loss : int { kLinear = 0, kLog = 1 };
 
-inline constexpr int kNormalWidth = kParamSlots * (kParamSlots + 1) / 2;
+inline constexpr int kNormalWidth = kGradientSlots * (kGradientSlots + 1) / 2;
 
 struct NormalEquationsJob {
     const float* wi = nullptr;  // (N, 3) shared by every problem, or (B, N, 3) with per_problem_directions
     const float* wo = nullptr;
     bool per_problem_directions = false;
     std::int64_t pairs = 0;               // N
-    const float* slots = nullptr;         // (B, kParamSlots): each problem's material
+    const float* slots = nullptr;         // (B, kGradientSlots): each problem's material (a 2012 or 2014 model's)
     const float* target = nullptr;        // (B, N, 3)
     const float* scale = nullptr;         // (B, N, 3)
     const float* gain = nullptr;          // (B,), or null for 1
@@ -205,6 +210,7 @@ struct SampleJob {
     Model model = Model::kDisney2014;
     SpecularSampler sampler = SpecularSampler::kVisibleNormals;
     bool energy_compensation = false;  // as in EvalJob
+    TransportMode mode = TransportMode::kRadiance;  // as in EvalJob
     MutableVec3Array wi, weight;  // outputs, (N, 3) or (3, N)
     float* pdf = nullptr;         // output, N
     std::int32_t* lobe = nullptr; // output, N: 0 cosine, 1 specular, 2 clearcoat

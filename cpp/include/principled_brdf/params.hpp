@@ -1,4 +1,5 @@
-// The 11 parameters of docs/model.md, "The model": names, defaults, domains.
+// The 14 parameters of docs/model.md, "The model", and docs/model-2015.md:
+// names, defaults, domains.
 // Shared by the reference, the batch layer and (through the bindings) Python,
 // so the table exists exactly once.
 #pragma once
@@ -25,8 +26,17 @@ enum Param : int {
     kSheenTint,
     kClearcoat,
     kClearcoatGloss,
-    kParamSlots  // 13
+    // read by the 2015 models only (docs/model-2015.md); 0 for the others
+    kSpecTrans,
+    kFlatness,
+    kDiffTrans,
+    kParamSlots  // 16
 };
+
+// The slots the 2012 and 2014 models read, and the columns of their
+// derivatives: base_color to clearcoat_gloss. The 2015 models' derivatives
+// take every slot (gradient_slots).
+inline constexpr int kGradientSlots = kSpecTrans;  // 13
 
 struct ParamInfo {
     const char* name;
@@ -40,7 +50,7 @@ struct ParamInfo {
 inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
 // Defaults are the BRDF Explorer's (disney.brdf's parameter block).
-inline constexpr std::array<ParamInfo, 11> kParams{{
+inline constexpr std::array<ParamInfo, 14> kParams{{
     {"base_color", kBaseColorR, 3, {0.82, 0.67, 0.16}, 0.0, kUnbounded},
     {"metallic", kMetallic, 1, {0.0}, 0.0, 1.0},
     {"subsurface", kSubsurface, 1, {0.0}, 0.0, 1.0},
@@ -52,6 +62,9 @@ inline constexpr std::array<ParamInfo, 11> kParams{{
     {"sheen_tint", kSheenTint, 1, {0.5}, 0.0, 1.0},
     {"clearcoat", kClearcoat, 1, {0.0}, 0.0, kUnbounded},
     {"clearcoat_gloss", kClearcoatGloss, 1, {1.0}, 0.0, 1.0},
+    {"spec_trans", kSpecTrans, 1, {0.0}, 0.0, 1.0},
+    {"flatness", kFlatness, 1, {0.0}, 0.0, 1.0},
+    {"diff_trans", kDiffTrans, 1, {0.0}, 0.0, 2.0},
 }};
 
 // The default of the parameter that owns a slot (base_color's for its three).
@@ -66,16 +79,33 @@ constexpr double default_of(Param slot) {
 enum class Model : int {
     kDisney2014 = 0,  // anisotropic Smith GGX with the material's alpha_x, alpha_y
     kDisney2012 = 1,  // isotropic Smith GGX with alpha_g = (0.5 + roughness / 2)^2
+    kDisney2015 = 2,  // the 2015 BSDF of a solid: a rough dielectric interface over the whole sphere (docs/model-2015.md)
 };
-inline constexpr std::array<const char*, 2> kModelNames{"disney2014", "disney2012"};
+inline constexpr std::array<const char*, 3> kModelNames{"disney2014", "disney2012", "disney2015"};
+
+// The models whose directions lie on the whole sphere (the others are BRDFs: f = 0 off the upper hemisphere).
+constexpr bool is_bsdf(Model model) { return model == Model::kDisney2015; }
+// The slots a model's derivatives are taken by: the first gradient_slots(model) of the table.
+constexpr int gradient_slots(Model model) { return is_bsdf(model) ? kParamSlots : kGradientSlots; }
 
 // The lobes of f, in the order eval_lobes returns them; multiple_scattering is
-// the energy compensation's (0 unless it is on).
-inline constexpr std::array<const char*, 5> kLobeNames{"diffuse", "sheen", "specular", "clearcoat", "multiple_scattering"};
+// the energy compensation's (0 unless it is on), transmission the 2015 models'
+// light through the interface (0 for the BRDFs).
+inline constexpr std::array<const char*, 6> kLobeNames{"diffuse", "sheen", "specular", "clearcoat", "multiple_scattering",
+                                                       "transmission"};
 inline constexpr int kLobeCount = static_cast<int>(kLobeNames.size());
+// The lobes a BRDF's eval_lobes writes (the first ones of kLobeNames; the others are 0).
+inline constexpr int kBrdfLobeCount = 5;
+constexpr int lobe_count(Model model) { return is_bsdf(model) ? kLobeCount : kBrdfLobeCount; }
 
-// The lobes sampling draws from, by the index a sample reports.
-inline constexpr std::array<const char*, 3> kSampledLobeNames{"cosine", "specular", "clearcoat"};
+// The lobes sampling draws from, by the index a sample reports (transmission: the 2015 models').
+inline constexpr std::array<const char*, 4> kSampledLobeNames{"cosine", "specular", "clearcoat", "transmission"};
+
+// Which way light flows through a transmitting interface (docs/model-2015.md):
+// radiance from wi to wo, or importance from wo to wi; only the 2015 solid's
+// transmission differs (by η_t²).
+enum class TransportMode : int { kRadiance = 0, kImportance = 1 };
+inline constexpr std::array<const char*, 2> kTransportModeNames{"radiance", "importance"};
 
 // How the primary specular lobe draws its half vector (docs/sampling.md).
 enum class SpecularSampler : int {

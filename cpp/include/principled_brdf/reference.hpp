@@ -33,6 +33,9 @@ struct Material {
     double sheen_tint = default_of(kSheenTint);
     double clearcoat = default_of(kClearcoat);
     double clearcoat_gloss = default_of(kClearcoatGloss);
+    double spec_trans = default_of(kSpecTrans);
+    double flatness = default_of(kFlatness);
+    double diff_trans = default_of(kDiffTrans);
 
     // A packed row in the slot order of params.hpp.
     static Material from_slots(const double* row) {
@@ -48,15 +51,19 @@ struct Material {
         m.sheen_tint = row[kSheenTint];
         m.clearcoat = row[kClearcoat];
         m.clearcoat_gloss = row[kClearcoatGloss];
+        m.spec_trans = row[kSpecTrans];
+        m.flatness = row[kFlatness];
+        m.diff_trans = row[kDiffTrans];
         return m;
     }
 
     std::array<double, kParamSlots> slots() const {
         return {base_color.x(), base_color.y(), base_color.z(), metallic, subsurface, specular, specular_tint,
-                roughness, anisotropic, sheen, sheen_tint, clearcoat, clearcoat_gloss};
+                roughness, anisotropic, sheen, sheen_tint, clearcoat, clearcoat_gloss, spec_trans, flatness, diff_trans};
     }
 
     Shading<double> shading() const { return shading_of(slots().data()); }
+    Shading2015<double> shading2015() const { return shading2015_of(slots().data()); }
 };
 
 // What a run of packed material rows (slot order of params.hpp) prepares,
@@ -109,6 +116,7 @@ using ShadingCache = RowCache<Shading<double>, &shading_of<double>>;
 template <Model model>
 using CompensatedCache = RowCache<Compensated, &compensated_of<model>>;
 using GradientShadingCache = RowCache<GradientShading, &gradient_shading_of>;
+using Shading2015Cache = RowCache<Shading2015<double>, &shading2015_of<double>>;
 
 // The four lobes, each already weighted as it enters the sum.
 struct Lobes {
@@ -117,7 +125,8 @@ struct Lobes {
     Vector3d specular = Vector3d::Zero();   // primary GGX lobe
     Vector3d clearcoat = Vector3d::Zero();  // grey
     Vector3d multiple_scattering = Vector3d::Zero();  // energy compensation (model/energy.hpp); 0 when off
-    Vector3d total() const { return diffuse + sheen + specular + clearcoat + multiple_scattering; }
+    Vector3d transmission = Vector3d::Zero();         // the 2015 models' (model/bsdf2015.hpp)
+    Vector3d total() const { return diffuse + sheen + specular + clearcoat + multiple_scattering + transmission; }
 };
 
 inline Vec3<double> vec3(const Vector3d& w) { return {w.x(), w.y(), w.z()}; }
@@ -165,8 +174,8 @@ inline Vector3d eval(const Material& m, const Vector3d& wi, const Vector3d& wo, 
 // unless wi and wo lie strictly above the surface.
 struct Gradient {
     Vector3d value = Vector3d::Zero();
-    Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor> jacobian =
-            Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor>::Zero();
+    Eigen::Matrix<double, 3, kGradientSlots, Eigen::RowMajor> jacobian =
+            Eigen::Matrix<double, 3, kGradientSlots, Eigen::RowMajor>::Zero();
 };
 
 template <Model model>
@@ -305,6 +314,70 @@ inline Sample sample(const Compensated& c, const Vector3d& wo, double u0, double
     const Uniforms<double> u{u0, u1, u2};
     return model == Model::kDisney2012 ? compensated_sample_of<Model::kDisney2012>(c, vec3(wo), u, sampler)
                                        : compensated_sample_of<Model::kDisney2014>(c, vec3(wo), u, sampler);
+}
+
+// ---------------------------------------------------------------- the 2015 solid (model/bsdf2015.hpp)
+// Directions anywhere on the sphere; f = 0 where either lies in the tangent plane.
+
+inline Lobes eval_lobes(const Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
+                        TransportMode mode = TransportMode::kRadiance) {
+    const Lobes2015<double> v = eval_lobes2015(vec3(wi), vec3(wo), s, mode);
+    Lobes out;
+    out.diffuse = vector3d(v.diffuse);
+    out.sheen = vector3d(v.sheen);
+    out.specular = vector3d(v.specular);
+    out.clearcoat = vector3d(v.clearcoat);
+    out.transmission = vector3d(v.transmission);
+    return out;
+}
+
+inline Vector3d eval(const Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
+                     TransportMode mode = TransportMode::kRadiance) {
+    return vector3d(eval_lobes2015(vec3(wi), vec3(wo), s, mode).total());
+}
+
+// P_k at wo of the cosine, specular, clearcoat and transmission lobes.
+inline std::array<double, 4> lobe_probabilities(const Shading2015<double>& s, const Vector3d& wo) {
+    const LobeWeights2015<double> w = lobe_weights2015(side_of(vec3(wo), vec3(wo), s), s);
+    return {w.cosine * w.inv_total, w.specular * w.inv_total, w.clearcoat * w.inv_total, w.transmission * w.inv_total};
+}
+
+// The mixture density of wi given wo over the whole sphere.
+inline double pdf(const Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
+                  SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
+    return pdf2015(vec3(wi), vec3(wo), s, sampler);
+}
+
+// As sample() of the BRDFs; lobe 3 is the transmission. wi = 0 where the
+// transmission's microfacet reflects totally (no refracted direction).
+inline Sample sample(const Shading2015<double>& s, const Vector3d& wo, double u0, double u1, double u2,
+                     SpecularSampler sampler = SpecularSampler::kVisibleNormals,
+                     TransportMode mode = TransportMode::kRadiance) {
+    const Sample2015<double> drawn = sample2015(vec3(wo), Uniforms<double>{u0, u1, u2}, s, sampler, mode);
+    const LobeChoice2015<double>& c = drawn.choice;
+    const int lobe = c.transmission ? 3 : c.reflected.cosine ? 0 : c.reflected.specular ? 1 : 2;
+    return {vector3d(drawn.wi), drawn.pdf, vector3d(drawn.weight), lobe};
+}
+
+// f and its Jacobian ∂f_c/∂p over every parameter slot (model/bsdf2015_gradient.hpp).
+struct Gradient2015 {
+    Vector3d value = Vector3d::Zero();
+    Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor> jacobian =
+            Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor>::Zero();
+};
+
+using GradientShading2015Cache = RowCache<GradientShading2015<double>, &gradient_shading2015_of<double>>;
+
+inline Gradient2015 eval_grad(const GradientShading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
+                              TransportMode mode = TransportMode::kRadiance) {
+    struct Sink {
+        Gradient2015& out;
+        bool wants(int) const { return true; }
+        void operator()(int c, int p, double value) { out.jacobian(c, p) = value; }
+    };
+    Gradient2015 out;
+    out.value = vector3d(eval_gradient2015(vec3(wi), vec3(wo), s, mode, false, Sink{out}));
+    return out;
 }
 
 }  // namespace principled_brdf::reference

@@ -30,6 +30,21 @@ PB_MODEL_INLINE F fresnel_dielectric(F cos_theta_i, F eta) {
     return select(total_internal_reflection, one, F(0.5) * mul_add(rs, rs, rp * rp));
 }
 
+// Its complement, the transmitted fraction 1 - F, without the cancellation of
+// 1 - F where F nears 1 (grazing light, the critical angle): with
+// 1 - rs² = 4 c η cos θt / (c + η cos θt)² and 1 - rp² = 4 η c cos θt / (η c + cos θt)²,
+//   1 - F = 2 η c cos θt (1 / (c + η cos θt)² + 1 / (η c + cos θt)²),
+// 0 under total internal reflection.
+template <class F>
+PB_MODEL_INLINE F fresnel_dielectric_transmittance(F cos_theta_i, F eta) {
+    F c = min(max(cos_theta_i, -cos_theta_i), F(1.0));
+    F cos2_t = cos2_theta_transmitted(c, eta);
+    F cos_t = square_root_nonnegative(cos2_t);
+    F s = c + eta * cos_t, p = mul_add(eta, c, cos_t);
+    F t = F(2.0) * eta * c * cos_t * (F(1.0) / (s * s) + F(1.0) / (p * p));
+    return select(cos2_t <= F(0.0), F(0.0), t);
+}
+
 // The direction refracted from w through the interface (Snell's law), on the
 // far side: with c = |cos θ| and cos θt = sqrt(1 - (1 - c²)/η²),
 //   wt = -w / η + (c / η - cos θt) sign(w·n) n.

@@ -70,11 +70,17 @@ struct DiffuseLobe {
         // Skipped when 0 in every lane: for a uniform material the test has the
         // same outcome for every batch, and mix(fd, ss, 0) = fd bit for bit.
         if (!with_subsurface || !any(subsurface != F(0.0))) return fd;
+        return mix(fd, subsurface_shape(g, fresnel), subsurface);
+    }
+
+    // ss, the Hanrahan-Krueger-like shape (the 2015 models' flatness reads it too)
+    PB_MODEL_INLINE F subsurface_shape(const Geometry<F>& g, const Fresnel<F>& fresnel) const {
+        F one(1.0);
+        F cos2_theta_d = F(0.25) * g.h_len2;
         F fss90_minus_1 = mul_sub(roughness, cos2_theta_d, one);
         F fss = mul_add(fss90_minus_1, fresnel.fl, one) * mul_add(fss90_minus_1, fresnel.fv, one);
         F inv_cos_sum = reciprocal(g.wi.z + g.wo.z);
-        F ss = F(1.25) * mul_add(fss, inv_cos_sum - F(0.5), F(0.5));
-        return mix(fd, ss, subsurface);
+        return F(1.25) * mul_add(fss, inv_cos_sum - F(0.5), F(0.5));
     }
 };
 

@@ -1,0 +1,67 @@
+// Part of the model (docs/model-2015.md, "Derivatives"): the 2015 solid's
+// derivatives in its parameter slots, by forward mode: eval_lobes2015
+// instantiated for dual numbers (model/dual.hpp), so that every path of the
+// model (its sides, η from specular through the exact Fresnel factor and the
+// refraction, the clamps) is differentiated as it is evaluated. Where the
+// model clamps (η >= 1.001, the alphas >= 0.001) the derivative is the
+// active branch's.
+//
+// The 16 slots are taken kSlotsAPass at a time, one evaluation a pass: one
+// instantiation of the model over Dual<F, kSlotsAPass> serves every pass, which
+// keeps the kernels' code (and their compile time) a fraction of one over all
+// 16 tangents, and a pass whose slots no column wants is skipped.
+#pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
+
+inline constexpr int kSlotsAPass = 4;
+inline constexpr int kGradientPasses = kParamSlots / kSlotsAPass;
+static_assert(kGradientPasses * kSlotsAPass == kParamSlots, "the passes cover the slots");
+
+template <class F>
+using PassDual = Dual<F, kSlotsAPass>;
+
+// The material's constants, pass by pass: pass q's tangents are those of slots
+// q kSlotsAPass ... (q + 1) kSlotsAPass - 1.
+template <class F>
+struct GradientShading2015 {
+    Shading2015<PassDual<F>> pass[kGradientPasses];
+};
+
+template <class F>
+PB_MODEL_INLINE GradientShading2015<F> gradient_shading2015_of(const F* p) {
+    GradientShading2015<F> g;
+    for (int q = 0; q < kGradientPasses; ++q) {
+        PassDual<F> slots[kParamSlots];
+        for (int k = 0; k < kParamSlots; ++k) {
+            const int tangent = k - q * kSlotsAPass;
+            slots[k] = tangent >= 0 && tangent < kSlotsAPass ? PassDual<F>::variable(p[k], tangent) : PassDual<F>(p[k]);
+        }
+        g.pass[q] = shading2015_of(slots);
+    }
+    return g;
+}
+
+// f (times |cos θl| if `cosine`), returned, and ∂f_c/∂p given to
+// `jacobian(c, p, value)` for every channel c and every slot p the sink
+// wants (jacobian.wants(p)).
+template <class F, class Sink>
+PB_MODEL_INLINE Rgb<F> eval_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, const GradientShading2015<F>& s,
+                                         TransportMode mode, bool cosine, Sink&& jacobian) {
+    using D = PassDual<F>;
+    Vec3<D> dwi{D(wi.x), D(wi.y), D(wi.z)}, dwo{D(wo.x), D(wo.y), D(wo.z)};
+    D cosine_factor(cosine ? max(wi.z, -wi.z) : F(1.0));
+    Rgb<F> value;
+    for (int q = 0; q < kGradientPasses; ++q) {
+        bool wanted = q == 0;  // (the first pass gives the value)
+        for (int t = 0; t < kSlotsAPass; ++t) wanted = wanted || jacobian.wants(q * kSlotsAPass + t);
+        if (!wanted) continue;
+        Rgb<D> f = cosine_factor * eval_lobes2015(dwi, dwo, s.pass[q], mode).total();
+        auto put = [&](int c, const D& channel) {
+            for (int t = 0; t < kSlotsAPass; ++t)
+                if (jacobian.wants(q * kSlotsAPass + t)) jacobian(c, q * kSlotsAPass + t, channel.d[t]);
+            return channel.v;
+        };
+        Rgb<F> channels{put(0, f.r), put(1, f.g), put(2, f.b)};
+        if (q == 0) value = channels;
+    }
+    return value;
+}

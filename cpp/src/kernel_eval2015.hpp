@@ -1,0 +1,109 @@
+// Part of kernel.hpp, included inside the per-arch namespace: the 2015
+// solid's evaluation loop (model/bsdf2015.hpp): f, its lobes, the sampling
+// pdf, f with the pdf, the Jacobian in the parameter slots and its product
+// with a cotangent (model/bsdf2015_gradient.hpp), over the whole sphere, in
+// any layout.
+#pragma once  // (per translation unit)
+
+// What a batch needs of its material: the constants, over dual numbers for the derivatives.
+template <Output output>
+using Prepared2015 = std::conditional_t<differentiates(output), GradientShading2015<Floats>, Shading2015<Floats>>;
+
+template <Output output>
+PB_KERNEL_INLINE Prepared2015<output> prepare2015(const RawMaterial& m) {
+    if constexpr (differentiates(output)) {
+        return gradient_shading2015_of(m.slot);
+    } else {
+        return shading2015_of(m.slot);
+    }
+}
+
+PB_KERNEL_INLINE Floats absolute(Floats x) { return xsimd::abs(x); }
+
+template <Output output, Layouts layouts>
+PB_KERNEL_INLINE void eval2015_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
+                                     const Prepared2015<output>& s) {
+    auto weighted = [&](const Rgb<Floats>& c) { return job.cosine ? absolute(wi.z) * c : c; };
+    if constexpr (output == Output::kGradient) {
+        JacobianStore<layouts> store{job, i};
+        Rgb<Floats> f = eval_gradient2015(wi, wo, s, job.mode, job.cosine, store);
+        store.finish();
+        store_rgb<layouts>(job.out[0], i, f);
+    } else if constexpr (output == Output::kVjp) {
+        VjpSink<layouts> sink{job, i, load_vec3<layouts>(job.cotangent, i)};
+        eval_gradient2015(wi, wo, s, job.mode, job.cosine, sink);
+        sink.finish();
+    } else if constexpr (output == Output::kPdf) {
+        pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
+    } else if constexpr (output == Output::kLobes) {
+        Lobes2015<Floats> lobes = eval_lobes2015(wi, wo, s, job.mode);
+        Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+        store_rgb<layouts>(job.out[0], i, weighted(lobes.diffuse));
+        store_rgb<layouts>(job.out[1], i, weighted(lobes.sheen));
+        store_rgb<layouts>(job.out[2], i, weighted(lobes.specular));
+        store_rgb<layouts>(job.out[3], i, weighted(lobes.clearcoat));
+        store_rgb<layouts>(job.out[4], i, zero);
+        store_rgb<layouts>(job.out[5], i, weighted(lobes.transmission));
+    } else {
+        if constexpr (output == Output::kValuePdf) pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
+        store_rgb<layouts>(job.out[0], i, weighted(eval_lobes2015(wi, wo, s, job.mode).total()));
+    }
+}
+
+template <Output output, bool per_element, Layouts layouts>
+PB_KERNEL_INLINE bool eval2015_one_batch(const EvalJob& job, std::int64_t i, const Prepared2015<output>& uniform) {
+    Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
+    Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
+    if (!accepted(job, wi, wo)) return false;
+    if constexpr (per_element) {
+        eval2015_batch<output, layouts>(job, i, wi, wo, prepare2015<output>(load_material(job.params, i)));
+    } else {
+        eval2015_batch<output, layouts>(job, i, wi, wo, uniform);
+    }
+    return true;
+}
+
+// -1 with every element of [begin, end) written, or the start of the first
+// batch the fast direction test did not accept (see run_checked).
+template <Output output, bool per_element, Layouts layouts>
+std::int64_t eval2015_batches(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    Prepared2015<output> uniform{};
+    if constexpr (!per_element) uniform = prepare2015<output>(load_material(job.params, 0));
+    std::int64_t i = begin;
+    for (; i + kLanes <= end; i += kLanes)
+        if (!eval2015_one_batch<output, per_element, layouts>(job, i, uniform)) return i;
+    auto one_batch = [&](const EvalJob& padded) { return eval2015_one_batch<output, per_element, Layouts::kMixed>(padded, 0, uniform); };
+    if (i < end && !eval_tail<output>(job, Padding{i, end - i}, one_batch)) return i;
+    return -1;
+}
+
+template <Output output, bool per_element>
+std::int64_t eval2015_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    auto rejected = [&](std::int64_t i) { return !unit_length_at(job.wi, i, job.check) || !unit_length_at(job.wo, i, job.check); };
+    // f alone gets a loop per layout; the other outputs one loop for every layout (the lobes, the pdf and
+    // the derivatives' dual numbers outweigh the loads; and the fewer loops, the shorter the build)
+    if constexpr (output != Output::kTotal) return run_checked(job, begin, end, eval2015_batches<output, per_element, Layouts::kMixed>, rejected);
+    switch (layouts_of(job)) {
+        case Layouts::kInterleaved: return run_checked(job, begin, end, eval2015_batches<output, per_element, Layouts::kInterleaved>, rejected);
+        case Layouts::kRows: return run_checked(job, begin, end, eval2015_batches<output, per_element, Layouts::kRows>, rejected);
+        default: return run_checked(job, begin, end, eval2015_batches<output, per_element, Layouts::kMixed>, rejected);
+    }
+}
+
+template <Output output>
+std::int64_t eval2015_range_of(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    return job.uniform_material() ? eval2015_range_for<output, false>(job, begin, end)
+                                  : eval2015_range_for<output, true>(job, begin, end);
+}
+
+// every output but the derivatives in the directions (the bindings refuse those for this model)
+inline std::int64_t eval2015_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    switch (job.output) {
+        case Output::kGradient: return eval2015_range_of<Output::kGradient>(job, begin, end);
+        case Output::kVjp: return eval2015_range_of<Output::kVjp>(job, begin, end);
+        case Output::kLobes: return eval2015_range_of<Output::kLobes>(job, begin, end);
+        case Output::kPdf: return eval2015_range_of<Output::kPdf>(job, begin, end);
+        case Output::kValuePdf: return eval2015_range_of<Output::kValuePdf>(job, begin, end);
+        default: return eval2015_range_of<Output::kTotal>(job, begin, end);
+    }
+}
