@@ -412,7 +412,11 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     third = None
     if cotangent is not None:
         third = _Directions("cotangent", cotangent, layout)
-        np.broadcast_to(cotangent, _vec3_shape(leading, layout))  # numpy's error unless it broadcasts to the call's shape
+        call_shape = _vec3_shape(leading, layout)
+        try:
+            np.broadcast_to(cotangent, call_shape)
+        except ValueError:
+            raise ValueError(f"cotangent: shape {np.shape(cotangent)} does not broadcast to the call's {call_shape}") from None
     call = _segmented(leading, layout, [wi_dirs, wo_dirs, third], material)
     (wi_flat, wi_code), (wo_flat, wo_code), (cotangent_flat, cotangent_code) = call.vectors
     params, segments, n = call.params, call.segments, _size(leading)

@@ -29,7 +29,7 @@ FUZZ = settings(derandomize=True, max_examples=150, deadline=None, database=None
 ISAS = pb.cpu_info()["available"]
 
 # Names an error message may start with or mention.
-ARGUMENT_NAMES = ("wi", "wo", "u", "out", "material", "model", "layout", "threads", "check", "cosine", "isa",
+ARGUMENT_NAMES = ("wi", "wo", "u", "out", "material", "model", "mode", "layout", "threads", "check", "cosine", "isa",
                   "seed", "specular_sampler", "n", "first", "samples", "cos_theta_o", "resolution", "light",
                   "light_intensity", "ambient", "leading shapes", "h", "w", "u1", "u2", "alpha", "alpha_x",
                   "alpha_y", "gamma", "p", "approximation", "correlated", "closed_forms", "params",
@@ -170,7 +170,8 @@ def material_argument(draw, n, rng):
 
 
 OPTION_VALUES = {
-    "model": ("disney2014", "disney2012", "disney2015", None, 2014),
+    "model": ("disney2014", "disney2012", "disney2015", "disney2015", None, 2014),
+    "mode": ("radiance", "importance", "light", None),
     "threads": (None, 1, 2, 3, 0, -1, 2**31, 1.5, "2", True),
     "check": (True, True, True, False, np.True_, None, "no", np.array([True, False])),
     "cosine": (False, True, np.bool_(True), 1, np.array([True])),
@@ -238,9 +239,10 @@ def draw_pair_call(data, leading, seed, option_names):
        entry=st.sampled_from(("eval", "eval_out", "eval_lobes", "pdf", "eval_grad", "eval_vjp")))
 def test_fuzz_evaluation(data, leading, seed, entry):
     names = {"pdf": ["threads", "check", "isa", "layout", "specular_sampler"],
-             "eval_grad": ["model", "threads", "check", "cosine", "isa", "layout", "wrt"],
-             "eval_vjp": ["model", "threads", "check", "cosine", "isa", "layout", "wrt"]}
-    drawn = draw_pair_call(data, leading, seed, names.get(entry, ["model", "threads", "check", "cosine", "isa", "layout"]))
+             "eval_grad": ["model", "mode", "threads", "check", "cosine", "isa", "layout", "wrt"],
+             "eval_vjp": ["model", "mode", "threads", "check", "cosine", "isa", "layout", "wrt"]}
+    drawn = draw_pair_call(data, leading, seed,
+                           names.get(entry, ["model", "mode", "threads", "check", "cosine", "isa", "layout"]))
     if drawn is None:
         return
     opts, layout, wi, wo, material = drawn
@@ -296,7 +298,7 @@ def test_fuzz_evaluation(data, leading, seed, entry):
     if not (unit_length(a).all() and unit_length(b).all()):
         return  # check=False on non-unit directions: finite is all that is promised
     reference = pb.reference.eval_lobes if entry == "eval_lobes" else pb.reference.eval
-    expected = reference(material, a, b, model=opts.get("model", "disney2014"),
+    expected = reference(material, a, b, model=opts.get("model", "disney2014"), mode=opts.get("mode", "radiance"),
                          cosine=bool(opts.get("cosine", False)))
     for actual, wanted in zip(arrays, list(expected) if entry == "eval_lobes" else [expected]):  # eval_grad: its value
         actual = np.moveaxis(actual, 0, -1) if layout == "soa" else actual
