@@ -9,7 +9,7 @@ import numpy as np
 
 from . import _color, _core
 from ._segments import unexpanded
-from ._validate import as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
+from ._validate import BSDF_MODELS, as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -41,8 +41,8 @@ class _ParamInfo:
 PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
 
 # The parameters each model leaves unread, which must be at their defaults (docs/model-2015.md).
-_READ_BY_2015 = ("spec_trans", "flatness", "diff_trans")
-_READ_BY_2015_MODELS = ("disney2015",)
+# (the slots past the 2012 and 2014 models' derivative columns)
+_READ_BY_2015 = tuple(name for name, info in PARAMETERS.items() if info.first_slot >= _core.GRADIENT_SLOTS)
 _UNREAD_BY = {"disney2014": _READ_BY_2015, "disney2012": _READ_BY_2015, "disney2015": ("subsurface", "diff_trans")}
 
 
@@ -216,7 +216,7 @@ class Material:
             self._require_everywhere(name, lambda array: array == default,
                                      f"model {model!r} does not read it and needs its default {default:g} "
                                      + ("(use flatness)" if name == "subsurface" else ""))
-        if model in _READ_BY_2015_MODELS:
+        if model in BSDF_MODELS:
             self._require_everywhere("specular", lambda array: array < 12.5,
                                      f"model {model!r} needs specular < 12.5 (a finite index of refraction)")
 

@@ -40,7 +40,8 @@ from ._batch import eval_lobes as _eval_lobes
 from . import _color, _validate
 from .albedo import MAX_SAMPLES as _ALBEDO_MAX_SAMPLES
 from .albedo import albedo as _albedo
-from .material import PARAMETERS, Material
+from .material import Material
+from ._gradient import DIFFERENTIABLE as _DIFFERENTIABLE
 from . import measured as _measured
 from . import render as _render
 
@@ -61,8 +62,7 @@ __all__ = ["brdf_slice", "polar_lobes", "lit_sphere", "albedo_curves", "paramete
            "microfacet_family", "slice_directions", "SCALAR_PARAMETERS", "CHANNELS", "ALBEDO_QUADRATURE"]
 
 #: The ten scalar parameters of the 2012 and 2014 models, in the library's order.
-SCALAR_PARAMETERS = tuple(name for name, info in PARAMETERS.items()
-                          if info.slots == 1 and name not in ("spec_trans", "flatness", "diff_trans"))
+SCALAR_PARAMETERS = tuple(name for name, info in _DIFFERENTIABLE.items() if info.slots == 1)
 
 #: Channel names accepted by the scalar plots and their weights on linear RGB.
 CHANNELS = {

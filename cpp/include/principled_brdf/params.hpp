@@ -94,9 +94,6 @@ constexpr int gradient_slots(Model model) { return is_bsdf(model) ? kParamSlots 
 inline constexpr std::array<const char*, 6> kLobeNames{"diffuse", "sheen", "specular", "clearcoat", "multiple_scattering",
                                                        "transmission"};
 inline constexpr int kLobeCount = static_cast<int>(kLobeNames.size());
-// The lobes a BRDF's eval_lobes writes (the first ones of kLobeNames; the others are 0).
-inline constexpr int kBrdfLobeCount = 5;
-constexpr int lobe_count(Model model) { return is_bsdf(model) ? kLobeCount : kBrdfLobeCount; }
 
 // The lobes sampling draws from, by the index a sample reports (transmission: the 2015 models').
 inline constexpr std::array<const char*, 4> kSampledLobeNames{"cosine", "specular", "clearcoat", "transmission"};
