@@ -70,6 +70,17 @@ std::int64_t eval2015_batches(const EvalJob& job, std::int64_t begin, std::int64
     Prepared2015<output> uniform{};
     if constexpr (!per_element) uniform = prepare2015<output>(load_material(job.params, 0));
     std::int64_t i = begin;
+    if constexpr (!per_element && (output == Output::kTotal || output == Output::kValuePdf)) {
+        // two batches a step, as eval_two_batches: the second's work fills the first's chain of divisions
+        for (; i + 2 * kLanes <= end; i += 2 * kLanes) {
+            Vec3<Floats> wi = load_vec3<layouts>(job.wi, i), wo = load_vec3<layouts>(job.wo, i);
+            Vec3<Floats> next_wi = load_vec3<layouts>(job.wi, i + kLanes), next_wo = load_vec3<layouts>(job.wo, i + kLanes);
+            if (!accepted(job, wi, wo)) return i;
+            eval2015_batch<output, layouts>(job, i, wi, wo, uniform);
+            if (!accepted(job, next_wi, next_wo)) return i + kLanes;
+            eval2015_batch<output, layouts>(job, i + kLanes, next_wi, next_wo, uniform);
+        }
+    }
     for (; i + kLanes <= end; i += kLanes)
         if (!eval2015_one_batch<output, per_element, layouts>(job, i, uniform)) return i;
     auto one_batch = [&](const EvalJob& padded) { return eval2015_one_batch<output, per_element, Layouts::kMixed>(padded, 0, uniform); };

@@ -195,13 +195,16 @@ PB_MODEL_INLINE F transmission_value(const Side<F>& side, const Refraction<F>& r
 // Every lobe at (wi, wo), 0 where the pair is not one the model scatters
 // (a direction in the tangent plane, or not finite: see geometry_of).
 template <class F>
-PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s,
+PB_MODEL_INLINE MaskOf<F> scattered2015(const Side<F>& side, const Geometry<F>& g) {
+    return (side.wo.z > F(0.0)) & (side.wi.z != F(0.0)) & g.finite;
+}
+
+template <class F>
+PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Side<F>& side, const Geometry<F>& g, const Shading2015<F>& s,
                                              TransportMode mode) {
     F zero(0.0);
     Rgb<F> none{zero, zero, zero};
-    Side<F> side = side_of(wi, wo, s);
-    Geometry<F> g = geometry_of(side.wi, side.wo);
-    MaskOf<F> scattered = (side.wo.z > zero) & (side.wi.z != zero) & g.finite;
+    MaskOf<F> scattered = scattered2015(side, g);
     Lobes2015<F> out = reflection2015(side, g, s);
     MaskOf<F> reflected = scattered & (side.wi.z > zero);
     out.diffuse = select(reflected, out.diffuse, none);
@@ -213,6 +216,13 @@ PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Vec3<F>& wi, const Vec3<F>& wo
         out.transmission = t * s.transmission_color;
     }
     return out;
+}
+
+template <class F>
+PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s,
+                                             TransportMode mode) {
+    Side<F> side = side_of(wi, wo, s);
+    return eval_lobes2015(side, geometry_of(side.wi, side.wo), s, mode);
 }
 
 // ---------------------------------------------------------------- the sampling mixture (docs/sampling.md)
@@ -235,8 +245,9 @@ PB_MODEL_INLINE LobeWeights2015<F> lobe_weights2015(const Side<F>& side, const S
     F zero(0.0), one(1.0);
     F cos_v = side.wo.z;
     F fv = schlick_weight(cos_v);
-    F exact = fresnel_dielectric(cos_v, side.eta_t);
-    F transmitted = s.transmission_weight * fresnel_dielectric_transmittance(cos_v, side.eta_t) * s.transmission_luminance;
+    FresnelDielectric<F> fresnel = fresnel_dielectric_both(cos_v, side.eta_t);
+    F exact = fresnel.reflectance;
+    F transmitted = s.transmission_weight * fresnel.transmittance * s.transmission_luminance;
     F grey = mul_add(s.dielectric, exact, s.schlick_grazing * fv);
     F schlick_luminance = luminance_of(s.schlick_f0) * (one - fv);
     LobeWeights2015<F> w;
@@ -264,12 +275,10 @@ PB_MODEL_INLINE F transmission_pdf(const Side<F>& side, const Refraction<F>& r, 
 
 // Σ P_k pdf_k(wi) given wo: 0 where a direction lies in the tangent plane or is not finite.
 template <class F>
-PB_MODEL_INLINE F pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s, SpecularSampler sampler) {
+PB_MODEL_INLINE F pdf2015(const Side<F>& side, const Geometry<F>& g, const LobeWeights2015<F>& w,
+                          const Shading2015<F>& s, SpecularSampler sampler) {
     F zero(0.0);
-    Side<F> side = side_of(wi, wo, s);
-    Geometry<F> g = geometry_of(side.wi, side.wo);
-    MaskOf<F> scattered = (side.wo.z > zero) & (side.wi.z != zero) & g.finite;
-    LobeWeights2015<F> w = lobe_weights2015(side, s);
+    MaskOf<F> scattered = scattered2015(side, g);
     const Shading<F>& b = s.brdf;
     F specular = b.specular.pdf(g, b.specular.ggx.smith_denominator(side.wo), sampler);
     F clearcoat = b.clearcoat.absent() ? zero : w.clearcoat * b.clearcoat.gtr1.pdf(g);
@@ -280,6 +289,12 @@ PB_MODEL_INLINE F pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading201
         pdf = select(side.wi.z < zero, transmitted, pdf);
     }
     return select(scattered, w.inv_total * pdf, zero);
+}
+
+template <class F>
+PB_MODEL_INLINE F pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s, SpecularSampler sampler) {
+    Side<F> side = side_of(wi, wo, s);
+    return pdf2015(side, geometry_of(side.wi, side.wo), lobe_weights2015(side, s), s, sampler);
 }
 
 // The lobe a sample draws from: 0 cosine, 1 specular, 2 clearcoat, 3 transmission
@@ -349,10 +364,14 @@ PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u
     }
     // a draw counts only on its lobe's side: the reflected lobes' above, the transmission's below
     MaskOf<F> on_its_side = (choice.transmission & (wi.z < zero)) | (!choice.transmission & (wi.z > zero));
-    wi = select(view.inside, mirrored(wi), wi);  // back to the caller's frame
+    // the pair as the viewer sees it is the view with the drawn wi (side_of reads only wo)
+    Side<F> pair = view;
+    pair.wi = wi;
+    Geometry<F> g = geometry_of(pair.wi, pair.wo);
     Sample2015<F> out;
-    out.pdf = pdf2015(wi, wo, s, sampler);
-    out.lobes = eval_lobes2015(wi, wo, s, mode);
+    out.pdf = pdf2015(pair, g, w, s, sampler);
+    out.lobes = eval_lobes2015(pair, g, s, mode);
+    wi = select(view.inside, mirrored(wi), wi);  // back to the caller's frame
     MaskOf<F> valid = (out.pdf > zero) & (view.wo.z > zero) & on_its_side;
     out.scale = select(valid, max(wi.z, -wi.z) / out.pdf, zero);
     Rgb<F> f = out.lobes.total();

@@ -5,9 +5,9 @@
 #pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // The unpolarised Fresnel reflectance of a dielectric interface (Walter et
-// al. 2007 eq. 22 in the amplitude form): light arriving at |cos θi| from the
-// near side, with cos²θt = 1 - sin²θi / η²,
-//   rs = (cos θi - η cos θt) / (cos θi + η cos θt),  rp = (η cos θi - cos θt) / (η cos θi + cos θt),
+// al. 2007 eq. 22 in the amplitude form): light arriving at |cos θi| = c from
+// the near side, with cos²θt = 1 - sin²θi / η²,
+//   rs = (c - η cos θt) / (c + η cos θt),  rp = (η c - cos θt) / (η c + cos θt),
 //   F = (rs² + rp²) / 2,
 // and F = 1 under total internal reflection (cos²θt <= 0). cos²θt is formed as
 // (c² + (η - 1)(η + 1)) / η², which keeps its digits where 1 - sin²θi/η² would
@@ -17,32 +17,51 @@ PB_MODEL_INLINE F cos2_theta_transmitted(F c, F eta) {
     return mul_add(c, c, (eta - F(1.0)) * (eta + F(1.0))) / (eta * eta);
 }
 
+// Both factors at once from g = η cos θt (the form of Cook and Torrance 1982),
+// one square root and one division. With e = (η - 1)(η + 1),
+// sin²θi = (1 - c)(1 + c), b = c + g and q = η² c + g:
+//   rs = (c - g) / b = -e / b²,   rp = (η² c - g) / q = e (η² c² - sin²θi) / q²,
+//   F = (rs² + rp²) / 2,
+// and, from 1 - rs² = 4 c g / b² and 1 - rp² = 4 η² c g / q², the transmitted
+// fraction without the cancellation of 1 - F where F nears 1 (grazing light,
+// the critical angle):
+//   T = 2 c g (q² + η² b²) / (b² q²);
+// F = 1 and T = 0 under total internal reflection (g² <= 0) and at grazing
+// incidence (c = 0, where rs = rp = -1 up to the rounding of g). The differences
+// c - g and η² c - g are formed from their products, where they keep their
+// digits as η nears 1; g² = c² + e where c < η, else η² - sin²θi (η well below
+// 1 near normal incidence): each form rounds the smaller square.
 template <class F>
-PB_MODEL_INLINE F fresnel_dielectric(F cos_theta_i, F eta) {
-    F one(1.0);
+struct FresnelDielectric {
+    F reflectance, transmittance;
+};
+
+template <class F>
+PB_MODEL_INLINE FresnelDielectric<F> fresnel_dielectric_both(F cos_theta_i, F eta) {
+    F one(1.0), zero(0.0);
     F c = min(max(cos_theta_i, -cos_theta_i), one);  // |cos θi|
-    F cos2_t = cos2_theta_transmitted(c, eta);
-    MaskOf<F> total_internal_reflection = cos2_t <= F(0.0);
-    F cos_t = square_root(cos2_t);
-    F eta_cos_t = eta * cos_t, eta_cos_i = eta * c;
-    F rs = (c - eta_cos_t) / (c + eta_cos_t);
-    F rp = (eta_cos_i - cos_t) / (eta_cos_i + cos_t);
-    return select(total_internal_reflection, one, F(0.5) * mul_add(rs, rs, rp * rp));
+    F eta2 = eta * eta, e = (eta - one) * (eta + one), sin2 = (one - c) * (one + c);
+    F g2 = select(c < eta, mul_add(c, c, e), eta2 - sin2);
+    MaskOf<F> reflects_all = (g2 <= zero) | (c == zero);
+    F g = square_root_nonnegative(g2);
+    F b = c + g, q = mul_add(eta2, c, g);
+    F b2 = b * b, q2 = q * q;
+    F inv_b2_q2 = one / (b2 * q2);
+    F rs = -e * q2 * inv_b2_q2;
+    F rp = e * mul_sub(eta2 * c, c, sin2) * b2 * inv_b2_q2;
+    F reflectance = F(0.5) * mul_add(rs, rs, rp * rp);
+    F transmittance = F(2.0) * c * g * mul_add(eta2, b2, q2) * inv_b2_q2;
+    return {select(reflects_all, one, reflectance), select(reflects_all, zero, transmittance)};
 }
 
-// Its complement, the transmitted fraction 1 - F, without the cancellation of
-// 1 - F where F nears 1 (grazing light, the critical angle): with
-// 1 - rs² = 4 c η cos θt / (c + η cos θt)² and 1 - rp² = 4 η c cos θt / (η c + cos θt)²,
-//   1 - F = 2 η c cos θt (1 / (c + η cos θt)² + 1 / (η c + cos θt)²),
-// 0 under total internal reflection.
+template <class F>
+PB_MODEL_INLINE F fresnel_dielectric(F cos_theta_i, F eta) {
+    return fresnel_dielectric_both(cos_theta_i, eta).reflectance;
+}
+
 template <class F>
 PB_MODEL_INLINE F fresnel_dielectric_transmittance(F cos_theta_i, F eta) {
-    F c = min(max(cos_theta_i, -cos_theta_i), F(1.0));
-    F cos2_t = cos2_theta_transmitted(c, eta);
-    F cos_t = square_root_nonnegative(cos2_t);
-    F s = c + eta * cos_t, p = mul_add(eta, c, cos_t);
-    F t = F(2.0) * eta * c * cos_t * (F(1.0) / (s * s) + F(1.0) / (p * p));
-    return select(cos2_t <= F(0.0), F(0.0), t);
+    return fresnel_dielectric_both(cos_theta_i, eta).transmittance;
 }
 
 // The direction refracted from w through the interface (Snell's law), on the
