@@ -53,6 +53,24 @@ def environments(path: str) -> None:
     demo.write_picture(path, spheres, labels, columns=len(ENVIRONMENT_PRESETS), row_titles=titles)
 
 
+# (label, model, parameters): the demo picture's row of the 2015 BSDF with water beside the glass
+GLASS = demo.GLASS_ROW[:3] + (
+    ("water, ior 1.33", "disney2015", dict(base_color=(0.85, 0.95, 1.0), spec_trans=1.0, roughness=0.02, ior=1.33)),
+) + demo.GLASS_ROW[3:]
+
+
+def glass(path: str) -> None:
+    """The 2015 BSDF's solids and thin shells in the studio and outdoors: light refracted through
+    each sphere and out again, every event drawn by pb.sample."""
+    spheres, titles = [], []
+    for environment in ("studio", "outdoor"):
+        spheres += [pb.render.render_sphere(pb.Material(**params), 128, model=model, environment=environment,
+                                            samples=512) for _, model, params in GLASS]
+        titles.append(environment)
+    labels = [label for label, _, _ in GLASS] + [""] * len(GLASS)
+    demo.write_picture(path, spheres, labels, columns=len(GLASS), row_titles=titles)
+
+
 def environment_maps(path: str) -> None:
     """The studio and outdoor maps side by side, tone mapped (each 256 x 512, a 2 x 2 mean of the map)."""
     panoramas = []
@@ -106,7 +124,7 @@ def main(directory: str, only: list[str] | None = None) -> None:
     os.makedirs(directory, exist_ok=True)
     pictures = [("demo", lambda path: demo.run(pairs=1 << 16, output=path, repeats=1, report=lambda message: None)),
                 ("presets", presets), ("metals", metals), ("environments", environments),
-                ("environment_maps", environment_maps), ("plots", plots), ("parameter_sweep", sweep),
+                ("environment_maps", environment_maps), ("glass", glass), ("plots", plots), ("parameter_sweep", sweep),
                 ("microfacet_family", family)]
     for name, draw in pictures:
         if only and name not in only:

@@ -88,6 +88,18 @@ void each_compensated(Model model, Function&& f) {
     }
 }
 
+// f(cache) with a shading cache of the 2015 model, the solid's or the thin sheet's.
+template <class Function>
+void each_shading2015(Model model, Function&& f) {
+    if (model == Model::kDisney2015Thin) {
+        reference::ThinShading2015Cache cache;
+        f(cache);
+    } else {
+        reference::Shading2015Cache cache;
+        f(cache);
+    }
+}
+
 // f or the lobes for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
 py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
                                    int model, bool lobes, bool energy_compensation, int mode) {
@@ -114,19 +126,21 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
             Eigen::Map<Eigen::Vector3d>(row + 9) = result.clearcoat;
             Eigen::Map<Eigen::Vector3d>(row + 12) = result.multiple_scattering;
             Eigen::Map<Eigen::Vector3d>(row + 15) = result.transmission;
+            Eigen::Map<Eigen::Vector3d>(row + 18) = result.diffuse_transmission;
         };
         if (is_bsdf(which_model)) {
             const TransportMode transport = mode_from(mode);
-            reference::Shading2015Cache shading;
-            for (py::ssize_t i = 0; i < n; ++i) {
-                const auto& material = shading.of(material_rows.row(i));
-                const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
-                if (lobes) {
-                    store(i, reference::eval_lobes(material, in, view, transport));
-                } else {
-                    Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, transport);
+            each_shading2015(which_model, [&](auto& shading) {
+                for (py::ssize_t i = 0; i < n; ++i) {
+                    const auto& material = shading.of(material_rows.row(i));
+                    const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+                    if (lobes) {
+                        store(i, reference::eval_lobes(material, in, view, transport));
+                    } else {
+                        Eigen::Map<Eigen::Vector3d>(out_data + 3 * i) = reference::eval(material, in, view, transport);
+                    }
                 }
-            }
+            });
         } else if (energy_compensation) {
             each_compensated(which_model, [&](auto& cache) {
                 for (py::ssize_t i = 0; i < n; ++i) {
@@ -177,10 +191,18 @@ py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, co
     {
         py::gil_scoped_release release;
         if (is_bsdf(which_model)) {
-            reference::GradientShading2015Cache prepared;
-            for (py::ssize_t i = 0; i < n; ++i) {
-                const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
-                store(i, reference::eval_grad(prepared.of(material_rows.row(i)), in, view, transport));
+            auto run = [&](auto& prepared) {
+                for (py::ssize_t i = 0; i < n; ++i) {
+                    const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
+                    store(i, reference::eval_grad(prepared.of(material_rows.row(i)), in, view, transport));
+                }
+            };
+            if (which_model == Model::kDisney2015Thin) {
+                reference::ThinGradientShading2015Cache prepared;
+                run(prepared);
+            } else {
+                reference::GradientShading2015Cache prepared;
+                run(prepared);
             }
         } else {
             reference::GradientShadingCache prepared;
@@ -251,12 +273,13 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
         };
         if (is_bsdf(which_model)) {
             const TransportMode transport = mode_from(mode);
-            reference::Shading2015Cache shading;
-            for (py::ssize_t i = 0; i < n; ++i) {
-                const double* ui = uniforms.row(i);
-                store(i, reference::sample(shading.of(material_rows.row(i)), Eigen::Vector3d(view.row(i)), ui[0], ui[1], ui[2],
-                                           which_sampler, transport));
-            }
+            each_shading2015(which_model, [&](auto& shading) {
+                for (py::ssize_t i = 0; i < n; ++i) {
+                    const double* ui = uniforms.row(i);
+                    store(i, reference::sample(shading.of(material_rows.row(i)), Eigen::Vector3d(view.row(i)), ui[0], ui[1],
+                                               ui[2], which_sampler, transport));
+                }
+            });
         } else if (energy_compensation) {
             each_compensated(which_model, run);
         } else {
@@ -289,8 +312,7 @@ py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo
             }
         };
         if (is_bsdf(which_model)) {
-            reference::Shading2015Cache shading;
-            run(shading);
+            each_shading2015(which_model, run);
         } else if (energy_compensation) {
             each_compensated(which_model, run);
         } else {
@@ -307,7 +329,7 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
     const py::ssize_t n = common_row_count({&wo, &params});
     const Rows view = shared_or_rows(wo, n, 3, "wo");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
-    const py::ssize_t lobes = is_bsdf(model_from(model)) ? 4 : 3;
+    const py::ssize_t lobes = is_bsdf(model_from(model)) ? py::ssize_t(kSampledLobeNames.size()) : 3;
     py::array_t<double> out({n, lobes});
     double* out_data = out.mutable_data();
     {
@@ -320,8 +342,7 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
             }
         };
         if (is_bsdf(model_from(model))) {
-            reference::Shading2015Cache shading;
-            run(shading);
+            each_shading2015(model_from(model), run);
         } else if (energy_compensation) {
             each_compensated(model_from(model), run);
         } else {
@@ -337,7 +358,7 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
 void bind_reference(py::module_& m) {
     m.def("reference_eval", &reference_eval, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
           py::arg("lobes"), py::arg("energy_compensation") = false, py::arg("mode") = 0,
-          "Float64 reference f (N,3) or lobes (N,6,3) for packed, already validated rows.");
+          "Float64 reference f (N,3) or lobes (N,7,3) for packed, already validated rows.");
     m.def("reference_eval_grad", &reference_eval_grad, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
           py::arg("mode") = 0,
           "Float64 reference f (N,3) and its Jacobian (N,3,P) over the model's P parameter slots, for packed validated rows.");
@@ -351,7 +372,7 @@ void bind_reference(py::module_& m) {
     m.def("reference_pdf", &reference_pdf, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
           py::arg("sampler"), py::arg("energy_compensation") = false, "Float64 reference mixture pdf (N,) for validated rows (N or one shared row each).");
     m.def("reference_lobe_probabilities", &reference_lobe_probabilities, py::arg("wo"), py::arg("params"),
-          py::arg("model") = 0, py::arg("energy_compensation") = false, "Lobe probabilities (N,3), (N,4) for the 2015 models, at wo for validated rows (N or one shared row each).");
+          py::arg("model") = 0, py::arg("energy_compensation") = false, "Lobe probabilities (N,3), (N,5) for the 2015 models, at wo for validated rows (N or one shared row each).");
 }
 
 }  // namespace principled_brdf::bindings

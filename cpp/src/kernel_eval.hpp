@@ -165,6 +165,7 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
         store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
         store_rgb<layouts>(job.out[4], i, masked(ms.rgb(multiple_scattering)));
         store_rgb<layouts>(job.out[5], i, zero);
+        store_rgb<layouts>(job.out[6], i, zero);
     } else if constexpr (output != Output::kPdf) {
         store_rgb<layouts, true>(job.out[0], i, masked(ms.added_to(values.template total<lobes>(s), multiple_scattering)));
     }
@@ -216,6 +217,7 @@ PB_KERNEL_INLINE void eval_values_batch(const EvalJob& job, std::int64_t i, cons
             store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
             store_rgb<layouts>(job.out[4], i, zero);
             store_rgb<layouts>(job.out[5], i, zero);
+            store_rgb<layouts>(job.out[6], i, zero);
         } else {
             store_rgb<layouts, true>(job.out[0], i, masked(values.template total<lobes>(s)));
         }

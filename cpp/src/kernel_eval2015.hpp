@@ -10,11 +10,11 @@ template <Output output>
 using Prepared2015 = std::conditional_t<differentiates(output), GradientShading2015<Floats>, Shading2015<Floats>>;
 
 template <Output output>
-PB_KERNEL_INLINE Prepared2015<output> prepare2015(const RawMaterial& m) {
+PB_KERNEL_INLINE Prepared2015<output> prepare2015(const RawMaterial& m, bool thin) {
     if constexpr (differentiates(output)) {
-        return gradient_shading2015_of(m.slot);
+        return gradient_shading2015_of(m.slot, thin);
     } else {
-        return shading2015_of(m.slot);
+        return shading2015_of(m.slot, thin);
     }
 }
 
@@ -44,6 +44,7 @@ PB_KERNEL_INLINE void eval2015_batch(const EvalJob& job, std::int64_t i, const V
         store_rgb<layouts>(job.out[3], i, weighted(lobes.clearcoat));
         store_rgb<layouts>(job.out[4], i, zero);
         store_rgb<layouts>(job.out[5], i, weighted(lobes.transmission));
+        store_rgb<layouts>(job.out[6], i, weighted(lobes.diffuse_transmission));
     } else {
         if constexpr (output == Output::kValuePdf) pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
         store_rgb<layouts>(job.out[0], i, weighted(eval_lobes2015(wi, wo, s, job.mode).total()));
@@ -56,7 +57,7 @@ PB_KERNEL_INLINE bool eval2015_one_batch(const EvalJob& job, std::int64_t i, con
     Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
     if (!accepted(job, wi, wo)) return false;
     if constexpr (per_element) {
-        eval2015_batch<output, layouts>(job, i, wi, wo, prepare2015<output>(load_material(job.params, i)));
+        eval2015_batch<output, layouts>(job, i, wi, wo, prepare2015<output>(load_material(job.params, i), job.thin()));
     } else {
         eval2015_batch<output, layouts>(job, i, wi, wo, uniform);
     }
@@ -68,7 +69,7 @@ PB_KERNEL_INLINE bool eval2015_one_batch(const EvalJob& job, std::int64_t i, con
 template <Output output, bool per_element, Layouts layouts>
 std::int64_t eval2015_batches(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     Prepared2015<output> uniform{};
-    if constexpr (!per_element) uniform = prepare2015<output>(load_material(job.params, 0));
+    if constexpr (!per_element) uniform = prepare2015<output>(load_material(job.params, 0), job.thin());
     std::int64_t i = begin;
     if constexpr (!per_element && (output == Output::kTotal || output == Output::kValuePdf)) {
         // two batches a step, as eval_two_batches: the second's work fills the first's chain of divisions

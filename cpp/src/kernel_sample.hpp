@@ -67,6 +67,7 @@ PB_KERNEL_INLINE void store_sample(const SampleJob& job, std::int64_t i, const L
         store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
         store_rgb<layouts>(job.lobe_weight[4], i, multiple_scattering_share);
         store_rgb<layouts>(job.lobe_weight[5], i, Rgb<Floats>{Floats(0.0f), Floats(0.0f), Floats(0.0f)});
+        store_rgb<layouts>(job.lobe_weight[6], i, Rgb<Floats>{Floats(0.0f), Floats(0.0f), Floats(0.0f)});
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };

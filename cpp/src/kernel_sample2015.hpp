@@ -1,5 +1,5 @@
 // Part of kernel.hpp, included inside the per-arch namespace: the 2015
-// solid's sampling loop (model/bsdf2015.hpp), batch after batch, any layout.
+// models' sampling loop (model/bsdf2015.hpp), batch after batch, any layout.
 #pragma once  // (per translation unit)
 
 template <bool with_lobes>
@@ -16,12 +16,14 @@ PB_KERNEL_INLINE void store_sample2015(const SampleJob& job, std::int64_t i, con
         store_rgb(job.lobe_weight[3], i, share(drawn.lobes.clearcoat));
         store_rgb(job.lobe_weight[4], i, zero);
         store_rgb(job.lobe_weight[5], i, share(drawn.lobes.transmission));
+        store_rgb(job.lobe_weight[6], i, share(drawn.lobes.diffuse_transmission));
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
     const LobeChoice<Floats>& reflected = drawn.choice.reflected;
+    Floats reflected_index = select(reflected.cosine, index_bits(0), select(reflected.specular, index_bits(1), index_bits(2)));
     Floats lobe_index = select(drawn.choice.transmission, index_bits(3),
-                               select(reflected.cosine, index_bits(0), select(reflected.specular, index_bits(1), index_bits(2))));
+                               select(drawn.choice.diffuse_transmission, index_bits(4), reflected_index));
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
@@ -31,7 +33,7 @@ PB_KERNEL_INLINE bool sample2015_one_batch(const SampleJob& job, std::int64_t i,
     Chosen c;
     if (!load_inputs<Layouts::kMixed>(job, i, seed, c)) return false;
     if constexpr (per_element) {
-        store_sample2015<with_lobes>(job, i, sample2015(c.wo, c.u, shading2015_of(load_material(job.params, i).slot), job.sampler, job.mode));
+        store_sample2015<with_lobes>(job, i, sample2015(c.wo, c.u, shading2015_of(load_material(job.params, i).slot, job.thin()), job.sampler, job.mode));
     } else {
         store_sample2015<with_lobes>(job, i, sample2015(c.wo, c.u, uniform, job.sampler, job.mode));
     }
@@ -41,7 +43,7 @@ PB_KERNEL_INLINE bool sample2015_one_batch(const SampleJob& job, std::int64_t i,
 template <bool per_element, bool with_lobes>
 std::int64_t sample2015_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     Shading2015<Floats> uniform{};
-    if constexpr (!per_element) uniform = shading2015_of(load_material(job.params, 0).slot);
+    if constexpr (!per_element) uniform = shading2015_of(load_material(job.params, 0).slot, job.thin());
     CounterSeed seed = counter_seed(job.seed);
     std::int64_t i = begin;
     for (; i + kLanes <= end; i += kLanes)

@@ -64,6 +64,7 @@ if TYPE_CHECKING:  # the fields of LOBE_NAMES (the C++ table), spelled out for t
         clearcoat: FloatArray
         multiple_scattering: FloatArray
         transmission: FloatArray
+        diffuse_transmission: FloatArray
 else:
     _LobeArrays = NamedTuple("LobeArrays", [(name, np.ndarray) for name in LOBE_NAMES])
 
@@ -498,9 +499,10 @@ def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, mode
                cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None, check: bool = True,
                isa: str | None = None, energy_compensation: bool = False, mode: Mode = "radiance") -> Lobes:
     """The lobes (diffuse, sheen, specular, clearcoat, multiple_scattering,
-    transmission) as a :class:`Lobes` of float32 arrays, each shaped like
+    transmission, diffuse_transmission) as a :class:`Lobes` of float32 arrays, each shaped like
     :func:`eval`'s result; multiple_scattering is 0 unless
-    ``energy_compensation``, transmission 0 but for the 2015 models."""
+    ``energy_compensation``, transmission 0 but for the 2015 models,
+    diffuse_transmission 0 but for ``disney2015_thin``."""
     model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
     outputs = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa,
                         lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in LOBE_NAMES],
@@ -752,7 +754,7 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     ``energy_compensation=True``: f includes the multiple-scattering lobe, drawn
     by the cosine lobe (its weight joins that lobe's chance, ``lobe`` 0).
     ``model="disney2015"``: ``wi`` anywhere on the sphere, ``lobe`` 3 for the
-    transmission; weight ``f |cos θl| / pdf`` with ``f`` in ``mode``; a
+    transmission (4: the thin sheet's diffuse transmission); weight ``f |cos θl| / pdf`` with ``f`` in ``mode``; a
     transmission draw the microfacet reflects totally is no sample (``wi`` 0,
     pdf and weight 0).
     """

@@ -40,7 +40,7 @@ RealArrayLike = Union[
 _Key = Union[SupportsIndex, slice, None, NDArray[Union[np.integer[Any], np.bool_]], Sequence[int]]
 Index = Union[_Key, tuple[_Key, ...]]  # what indexes a Material's leading shape, as numpy indexes
 
-Model = Literal["disney2014", "disney2012", "disney2015"]  # _core.MODEL_NAMES
+Model = Literal["disney2014", "disney2012", "disney2015", "disney2015_thin"]  # _core.MODEL_NAMES
 Mode = Literal["radiance", "importance"]  # _core.MODE_NAMES
 SpecularSampler = Literal["visible", "distribution"]  # _core.SAMPLER_NAMES
 Layout = Literal["aos", "soa"]

@@ -238,8 +238,9 @@ def model_index(model: object) -> int:
 
 
 MODES = {name: index for index, name in enumerate(_core.MODE_NAMES)}
-# The models of the whole sphere (the 2015 BSDF, docs/model-2015.md); the others are BRDFs.
-BSDF_MODELS = ("disney2015",)
+# The models of the whole sphere (the 2015 BSDF of a solid and of a thin sheet, docs/model-2015.md);
+# the others are BRDFs.
+BSDF_MODELS = ("disney2015", "disney2015_thin")
 
 
 def mode_index(mode: object) -> int:

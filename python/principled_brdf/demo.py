@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
     from typing import Any
 
-    from ._typing import Float32Array, FloatArray
+    from ._typing import Float32Array, FloatArray, Model
 
 DEMO_MATERIAL: dict[str, Any] = dict(base_color=(0.9, 0.55, 0.25), metallic=0.3, roughness=0.35, anisotropic=0.4,
                                      sheen=0.3, clearcoat=0.6, clearcoat_gloss=0.8)
@@ -31,6 +31,17 @@ PICTURE_RESOLUTION = 128  # pixels per sphere
 SWEEP_METALS = {"white metal": (0.95, 0.95, 0.95), "gold": (1.0, 0.71, 0.29)}
 SWEEP_ROUGHNESS = np.linspace(0.05, 1.0, len(PICTURE_PRESETS))
 LABEL_STRIP, ROW_GAP = 22, 4  # pixels above a row of spheres with labels, and above one without
+#: The picture's row of the 2015 BSDF (label, model, parameters), outdoors: solids that refract what
+#: is behind them, and thin shells that let light through.
+GLASS_ROW: tuple[tuple[str, Model, dict[str, Any]], ...] = (
+    ("clear glass", "disney2015", dict(base_color=(1.0, 1.0, 1.0), spec_trans=1.0, roughness=0.02, ior=1.5)),
+    ("frosted glass", "disney2015", dict(base_color=(1.0, 1.0, 1.0), spec_trans=1.0, roughness=0.3, ior=1.5)),
+    ("tinted glass", "disney2015", dict(base_color=(0.55, 0.8, 0.6), spec_trans=1.0, roughness=0.02, ior=1.5)),
+    ("diamond, ior 2.4", "disney2015", dict(base_color=(1.0, 1.0, 1.0), spec_trans=1.0, roughness=0.02, ior=2.4)),
+    ("leaf (thin)", "disney2015_thin", dict(base_color=(0.3, 0.6, 0.08), roughness=0.45, diff_trans=1.2, sheen=0.2)),
+    ("paper lantern (thin)", "disney2015_thin", dict(base_color=(0.95, 0.85, 0.6), roughness=0.8, diff_trans=1.6)),
+)
+GLASS_ENVIRONMENT = "outdoor"  # a sky, a sun and a tiled ground: what refraction bends shows
 
 
 def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats: int = 5,
@@ -81,13 +92,14 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
                             seed=1, energy_compensation=compensated).total[0]) for compensated in (False, True)]
     report(f"white furnace (base_color 1, metallic 1, roughness 1, view along the normal): directional albedo "
            f"{furnace[0]:.3f} single scattering, {furnace[1]:.3f} with energy_compensation")
-    report(f"rendering {len(PICTURE_PRESETS)} presets and a roughness sweep of two metals, without and with "
-           "energy compensation ...")
+    report(f"rendering {len(PICTURE_PRESETS)} presets, a roughness sweep of two metals, without and with "
+           "energy compensation, and a row of glass and thin sheets ...")
     images, labels, titles = picture_spheres()
     write_picture(output, images, labels, columns=len(PICTURE_PRESETS), row_titles=titles)
     report(f"wrote {output}: presets {', '.join(PICTURE_PRESETS)} (top); below, a white and a gold metal from "
            f"roughness {SWEEP_ROUGHNESS[0]:g} to {SWEEP_ROUGHNESS[-1]:g}, each without and with energy_compensation "
-           "(Kulla & Conty 2017), in the studio environment (softboxes, a dark surround)")
+           "(Kulla & Conty 2017), in the studio environment (softboxes, a dark surround); at the bottom the 2015 "
+           f"BSDF outdoors: {', '.join(label for label, _, _ in GLASS_ROW)}")
     return {"rates": rates, "max_relative_error": error, "white_furnace": furnace, "output": output}
 
 
@@ -105,6 +117,10 @@ def picture_spheres(resolution: int = PICTURE_RESOLUTION) -> tuple[list[Float32A
             # the roughness above the first row of each pair; the second follows without a strip
             labels += ["" if compensated else f"roughness {r:.2f}" for r in SWEEP_ROUGHNESS]
             titles.append("+ energy\ncompensation" if compensated else name)
+    images += [lit_sphere(Material(**params), resolution, model=model, environment=GLASS_ENVIRONMENT)
+               for _, model, params in GLASS_ROW]
+    labels += [label for label, _, _ in GLASS_ROW]
+    titles.append("2015 BSDF,\noutdoors")
     return images, labels, titles
 
 
@@ -112,12 +128,12 @@ PICTURE_ENVIRONMENT = "studio"  # softboxes in a dark studio: metals read as the
 PICTURE_SAMPLES = 256  # map samples per pixel: no visible grain on a glossy metal under the softboxes
 
 
-def lit_sphere(material: Material, resolution: int = PICTURE_RESOLUTION, *,
-               energy_compensation: bool = False) -> Float32Array:
-    """A sphere in :data:`PICTURE_ENVIRONMENT` (render_sphere, linear RGB) with
-    :data:`PICTURE_SAMPLES` per pixel. ``material`` of leading shape ``S + (1, 1)``
-    gives ``S`` spheres (``render_sphere``); ``energy_compensation`` as in ``pb.eval``."""
-    return render_sphere(material, resolution, environment=PICTURE_ENVIRONMENT, samples=PICTURE_SAMPLES,
+def lit_sphere(material: Material, resolution: int = PICTURE_RESOLUTION, *, energy_compensation: bool = False,
+               model: Model = "disney2014", environment: str = PICTURE_ENVIRONMENT) -> Float32Array:
+    """A sphere in ``environment`` (render_sphere, linear RGB) with :data:`PICTURE_SAMPLES`
+    per pixel. ``material`` of leading shape ``S + (1, 1)`` gives ``S`` spheres
+    (``render_sphere``); ``energy_compensation`` and ``model`` as in ``pb.eval``."""
+    return render_sphere(material, resolution, environment=environment, samples=PICTURE_SAMPLES, model=model,
                          energy_compensation=energy_compensation)
 
 

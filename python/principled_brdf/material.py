@@ -43,7 +43,8 @@ PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
 # The parameters each model leaves unread, which must be at their defaults (docs/model-2015.md).
 # (the slots past the 2012 and 2014 models' derivative columns)
 _READ_BY_2015 = tuple(name for name, info in PARAMETERS.items() if info.first_slot >= _core.GRADIENT_SLOTS)
-_UNREAD_BY = {"disney2014": _READ_BY_2015, "disney2012": _READ_BY_2015, "disney2015": ("subsurface", "diff_trans")}
+_UNREAD_BY = {"disney2014": _READ_BY_2015, "disney2012": _READ_BY_2015, "disney2015": ("subsurface", "diff_trans"),
+              "disney2015_thin": ("subsurface",)}
 
 
 

@@ -73,7 +73,8 @@ CHANNELS = {
 }
 
 _LOBE_COLORS = {"diffuse": "tab:orange", "sheen": "tab:purple", "specular": "tab:blue", "clearcoat": "tab:green",
-                "multiple_scattering": "tab:cyan", "total": "black"}
+                "multiple_scattering": "tab:cyan", "transmission": "tab:red", "diffuse_transmission": "tab:brown",
+                "reflectance": "tab:olive", "transmittance": "tab:pink", "total": "black"}
 
 # Shading of pb.render.render_sphere, used where many spheres are shaded in one kernel call.
 _LIGHT_INTENSITY = 3.0
@@ -340,7 +341,10 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
     """f(wi, wo) in the plane of incidence, per lobe and in total, on a polar Axes.
 
     ``wo = (sin θo, 0, cos θo)`` (``theta_o`` in degrees, in (-90, 90)), ``wi =
-    (sin t, 0, cos t)`` for t from -90 to 90 degrees in ``resolution`` steps;
+    (sin t, 0, cos t)`` for t from -90 to 90 degrees in ``resolution`` steps
+    (the 2015 models, BSDFs: ``theta_o`` in (-180, 180), a view from inside or
+    below past ±90, and t around the whole circle, so that the transmitted
+    lobe shows below the surface's line);
     the angle of the plot is t (0 at the top = the normal, positive to the
     right, the side of wo), the radius is f in 1/sr (``cosine``: f cos θl).
     ``log``: the radius is log10 f over the ``decades`` below the largest
@@ -358,7 +362,8 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
     """
     _validate.model_index(model)
     brdf = _brdf("material", material, model, cosine=_validate.flag("cosine", cosine))
-    theta = _validate.real_number("theta_o", theta_o, -90.0, 90.0, open_upper=True, open_lower=True)
+    span = 180.0 if model in _validate.BSDF_MODELS else 90.0  # the circle, or the upper half of it
+    theta = _validate.real_number("theta_o", theta_o, -span, span, open_upper=True, open_lower=True)
     n = _validate.resolution("resolution", resolution, unit=" angles")
     weights = _channel(channel)
     decades = _validate.real_number("decades", decades, 0.0, open_lower=True)
@@ -366,9 +371,9 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
     ax = typing.cast("PolarAxes", _axes(ax, polar=True))  # checked: its name is "polar"
     from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
 
-    t = np.radians(np.linspace(-90.0, 90.0, n))
+    t = np.radians(np.linspace(-span, span, n))
     wi = np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
-    wi[[0, -1], 2] = 0.0  # exactly on the horizon (cos(±π/2) is 6e-17)
+    wi[np.isclose(np.abs(t), np.pi / 2, rtol=0.0, atol=1e-12), 2] = 0.0  # exactly on the horizon (cos(±π/2) is 6e-17)
     wo = np.array([np.sin(np.radians(theta)), 0.0, np.cos(np.radians(theta))])
     if brdf.material is not None:
         values = _eval_lobes(brdf.material, wi, wo, cosine=cosine, model=model)
@@ -394,7 +399,13 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
         ax.plot(t, radius(curve), color=_LOBE_COLORS[name], lw=1.3, label=name, zorder=3)
     top = float(radius(np.array(peak)))
     ax.plot([np.radians(theta)] * 2, [0.0, top], color="0.5", ls="--", lw=1.0, label="wo", zorder=1)
-    _upper_half_disc(ax)
+    if span == 90.0:
+        _upper_half_disc(ax)
+    else:  # the whole circle, the normal at the top and the surface as a line through the centre
+        ax.set_theta_zero_location("N")
+        ax.set_theta_direction(-1)
+        for side in (-np.pi / 2, np.pi / 2):
+            ax.plot([side, side], [0.0, top * 1.05], color="0.3", lw=0.8, zorder=1)
     ax.set_ylim(0.0, top * 1.05)
     if log:  # a tick per decade (or per few), labelled with f itself
         step = max(1, int(np.ceil(decades / 4)))
@@ -408,8 +419,10 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
     quantity = "f cos θl" if cosine else "f"
     ax.set_title(f"{quantity} (1/sr, {channel}{', log radius' if log else ''}), θo = {theta:g}°\n"
                  "plane of incidence; angle θl from the normal", fontsize="medium")
-    if legend:  # below the half disc (its baseline is at axes y = 0.25)
+    if legend and span == 90.0:  # below the half disc (its baseline is at axes y = 0.25)
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.17), ncol=3, fontsize="small", frameon=False)
+    elif legend:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small", frameon=False)
     return ax
 
 
@@ -469,7 +482,10 @@ def albedo_curves(material: Material | str | _measured.MerlBRDF | Callable[..., 
                   ax: Axes | None = None, energy_compensation: bool = False, label: str = "total") -> Axes:
     """Directional albedo ``E(θo) = ∫ f cos θl dωi`` against θo (``pb.albedo``), per lobe and in total.
 
-    ``angles``: view angles in degrees, in [0, 90). Each point is the mean of
+    ``angles``: view angles in degrees, in [0, 90); for the 2015 models (BSDFs)
+    in [0, 180) without 90, a view from inside or below past 90, and the
+    total is split into ``"reflectance"`` (wi on the view's side) and
+    ``"transmittance"`` (wi on the other), drawn as well. Each point is the mean of
     ``samples`` importance-sampled weights; the bands are ±2 standard errors
     (for ``"luminance"`` the luminance-weighted sum of the per-channel errors,
     an upper bound). Lobes whose albedo is zero at every angle are left out.
@@ -488,8 +504,11 @@ def albedo_curves(material: Material | str | _measured.MerlBRDF | Callable[..., 
     theta = np.asarray(angles, dtype=np.float64) if not isinstance(angles, str) else None
     if theta is None or theta.ndim != 1 or theta.size < 1 or not np.all(np.isfinite(theta)):
         raise ValueError("angles: expected a 1-d array of finite angles in degrees")
-    if np.any(theta < 0.0) or np.any(theta >= 90.0):
-        raise ValueError(f"angles: expected degrees in [0, 90), got values from {theta.min():g} to {theta.max():g}")
+    sphere = model in _validate.BSDF_MODELS
+    last = 180.0 if sphere else 90.0
+    if np.any(theta < 0.0) or np.any(theta >= last) or np.any(theta == 90.0):
+        raise ValueError(f"angles: expected degrees in [0, {last:g}){' without 90' if sphere else ''}, got values "
+                         f"from {theta.min():g} to {theta.max():g}")
     _validate.integer_in("samples", samples, 2, _ALBEDO_MAX_SAMPLES)
     _validate.model_index(model)
     ax = _axes(ax)
@@ -501,6 +520,9 @@ def albedo_curves(material: Material | str | _measured.MerlBRDF | Callable[..., 
         result = _albedo(brdf.material, np.cos(np.radians(theta)), samples=samples, seed=seed, model=model,
                          energy_compensation=energy_compensation)
         curves = [("total", result.total, result.total_error)]
+        if sphere:  # (their standard errors are at most the total's)
+            curves += [("reflectance", result.reflectance, result.total_error),
+                       ("transmittance", result.transmittance, result.total_error)]
         if lobes:
             curves += [(name, value, error)
                        for name, value, error in zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)]
@@ -512,7 +534,9 @@ def albedo_curves(material: Material | str | _measured.MerlBRDF | Callable[..., 
         ax.plot(theta, mean, color=color, lw=1.8 if name == "total" else 1.2, label=label if name == "total" else name,
                 ls="-" if brdf.material is not None else "--")
         ax.fill_between(theta, mean - band, mean + band, color=color, alpha=0.25, lw=0)
-    ax.set_xlim(0.0, 90.0)
+    ax.set_xlim(0.0, last)
+    if sphere:
+        ax.axvline(90.0, color="0.3", lw=0.8)
     ax.set_ylim(bottom=0.0)
     ax.set_xlabel("θo (degrees)")
     ax.set_ylabel(f"directional albedo ({channel}, unitless)")

@@ -121,7 +121,7 @@ def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, mode
                cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False,
                mode: Mode = "radiance") -> Lobes:
     """The lobes as a :class:`Lobes` of float64 ``(..., 3)`` (``(3, ...)``) arrays
-    (multiple_scattering 0 unless ``energy_compensation``, transmission 0 but for the 2015 models)."""
+    (multiple_scattering 0 unless ``energy_compensation``, transmission 0 but for the 2015 models, diffuse_transmission but for the thin sheet)."""
     soa = _layout(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     mode_id = _validate.model_and_mode(material, model, mode, energy_compensation)[1]
@@ -183,7 +183,8 @@ def sample(material: Material, wo: RealArrayLike, u: RealArrayLike, *, model: Mo
     :func:`pdf` gives for the returned pair, and ``weight = f cos θl / pdf``;
     both are 0 when ``wi`` or ``wo`` is at or below the horizon. ``layout="soa"``:
     ``wo``, ``u``, ``wi`` and ``weight`` as ``(3, ...)``. ``model="disney2015"``:
-    the four-lobe mixture over the whole sphere (lobe 3 the transmission) and
+    the mixture over the whole sphere (lobe 3 the transmission, 4 the thin sheet's
+    diffuse transmission) and
     ``weight = f |cos θl| / pdf`` in ``mode``.
     """
     _require_material("material", material)
@@ -232,13 +233,14 @@ def lobe_probabilities(material: Material, wo: RealArrayLike, *, model: Model = 
     """``(P0, P1, P2)`` on the last axis, ``(..., 3)``: the chances of the cosine, primary
     specular and clearcoat lobes at ``wo`` (docs/sampling.md); with
     ``energy_compensation`` the cosine lobe's includes the multiple-scattering lobe's.
-    The 2015 models: ``(..., 4)``, the transmission's last."""
+    The 2015 models: ``(..., 5)``, then the transmission's and the diffuse transmission's
+    (``SAMPLED_LOBE_NAMES``; 0 but for ``disney2015_thin``)."""
     _require_material("material", material)
     model_id = _validate.model_and_mode(material, model, energy_compensation=energy_compensation)[0]
     compensated = _validate.flag("energy_compensation", energy_compensation)
     wo = _validate.directions("wo", wo)
     shape = _validate.broadcast_leading(wo=wo.shape[:-1], material=material.shape)
-    lobes = 4 if model in _validate.BSDF_MODELS else 3
+    lobes = len(_validate.SAMPLED_LOBE_NAMES) if model in _validate.BSDF_MODELS else 3
     if int(np.prod(shape, dtype=np.int64)) == 0:
         return np.zeros(shape + (lobes,))
     p = _core.reference_lobe_probabilities(_shared_or_rows(wo, shape, 3), _material_rows(material, shape), model_id,

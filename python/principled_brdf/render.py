@@ -25,7 +25,8 @@ import zlib
 
 import numpy as np
 
-from . import _color, _validate
+from . import _color, _sphere_paths, _validate
+from ._sphere_paths import power_heuristic as _power_heuristic
 from ._batch import eval as _eval
 from ._batch import eval_pdf as _eval_pdf
 from ._batch import random_uniforms as _random_uniforms
@@ -206,6 +207,7 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
     radiance = np.float32(light_intensity) * _eval(material, wi, wo, cosine=True, model=model,
                                                    energy_compensation=energy_compensation)
+    radiance[..., wi[..., 2] <= 0.0, :] = 0.0  # (the 2015 models: the sphere hides a light behind its tangent plane)
     if ambient > 0.0:
         radiance += np.float32(ambient) * np.asarray(material.base_color, dtype=np.float32)
     if lighting is not None:
@@ -255,13 +257,6 @@ def lattice_uniforms(count: int, shape: tuple[int, ...], seed: int = 0, first: i
     return np.minimum(points, np.nextafter(np.float32(1.0), np.float32(0.0)))
 
 
-def _power_heuristic(pdf: FloatArray, other: FloatArray) -> Float64Array:
-    """Veach's power heuristic (β = 2) for one sample of each of two strategies:
-    ``pdf² / (pdf² + other²)``, 0 where both densities are 0."""
-    p, q = np.broadcast_arrays(np.asarray(pdf, dtype=np.float64) ** 2, np.asarray(other, dtype=np.float64) ** 2)
-    return np.divide(p, p + q, out=np.zeros(p.shape), where=p > 0.0)
-
-
 def render_environment(material: Material, resolution: int = 256, environment: _EnvironmentArg = None,
                        samples: int = DEFAULT_SAMPLES, seed: int = 0, model: Model = "disney2014", *,
                        energy_compensation: bool = False) -> Float64Array:
@@ -298,6 +293,15 @@ def render_environment(material: Material, resolution: int = 256, environment: _
     shape = np.broadcast_shapes(material.shape, inside.shape)
     elements = int(np.prod(shape, dtype=np.int64))
     is_map = isinstance(lighting, Environment)
+    # the 2015 models send light into the sphere: such paths go on inside (_sphere_paths), and the
+    # environment lights a point only from above its tangent plane (the sphere hides the rest)
+    normals = np.broadcast_to(to_camera(np.array([0.0, 0.0, 1.0])), shape + (3,)).reshape(-1, 3)
+
+    def material_at(element: NDArray[np.intp]) -> Material:
+        if material.shape == ():
+            return material
+        index = np.unravel_index(element, shape)[len(shape) - len(material.shape):]
+        return material[tuple(np.where(np.asarray(material.shape)[k] == 1, 0, i) for k, i in enumerate(index))]
     chunk = max(1, (1 << 20) // (elements * (2 if is_map else 1)))
     total = np.zeros(shape + (3,))
     # the points depend on the pixel alone: a sphere looks the same rendered alone or in a batch
@@ -309,20 +313,31 @@ def render_environment(material: Material, resolution: int = 256, environment: _
         u = points.reshape((count,) + spheres + inside.shape + (3,))
         drawn = _sample(material, wo, u=u, **options)
         direction = to_camera(drawn.wi)
+        above = (drawn.wi[..., 2] > 0.0)[..., None]
+        entering = np.nonzero(~above[..., 0] & (drawn.pdf > 0.0))
+        if len(entering[0]):
+            element = np.ravel_multi_index(entering[1:], shape)
+            # a path's key: its sample and its pixel (not its sphere: a batch looks like its spheres alone)
+            keys = (start + entering[0]).astype(np.uint64) * np.uint64(inside.size) + np.ravel_multi_index(
+                entering[-2:], inside.shape).astype(np.uint64)
+            paths = _sphere_paths.through_the_sphere(material_at, element, normals[element], direction[entering],
+                                                     drawn.weight[entering], lighting, model, keys, seed)
+            np.add.at(total.reshape(-1, 3), element, paths)
         if not is_map:
             radiance = np.asarray(lighting(direction))
             if radiance.shape != direction.shape:
                 raise ValueError(f"environment: expected RGB radiance of shape {direction.shape}, got {radiance.shape}")
-            total += (drawn.weight * radiance).sum(axis=0, dtype=np.float64)
+            total += np.where(above, drawn.weight * radiance, 0.0).sum(axis=0, dtype=np.float64)
             continue
         environment_map = typing.cast(Environment, lighting)
         radiance, light_pdf = environment_map.lookup(direction)
-        weight = drawn.weight * _power_heuristic(drawn.pdf, light_pdf)[..., None]
+        weight = np.where(above, drawn.weight * _power_heuristic(drawn.pdf, light_pdf)[..., None], 0.0)
         total += (weight * radiance).sum(axis=0, dtype=np.float64)
         # the map's strategy: directions per pixel (shared by the spheres of a batch), from two of the point's axes
         towards, light_pdf, radiance = environment_map.sample(points[..., 1:])
         local = to_shading(towards).reshape((count,) + spheres + inside.shape + (3,))
         value, bsdf_pdf = _eval_pdf(material, local, wo, cosine=True, **options)
+        value = np.where(local[..., 2:3] > 0.0, value, 0.0)
         light_pdf = light_pdf.reshape((count,) + spheres + inside.shape)
         # f |cos| L / pdf_light x pdf_light² / (pdf_light² + pdf_bsdf²)
         heuristic = _power_heuristic(light_pdf, bsdf_pdf)

@@ -36,7 +36,7 @@ def test_one_table_per_fact():
         pb.eval(pb.Material(), np.float32([0, 0, 1]), np.float32([0, 0, 1]), model=name)
         assert pb._validate.MODELS[name] == index
     assert tuple(pb._validate.SAMPLERS) == tuple(_core.SAMPLER_NAMES) == ("visible", "distribution")
-    assert tuple(_core.SAMPLED_LOBE_NAMES) == ("cosine", "specular", "clearcoat", "transmission")
+    assert tuple(_core.SAMPLED_LOBE_NAMES) == ("cosine", "specular", "clearcoat", "transmission", "diffuse_transmission")
     # the reference's defaults are the table's
     m = pb.Material()
     np.testing.assert_array_equal(pb.reference.eval(m, [0.6, 0, 0.8], [0, 0, 1]),

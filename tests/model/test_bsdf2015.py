@@ -280,5 +280,5 @@ def test_glass_from_either_side_in_every_entry_point():
                                rtol=1e-3, atol=1e-5 * np.abs(gradient.jacobian).max())
     assert set(pb.eval_vjp(glass, below, wo, np.ones(3), **options)) == set(gradient.names)
     assert pb.albedo(glass, [0.8, -0.8], samples=1024, **options).transmittance.min() > 0
-    assert pb.reference.lobe_probabilities(glass, wo, model="disney2015").shape == (4,)
+    assert pb.reference.lobe_probabilities(glass, wo, model="disney2015").shape == (5,)
     assert pb.reference.sample(glass, wo, [0.99, 0.3, 0.6], **options).lobe == 3

@@ -49,8 +49,8 @@ def test_demo_writes_a_picture_and_reports_throughput(tmp_path):
     for phrase in ("M pairs/s", "roofline", "sample", "float64 reference", "max relative error"):
         assert phrase in result.stdout
     width, height = read_png_size(output)
-    # row titles on the left; a label strip above the presets and above each metal's first row
-    assert width == 120 + 6 * 128 and height == 5 * 128 + 3 * 22 + 2 * 4
+    # row titles on the left; a label strip above the presets, each metal's first row and the glass row
+    assert width == 120 + 6 * 128 and height == 6 * 128 + 4 * 22 + 2 * 4
 
 
 def test_render_preset_with_parameters(tmp_path, capsys):
@@ -59,6 +59,22 @@ def test_render_preset_with_parameters(tmp_path, capsys):
                  "--resolution", "64", "--output", str(output)]) == 0
     assert read_png_size(output) == (64, 64)
     assert "roughness=0.2" in capsys.readouterr().out
+
+
+def test_render_takes_the_2015_models(tmp_path, capsys):
+    output = tmp_path / "glass.npy"
+    assert main(["render", "--model", "disney2015", "--param", "spec_trans=1", "--param", "base_color=1,1,1",
+                 "--param", "roughness=0.05", "--environment", "outdoor", "--resolution", "24", "--samples", "16",
+                 "--output", str(output)]) == 0
+    image = np.load(output)
+    expected = pb.render.render_sphere(pb.Material(spec_trans=1, base_color=(1, 1, 1), roughness=0.05), 24,
+                                       model="disney2015", environment="outdoor", samples=16)
+    np.testing.assert_array_equal(image, expected)
+    assert main(["render", "--model", "disney2015_thin", "--param", "diff_trans=1.5", "--resolution", "16",
+                 "--samples", "8", "--output", str(tmp_path / "leaf.png")]) == 0
+    with pytest.raises(SystemExit) as exit_info:
+        main(["render", "--model", "disney2016", "--output", str(tmp_path / "x.png")])
+    assert exit_info.value.code == 2 and "--model" in capsys.readouterr().err
 
 
 def test_render_writes_linear_npy_and_exr_and_switches_the_sky(tmp_path):

@@ -80,23 +80,27 @@ enum class Model : int {
     kDisney2014 = 0,  // anisotropic Smith GGX with the material's alpha_x, alpha_y
     kDisney2012 = 1,  // isotropic Smith GGX with alpha_g = (0.5 + roughness / 2)^2
     kDisney2015 = 2,  // the 2015 BSDF of a solid: a rough dielectric interface over the whole sphere (docs/model-2015.md)
+    kDisney2015Thin = 3,  // the 2015 BSDF of a thin sheet: light passes through without bending (docs/model-2015.md)
 };
-inline constexpr std::array<const char*, 3> kModelNames{"disney2014", "disney2012", "disney2015"};
+inline constexpr std::array<const char*, 4> kModelNames{"disney2014", "disney2012", "disney2015", "disney2015_thin"};
 
 // The models whose directions lie on the whole sphere (the others are BRDFs: f = 0 off the upper hemisphere).
-constexpr bool is_bsdf(Model model) { return model == Model::kDisney2015; }
+constexpr bool is_bsdf(Model model) { return model == Model::kDisney2015 || model == Model::kDisney2015Thin; }
 // The slots a model's derivatives are taken by: the first gradient_slots(model) of the table.
 constexpr int gradient_slots(Model model) { return is_bsdf(model) ? kParamSlots : kGradientSlots; }
 
 // The lobes of f, in the order eval_lobes returns them; multiple_scattering is
 // the energy compensation's (0 unless it is on), transmission the 2015 models'
-// light through the interface (0 for the BRDFs).
-inline constexpr std::array<const char*, 6> kLobeNames{"diffuse", "sheen", "specular", "clearcoat", "multiple_scattering",
-                                                       "transmission"};
+// light through the interface (0 for the BRDFs), diffuse_transmission the thin
+// sheet's diffuse light through it (0 for the others).
+inline constexpr std::array<const char*, 7> kLobeNames{"diffuse", "sheen", "specular", "clearcoat", "multiple_scattering",
+                                                       "transmission", "diffuse_transmission"};
 inline constexpr int kLobeCount = static_cast<int>(kLobeNames.size());
 
-// The lobes sampling draws from, by the index a sample reports (transmission: the 2015 models').
-inline constexpr std::array<const char*, 4> kSampledLobeNames{"cosine", "specular", "clearcoat", "transmission"};
+// The lobes sampling draws from, by the index a sample reports (transmission: the 2015 models';
+// diffuse_transmission: the thin sheet's).
+inline constexpr std::array<const char*, 5> kSampledLobeNames{"cosine", "specular", "clearcoat", "transmission",
+                                                              "diffuse_transmission"};
 
 // Which way light flows through a transmitting interface (docs/model-2015.md):
 // radiance from wi to wo, or importance from wo to wi; only the 2015 solid's

@@ -116,7 +116,8 @@ using ShadingCache = RowCache<Shading<double>, &shading_of<double>>;
 template <Model model>
 using CompensatedCache = RowCache<Compensated, &compensated_of<model>>;
 using GradientShadingCache = RowCache<GradientShading, &gradient_shading_of>;
-using Shading2015Cache = RowCache<Shading2015<double>, &shading2015_of<double>>;
+using Shading2015Cache = RowCache<Shading2015<double>, &solid_shading2015_of<double>>;
+using ThinShading2015Cache = RowCache<Shading2015<double>, &thin_shading2015_of<double>>;
 
 // The four lobes, each already weighted as it enters the sum.
 struct Lobes {
@@ -126,7 +127,10 @@ struct Lobes {
     Vector3d clearcoat = Vector3d::Zero();  // grey
     Vector3d multiple_scattering = Vector3d::Zero();  // energy compensation (model/energy.hpp); 0 when off
     Vector3d transmission = Vector3d::Zero();         // the 2015 models' (model/bsdf2015.hpp)
-    Vector3d total() const { return diffuse + sheen + specular + clearcoat + multiple_scattering + transmission; }
+    Vector3d diffuse_transmission = Vector3d::Zero();  // the thin sheet's
+    Vector3d total() const {
+        return diffuse + sheen + specular + clearcoat + multiple_scattering + transmission + diffuse_transmission;
+    }
 };
 
 inline Vec3<double> vec3(const Vector3d& w) { return {w.x(), w.y(), w.z()}; }
@@ -328,6 +332,7 @@ inline Lobes eval_lobes(const Shading2015<double>& s, const Vector3d& wi, const 
     out.specular = vector3d(v.specular);
     out.clearcoat = vector3d(v.clearcoat);
     out.transmission = vector3d(v.transmission);
+    out.diffuse_transmission = vector3d(v.diffuse_transmission);
     return out;
 }
 
@@ -336,10 +341,11 @@ inline Vector3d eval(const Shading2015<double>& s, const Vector3d& wi, const Vec
     return vector3d(eval_lobes2015(vec3(wi), vec3(wo), s, mode).total());
 }
 
-// P_k at wo of the cosine, specular, clearcoat and transmission lobes.
-inline std::array<double, 4> lobe_probabilities(const Shading2015<double>& s, const Vector3d& wo) {
+// P_k at wo of the sampled lobes (kSampledLobeNames).
+inline std::array<double, kSampledLobeNames.size()> lobe_probabilities(const Shading2015<double>& s, const Vector3d& wo) {
     const LobeWeights2015<double> w = lobe_weights2015(side_of(vec3(wo), vec3(wo), s), s);
-    return {w.cosine * w.inv_total, w.specular * w.inv_total, w.clearcoat * w.inv_total, w.transmission * w.inv_total};
+    return {w.cosine * w.inv_total, w.specular * w.inv_total, w.clearcoat * w.inv_total, w.transmission * w.inv_total,
+            w.diffuse_transmission * w.inv_total};
 }
 
 // The mixture density of wi given wo over the whole sphere.
@@ -348,14 +354,14 @@ inline double pdf(const Shading2015<double>& s, const Vector3d& wi, const Vector
     return pdf2015(vec3(wi), vec3(wo), s, sampler);
 }
 
-// As sample() of the BRDFs; lobe 3 is the transmission. wi = 0 where the
+// As sample() of the BRDFs; lobe 3 is the transmission, 4 the thin sheet's diffuse transmission. wi = 0 where the
 // transmission's microfacet reflects totally (no refracted direction).
 inline Sample sample(const Shading2015<double>& s, const Vector3d& wo, double u0, double u1, double u2,
                      SpecularSampler sampler = SpecularSampler::kVisibleNormals,
                      TransportMode mode = TransportMode::kRadiance) {
     const Sample2015<double> drawn = sample2015(vec3(wo), Uniforms<double>{u0, u1, u2}, s, sampler, mode);
     const LobeChoice2015<double>& c = drawn.choice;
-    const int lobe = c.transmission ? 3 : c.reflected.cosine ? 0 : c.reflected.specular ? 1 : 2;
+    const int lobe = c.transmission ? 3 : c.diffuse_transmission ? 4 : c.reflected.cosine ? 0 : c.reflected.specular ? 1 : 2;
     return {vector3d(drawn.wi), drawn.pdf, vector3d(drawn.weight), lobe};
 }
 
@@ -366,7 +372,8 @@ struct Gradient2015 {
             Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor>::Zero();
 };
 
-using GradientShading2015Cache = RowCache<GradientShading2015<double>, &gradient_shading2015_of<double>>;
+using GradientShading2015Cache = RowCache<GradientShading2015<double>, &solid_gradient_shading2015_of<double>>;
+using ThinGradientShading2015Cache = RowCache<GradientShading2015<double>, &thin_gradient_shading2015_of<double>>;
 
 inline Gradient2015 eval_grad(const GradientShading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
                               TransportMode mode = TransportMode::kRadiance) {

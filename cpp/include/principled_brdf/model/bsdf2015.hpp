@@ -4,10 +4,16 @@
 // 2007) that reflects and transmits from either side.
 //
 // Sides. Every function takes the pair as the viewer sees it: when wo lies
-// inside (wo.z < 0) both directions are mirrored through the tangent plane
+// below the tangent plane (wo.z < 0) both directions are mirrored through it
 // first (Side), so that the viewer is above and the light above (reflection)
 // or below (transmission); η_t is then the light side's index over the
 // viewer's, η outside and 1/η inside.
+//
+// The thin sheet (disney2015_thin, Burley 2015) shares the solid's lobes
+// above the sheet and replaces the refraction: both interfaces lie at one
+// point, so light passes without bending, through a microfacet lobe mirrored
+// below the sheet (roughness r_t) and a diffuse one; the sheet has no inside,
+// both of its faces see the lobes outside.
 #pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
 // η - 1 from specular: ((η - 1)/(η + 1))² = 0.08 specular gives
@@ -38,12 +44,27 @@ struct Shading2015 {
     F transmission_luminance;   // lum(sqrt(base_color))
     F eta, inv_eta;
     F eta_minus_one, inv_eta_minus_one;  // η - 1 and 1/η - 1 = -(η - 1)/η
+    // the thin sheet's: the transmission's GGX, alphas of r_t = clamp((0.65 η - 0.35) r, 0, 1) with
+    // roughness's anisotropy, and the diffuse transmission w_D dt c / π, its sampling weight w_D dt lum(c)
+    bool thin = false;
+    Ggx<F> thin_ggx;
+    Rgb<F> diffuse_transmission;
+    F diffuse_transmission_luminance;
 
     PB_MODEL_INLINE bool opaque() const { return !any(transmission_weight != F(0.0)); }
 };
 
+// Both GGX alphas of a roughness, with the 2014 anisotropy (principled.hpp's shading_of).
 template <class F>
-PB_MODEL_INLINE Shading2015<F> shading2015_of(const F* p) {
+PB_MODEL_INLINE Ggx<F> ggx_of_roughness(F roughness, F anisotropic) {
+    F aspect2 = neg_mul_add(F(0.9), anisotropic, F(1.0));
+    F inv_aspect = reciprocal_sqrt(aspect2);
+    F alpha = roughness * roughness;
+    return Ggx<F>::from_alphas(max(F(0.001), alpha * inv_aspect), max(F(0.001), alpha * (aspect2 * inv_aspect)));
+}
+
+template <class F>
+PB_MODEL_INLINE Shading2015<F> shading2015_of(const F* p, bool thin = false) {
     F one(1.0);
     Shading2015<F> s;
     s.brdf = shading_of(p);
@@ -68,14 +89,37 @@ PB_MODEL_INLINE Shading2015<F> shading2015_of(const F* p) {
     s.eta = s.eta_minus_one + one;
     s.inv_eta = one / s.eta;
     s.inv_eta_minus_one = -s.eta_minus_one * s.inv_eta;
+    s.thin = thin;
+    if (thin) {
+        // dt = diff_trans / 2 of the diffuse goes through the sheet; transmitted light keeps c, not sqrt(c)
+        F kept = neg_mul_add(F(0.5), p[kDiffTrans], one);
+        F through = F(0.5) * p[kDiffTrans];
+        s.brdf.diffuse.color = kept * s.brdf.diffuse.color;
+        s.brdf.sheen.color = kept * s.brdf.sheen.color;
+        s.brdf.diffuse.cosine_lobe_weight = kept * s.brdf.diffuse.cosine_lobe_weight;
+        s.transmission_color = base;
+        s.transmission_luminance = luminance_of(base);
+        F diffuse_weight = dielectric * opaque_fraction * through;
+        s.diffuse_transmission = (diffuse_weight * F(kInvPi)) * base;
+        s.diffuse_transmission_luminance = diffuse_weight * s.transmission_luminance;
+        F thin_roughness = min(max(mul_add(F(0.65), s.eta, F(-0.35)) * p[kRoughness], F(0.0)), one);
+        s.thin_ggx = ggx_of_roughness(thin_roughness, p[kAnisotropic]);
+    }
     return s;
 }
+
+// (one model's each, for a function pointer)
+template <class F>
+PB_MODEL_INLINE Shading2015<F> solid_shading2015_of(const F* p) { return shading2015_of(p, false); }
+template <class F>
+PB_MODEL_INLINE Shading2015<F> thin_shading2015_of(const F* p) { return shading2015_of(p, true); }
 
 // The pair as the viewer sees it (the file's comment).
 template <class F>
 struct Side {
-    Vec3<F> wi, wo;     // mirrored when the viewer is inside: wo.z >= 0
-    MaskOf<F> inside;   // the viewer is inside
+    Vec3<F> wi, wo;     // mirrored when wo.z < 0: wo.z >= 0
+    MaskOf<F> flipped;  // mirrored
+    MaskOf<F> inside;   // the viewer is inside the solid (flipped; never on a thin sheet)
     F eta_t;            // η_t: η outside, 1/η inside
     F eta_t_minus_one;  // η_t - 1
 };
@@ -86,9 +130,10 @@ PB_MODEL_INLINE Vec3<F> mirrored(const Vec3<F>& w) { return {w.x, w.y, -w.z}; }
 template <class F>
 PB_MODEL_INLINE Side<F> side_of(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s) {
     Side<F> side;
-    side.inside = wo.z < F(0.0);
-    side.wi = select(side.inside, mirrored(wi), wi);
-    side.wo = select(side.inside, mirrored(wo), wo);
+    side.flipped = wo.z < F(0.0);
+    side.inside = s.thin ? MaskOf<F>(false) : side.flipped;
+    side.wi = select(side.flipped, mirrored(wi), wi);
+    side.wo = select(side.flipped, mirrored(wo), wo);
     side.eta_t = select(side.inside, s.inv_eta, s.eta);
     side.eta_t_minus_one = select(side.inside, s.inv_eta_minus_one, s.eta_minus_one);
     return side;
@@ -97,9 +142,9 @@ PB_MODEL_INLINE Side<F> side_of(const Vec3<F>& wi, const Vec3<F>& wo, const Shad
 // The lobes of f at a pair, per channel.
 template <class F>
 struct Lobes2015 {
-    Rgb<F> diffuse, sheen, specular, clearcoat, transmission;
+    Rgb<F> diffuse, sheen, specular, clearcoat, transmission, diffuse_transmission;
 
-    Rgb<F> total() const { return diffuse + sheen + specular + clearcoat + transmission; }
+    Rgb<F> total() const { return diffuse + sheen + specular + clearcoat + transmission + diffuse_transmission; }
 };
 
 // The reflection, both directions on the viewer's side (wi.z, wo.z > 0 after
@@ -136,6 +181,7 @@ PB_MODEL_INLINE Lobes2015<F> reflection2015(const Side<F>& side, const Geometry<
     F clearcoat = select(outside, b.clearcoat.value(g, fh, b.clearcoat.smith_wo(side.wo)), zero);
     out.clearcoat = {clearcoat, clearcoat, clearcoat};
     out.transmission = none;
+    out.diffuse_transmission = none;
     return out;
 }
 
@@ -192,6 +238,32 @@ PB_MODEL_INLINE F transmission_value(const Side<F>& side, const Refraction<F>& r
     return select(r.valid, value, F(0.0));
 }
 
+// The thin sheet's microfacet transmission, viewer above, light below
+// (Burley 2015): the light's direction mirrored, wi' = mirror(wi), h' the half
+// vector of (wi', wo),
+//   w_T c (1 - F_D(wo·h'; η)) D_t(h') G1_t(wo) G1_t(wi') / (4 |cos θl| |cos θv|),
+// formed as the specular's Ds Gs (SpecularLobe::value) with the sheet's GGX; c applied by the caller.
+template <class F>
+PB_MODEL_INLINE F thin_transmission_value(const Side<F>& side, const Shading2015<F>& s) {
+    Vec3<F> through = mirrored(side.wi);
+    Geometry<F> g = geometry_of(through, side.wo);
+    F ds_gs = s.thin_ggx.d(g) / (s.thin_ggx.smith_denominator(through) * s.thin_ggx.smith_denominator(side.wo));
+    F value = s.transmission_weight * fresnel_dielectric_transmittance(g.cos_theta_d, s.eta) * ds_gs;
+    return select((side.wi.z < F(0.0)) & g.finite, value, F(0.0));
+}
+
+// The thin sheet's density of transmitted wi: the mirrored direction's, drawn
+// as a reflection about a half vector of the sheet's GGX (SpecularLobe::pdf).
+template <class F>
+PB_MODEL_INLINE F thin_transmission_pdf(const Side<F>& side, const Ggx<F>& ggx, SpecularSampler sampler) {
+    Vec3<F> through = mirrored(side.wi);
+    Geometry<F> g = geometry_of(through, side.wo);
+    F d_h = ggx.d(g);
+    F pdf = sampler == SpecularSampler::kDistribution ? ggx.distribution_pdf(d_h, g)
+                                                     : ggx.visible_pdf(d_h, ggx.smith_denominator(side.wo));
+    return select((side.wi.z < F(0.0)) & g.finite, pdf, F(0.0));
+}
+
 // Every lobe at (wi, wo), 0 where the pair is not one the model scatters
 // (a direction in the tangent plane, or not finite: see geometry_of).
 template <class F>
@@ -211,7 +283,14 @@ PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Side<F>& side, const Geometry<
     out.sheen = select(reflected, out.sheen, none);
     out.specular = select(reflected, out.specular, none);
     out.clearcoat = select(reflected, out.clearcoat, none);
-    if (!s.opaque()) {
+    out.diffuse_transmission = none;
+    if (s.thin) {
+        // no η² in importance mode: the sheet does not bend the light, and it is reciprocal as it stands
+        MaskOf<F> through = scattered & (side.wi.z < zero);
+        F t = s.opaque() ? zero : select(scattered, thin_transmission_value(side, s), zero);
+        out.transmission = t * s.transmission_color;
+        out.diffuse_transmission = select(through, s.diffuse_transmission, none);
+    } else if (!s.opaque()) {
         F t = select(scattered, transmission_value(side, refraction_of(side, s.brdf.specular.ggx), s, mode), zero);
         out.transmission = t * s.transmission_color;
     }
@@ -230,13 +309,19 @@ PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Vec3<F>& wi, const Vec3<F>& wo
 // their albedo at the view: outside, w0 = w_D (Cdlum + 0.1 sheen lum(Csheen))
 // (cosine), w1 = max(lum(F_s at cos θv), 0.02) (specular reflection), w2 the
 // clearcoat's, w3 = w_T (1 - F_D(cos θv; η)) lum(sqrt(c)) (transmission);
-// inside, w1 = w_T F_D(cos θv; 1/η), w3 = w_T (1 - F_D(cos θv; 1/η)) lum(sqrt(c))
-// and no other lobe. The reflected lobes count only above the viewer's side
-// and the transmission only below: a draw that lands on the wrong side is
-// no sample (pdf and weight 0).
+// inside only the interface exists: a half vector h is drawn first and the
+// draw reflects about it with probability F_D(wo·h; 1/η), else refracts
+// (the split of a smooth interface at every microfacet: the weight of a
+// reflection on the far side of the critical angle is not a ratio of two
+// Fresnel factors at different angles); the weights w1 = w_T F_D(cos θv; 1/η)
+// and w3 = w_T (1 - F_D(cos θv; 1/η)) report that split at h = n. The thin
+// sheet: the outside weights on either face, with w0 times 1 - dt, w3 with
+// lum(c), and w4 = w_D dt lum(c) (diffuse transmission). The reflected lobes
+// count only above the viewer's side and the transmission only below: a draw
+// that lands on the wrong side is no sample (pdf and weight 0).
 template <class F>
 struct LobeWeights2015 {
-    F cosine, specular, clearcoat, transmission;
+    F cosine, specular, clearcoat, transmission, diffuse_transmission;
     F inv_total;  // 0 where every weight is 0 (an opaque solid seen from inside)
 };
 
@@ -247,7 +332,7 @@ PB_MODEL_INLINE LobeWeights2015<F> lobe_weights2015(const Side<F>& side, const S
     F fv = schlick_weight(cos_v);
     FresnelDielectric<F> fresnel = fresnel_dielectric_both(cos_v, side.eta_t);
     F exact = fresnel.reflectance;
-    F transmitted = s.transmission_weight * fresnel.transmittance * s.transmission_luminance;
+    F transmitted = s.transmission_weight * fresnel.transmittance * select(side.inside, one, s.transmission_luminance);
     F grey = mul_add(s.dielectric, exact, s.schlick_grazing * fv);
     F schlick_luminance = luminance_of(s.schlick_f0) * (one - fv);
     LobeWeights2015<F> w;
@@ -255,7 +340,8 @@ PB_MODEL_INLINE LobeWeights2015<F> lobe_weights2015(const Side<F>& side, const S
     w.specular = select(side.inside, s.transmission_weight * exact, max(schlick_luminance + grey, F(0.02)));
     w.clearcoat = select(side.inside, zero, s.brdf.clearcoat.weight(fv));
     w.transmission = transmitted;
-    F total = w.cosine + w.specular + w.clearcoat + w.transmission;
+    w.diffuse_transmission = s.thin ? s.diffuse_transmission_luminance : zero;
+    F total = w.cosine + w.specular + w.clearcoat + w.transmission + w.diffuse_transmission;
     w.inv_total = select(total > zero, one / total, zero);
     return w;
 }
@@ -284,9 +370,21 @@ PB_MODEL_INLINE F pdf2015(const Side<F>& side, const Geometry<F>& g, const LobeW
     F clearcoat = b.clearcoat.absent() ? zero : w.clearcoat * b.clearcoat.gtr1.pdf(g);
     F reflected = mul_add(w.cosine * F(kInvPi), side.wi.z, mul_add(w.specular, specular, clearcoat));
     F pdf = select(side.wi.z > zero, reflected, zero);
-    if (!s.opaque()) {
-        F transmitted = w.transmission * transmission_pdf(side, refraction_of(side, b.specular.ggx), b.specular.ggx, sampler);
-        pdf = select(side.wi.z < zero, transmitted, pdf);
+    if (s.thin) {
+        F through = mul_add(w.diffuse_transmission * F(kInvPi), -side.wi.z,
+                            w.transmission * thin_transmission_pdf(side, s.thin_ggx, sampler));
+        pdf = select(side.wi.z < zero, through, pdf);
+    } else if (!s.opaque()) {
+        Refraction<F> r = refraction_of(side, b.specular.ggx);
+        F refracted = transmission_pdf(side, r, b.specular.ggx, sampler);
+        F mixture = w.inv_total * select(side.wi.z < zero, w.transmission * refracted, pdf);
+        if (any(side.inside)) {  // the interface alone, split at the microfacet
+            F reflects = fresnel_dielectric(g.cos_theta_d, side.eta_t);
+            F refracts = fresnel_dielectric_transmittance(r.wo_h * reciprocal_sqrt(r.h.h_len2), side.eta_t);
+            F interface = select(side.wi.z < zero, refracts * refracted, reflects * specular);
+            mixture = select(side.inside, select(s.transmission_weight > zero, interface, zero), mixture);
+        }
+        return select(scattered, mixture, zero);
     }
     return select(scattered, w.inv_total * pdf, zero);
 }
@@ -297,23 +395,27 @@ PB_MODEL_INLINE F pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading201
     return pdf2015(side, geometry_of(side.wi, side.wo), lobe_weights2015(side, s), s, sampler);
 }
 
-// The lobe a sample draws from: 0 cosine, 1 specular, 2 clearcoat, 3 transmission
-// (kSampledLobeNames), by u0 Σ w against the weights' running sums.
+// The lobe a sample draws from: 0 cosine, 1 specular, 2 clearcoat, 3 transmission,
+// 4 diffuse transmission (kSampledLobeNames), by u0 Σ w against the weights'
+// running sums. The diffuse transmission draws the cosine lobe's direction
+// and mirrors it below.
 template <class F>
 struct LobeChoice2015 {
-    LobeChoice<F> reflected;  // the reflected lobes' choice (sample_direction's), for lanes not transmitting
-    MaskOf<F> transmission;
+    LobeChoice<F> reflected;  // the direction's draw (sample_direction's), for lanes not transmitting through a microfacet
+    MaskOf<F> transmission, diffuse_transmission;
 };
 
 template <class F>
 PB_MODEL_INLINE LobeChoice2015<F> choose_lobe2015(F u0, const LobeWeights2015<F>& w) {
-    F scaled = u0 * (w.cosine + w.specular + w.clearcoat + w.transmission);
-    MaskOf<F> cosine = scaled < w.cosine;
+    F zero(0.0);
     F reflected_total = w.cosine + w.specular + w.clearcoat;
-    MaskOf<F> transmission = !(scaled < reflected_total) & (w.transmission > F(0.0));
+    F scaled = u0 * (reflected_total + w.transmission + w.diffuse_transmission);
+    MaskOf<F> diffuse_transmission = !(scaled < reflected_total + w.transmission) & (w.diffuse_transmission > zero);
+    MaskOf<F> transmission = !(scaled < reflected_total) & !diffuse_transmission & (w.transmission > zero);
+    MaskOf<F> cosine = (scaled < w.cosine) | diffuse_transmission;
     // past the specular's share: the clearcoat when it has one, else the specular
-    MaskOf<F> specular = !cosine & !transmission & ((scaled < w.cosine + w.specular) | (w.clearcoat <= F(0.0)));
-    return {{cosine, specular}, transmission};
+    MaskOf<F> specular = !cosine & !transmission & ((scaled < w.cosine + w.specular) | (w.clearcoat <= zero));
+    return {{cosine, specular}, transmission, diffuse_transmission};
 }
 
 // wi refracted from wo about the microfacet normal h = d / |d| with η_t (Snell's
@@ -355,15 +457,34 @@ PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u
     LobeWeights2015<F> w = lobe_weights2015(view, s);
     LobeChoice2015<F> choice = choose_lobe2015(u.u0, w);
     Vec3<F> wi = sample_direction(view.wo, u, choice.reflected, s.brdf, sampler).wi;
-    if (any(choice.transmission)) {
+    wi = select(choice.diffuse_transmission, mirrored(wi), wi);
+    if (s.thin && any(choice.transmission)) {
+        // a reflection about a half vector of the sheet's GGX, mirrored below
+        Shading<F> sheet = s.brdf;
+        sheet.specular.ggx = s.thin_ggx;
+        LobeChoice<F> specular{MaskOf<F>(false), MaskOf<F>(true)};
+        wi = select(choice.transmission, mirrored(sample_direction(view.wo, u, specular, sheet, sampler).wi), wi);
+    } else if (any(choice.transmission | view.inside)) {
         const Ggx<F>& ggx = s.brdf.specular.ggx;
         const auto [sin_phi, cos_phi] = sincos_turns(u.u1);
         Vec3<F> d = sampler == SpecularSampler::kDistribution ? ggx.sample_distribution(sin_phi, cos_phi, u.u2)
                                                                : ggx.sample_visible(view.wo, sin_phi, cos_phi, u.u2);
+        if (any(view.inside)) {  // the interface alone: reflect about h with probability F_D(wo·h; 1/η), u0 < F_D
+            F c = dot(view.wo, d) * reciprocal_sqrt(squared_length(d));
+            MaskOf<F> reflects = view.inside & (u.u0 < fresnel_dielectric(c, view.eta_t));
+            MaskOf<F> refracts = view.inside & !reflects;
+            F scale = F(2.0) * dot(view.wo, d) / squared_length(d);
+            Vec3<F> reflected{mul_sub(scale, d.x, view.wo.x), mul_sub(scale, d.y, view.wo.y), mul_sub(scale, d.z, view.wo.z)};
+            wi = select(reflects, reflected, wi);
+            choice.transmission = refracts | (!view.inside & choice.transmission);
+            choice.reflected.specular = reflects | (!view.inside & choice.reflected.specular);
+            choice.reflected.cosine = !view.inside & choice.reflected.cosine;
+        }
         wi = select(choice.transmission, refract_about(view.wo, d, view.eta_t), wi);
     }
     // a draw counts only on its lobe's side: the reflected lobes' above, the transmission's below
-    MaskOf<F> on_its_side = (choice.transmission & (wi.z < zero)) | (!choice.transmission & (wi.z > zero));
+    MaskOf<F> below = choice.transmission | choice.diffuse_transmission;
+    MaskOf<F> on_its_side = (below & (wi.z < zero)) | (!below & (wi.z > zero));
     // the pair as the viewer sees it is the view with the drawn wi (side_of reads only wo)
     Side<F> pair = view;
     pair.wi = wi;
@@ -371,7 +492,7 @@ PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u
     Sample2015<F> out;
     out.pdf = pdf2015(pair, g, w, s, sampler);
     out.lobes = eval_lobes2015(pair, g, s, mode);
-    wi = select(view.inside, mirrored(wi), wi);  // back to the caller's frame
+    wi = select(view.flipped, mirrored(wi), wi);  // back to the caller's frame
     MaskOf<F> valid = (out.pdf > zero) & (view.wo.z > zero) & on_its_side;
     out.scale = select(valid, max(wi.z, -wi.z) / out.pdf, zero);
     Rgb<F> f = out.lobes.total();

@@ -27,7 +27,7 @@ struct GradientShading2015 {
 };
 
 template <class F>
-PB_MODEL_INLINE GradientShading2015<F> gradient_shading2015_of(const F* p) {
+PB_MODEL_INLINE GradientShading2015<F> gradient_shading2015_of(const F* p, bool thin = false) {
     GradientShading2015<F> g;
     for (int q = 0; q < kGradientPasses; ++q) {
         PassDual<F> slots[kParamSlots];
@@ -35,10 +35,15 @@ PB_MODEL_INLINE GradientShading2015<F> gradient_shading2015_of(const F* p) {
             const int tangent = k - q * kSlotsAPass;
             slots[k] = tangent >= 0 && tangent < kSlotsAPass ? PassDual<F>::variable(p[k], tangent) : PassDual<F>(p[k]);
         }
-        g.pass[q] = shading2015_of(slots);
+        g.pass[q] = shading2015_of(slots, thin);
     }
     return g;
 }
+
+template <class F>
+PB_MODEL_INLINE GradientShading2015<F> solid_gradient_shading2015_of(const F* p) { return gradient_shading2015_of(p, false); }
+template <class F>
+PB_MODEL_INLINE GradientShading2015<F> thin_gradient_shading2015_of(const F* p) { return gradient_shading2015_of(p, true); }
 
 // f (times |cos θl| if `cosine`), returned, and ∂f_c/∂p given to
 // `jacobian(c, p, value)` for every channel c and every slot p the sink
