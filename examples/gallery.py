@@ -65,7 +65,7 @@ def glass(path: str) -> None:
     spheres, titles = [], []
     for environment in ("studio", "outdoor"):
         spheres += [pb.render.render_sphere(pb.Material(**params), 128, model=model, environment=environment,
-                                            samples=512) for _, model, params in GLASS]
+                                            samples=2048) for _, model, params in GLASS]
         titles.append(environment)
     labels = [label for label, _, _ in GLASS] + [""] * len(GLASS)
     demo.write_picture(path, spheres, labels, columns=len(GLASS), row_titles=titles)
