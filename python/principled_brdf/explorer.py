@@ -14,8 +14,10 @@ them, each a PNG in an ``ipywidgets.Image`` (``explorer.images[name]``):
     the material on a sphere (``pb.render.render_sphere``, orthographic from
     +z) lit from (θl, φl) in camera space (x right, y up): at the centre of
     the sphere, whose normal faces the viewer, that is the light of the
-    sliders in the local frame. ``sky light`` adds ``pb.render``'s sky by
-    importance sampling; ``exposure`` in stops, then ``pb.render.to_srgb8``.
+    sliders in the local frame. ``environment light`` adds the ``environment``
+    menu's (``pb.render``'s sky, the studio or the outdoor map) by importance
+    sampling; ``exposure`` in stops, then ``pb.render.to_srgb8``. With the 2015
+    models light passes through the sphere (``render_sphere``).
 ``"polar"``
     f (luminance, 1/sr) per lobe and in total in the plane of incidence of
     the view direction (θv, φv): wi sweeps the plane through the normal and
@@ -52,7 +54,7 @@ from . import render as _render
 from ._batch import FLOAT32_LIMITS as _KERNEL_LIMITS
 from ._batch import eval_lobes as _eval_lobes
 from .albedo import albedo as _albedo
-from .material import PARAMETERS, Material, srgb_to_linear
+from .material import PARAMETERS, Material, srgb_to_linear, unread_parameters
 from .plot import _LOBE_COLORS as _PLOT_LOBE_COLORS
 from .plot import CHANNELS, _rgba, _uniform_material, _upper_half_disc, slice_directions
 
@@ -81,10 +83,11 @@ CUSTOM = "(custom)"
 
 _LUMINANCE = np.asarray(CHANNELS["luminance"], dtype=np.float64)
 # plot's colors; the multiple-scattering lobe counts in the totals without a line of its own
-_LOBE_COLORS = {name: color for name, color in _PLOT_LOBE_COLORS.items() if name != "multiple_scattering"}
+_LOBE_COLORS = {name: color for name, color in _PLOT_LOBE_COLORS.items()
+                if name in _validate.LOBE_NAMES + ("total",) and name != "multiple_scattering"}
 # What each picture shows (keys of Explorer._state): it is redrawn only when one of these changes.
 _DEPENDS = {
-    "sphere": ("material", "model", "energy_compensation", "light", "exposure", "sky"),
+    "sphere": ("material", "model", "energy_compensation", "light", "exposure", "sky", "environment"),
     "polar": ("material", "model", "energy_compensation", "light", "view", "log"),
     "slice": ("material", "model", "energy_compensation", "light", "view"),
     "albedo": ("material", "model", "energy_compensation", "view"),
@@ -198,9 +201,10 @@ class Explorer:
     """The widget of :func:`explorer`: controls, four PNG images and the state behind them.
 
     Attributes (all ipywidgets): ``sliders`` (``{name: FloatSlider}`` for the
-    ten scalar parameters, ranges from ``pb.PARAMETERS``' domains),
-    ``base_color`` (ColorPicker, sRGB), ``model``, ``preset`` (Dropdowns),
-    ``light_theta``, ``light_phi``, ``view_theta``, ``view_phi`` (degrees),
+    scalar parameters, ranges from ``pb.PARAMETERS``' domains; those the model
+    does not read are disabled and count at their defaults),
+    ``base_color`` (ColorPicker, sRGB), ``model``, ``preset``, ``environment``
+    (Dropdowns), ``light_theta``, ``light_phi``, ``view_theta``, ``view_phi`` (degrees),
     ``exposure`` (stops), ``sky``, ``log_radius`` (Checkboxes),
     ``energy_compensation`` (a Checkbox: ``energy_compensation=`` of every
     picture's kernel calls), ``images`` (``{name: Image}`` for
@@ -280,7 +284,9 @@ class Explorer:
         self.view_theta = slider("view θ (°)", 45.0, 0.0, 90.0, 0.5, ".1f", "view_theta")
         self.view_phi = slider("view φ (°)", 0.0, 0.0, 360.0, 1.0, ".0f", "view_phi")
         self.exposure = slider("exposure (stops)", 0.0, -4.0, 4.0, 0.25, "+.2f", "exposure", _MAX_EXPOSURE_STOPS)
-        self.sky = widgets.Checkbox(value=True, description="sky light on the sphere", indent=False)
+        self.sky = widgets.Checkbox(value=True, description="environment light on the sphere", indent=False)
+        self.environment = widgets.Dropdown(options=list(_render.ENVIRONMENT_NAMES), value="sky",
+                                            description="environment", style=style, layout=layout)
         self.log_radius = widgets.Checkbox(value=False, description="log radius (polar)", indent=False)
         self.energy_compensation = widgets.Checkbox(value=False, description="energy compensation", indent=False)
 
@@ -313,7 +319,7 @@ class Explorer:
         controls = widgets.VBox(
             [header("Material"), self.preset, self.model, self.base_color, *self.sliders.values(),
              header("Light and view"), self.light_theta, self.light_phi, self.view_theta, self.view_phi,
-             self.exposure, *checks, self.status],
+             self.exposure, self.environment, *checks, self.status],
             layout=widgets.Layout(width="345px"))
         pictures = widgets.GridBox([cell(self.images[name]) for name in OUTPUTS],
                                    layout=widgets.Layout(grid_template_columns="auto auto"))
@@ -321,6 +327,7 @@ class Explorer:
         self._initial = (material, preset, {control: (control.value, getattr(control, "max", None))
                                             for control in self._controls()
                                             if control not in (self.preset, self.base_color)})
+        self._grey_out_unread()
         self.refresh()
 
     # ------------------------------------------------------------------
@@ -336,22 +343,34 @@ class Explorer:
 
     def _controls(self) -> list[Any]:
         return [*self.sliders.values(), self.base_color, self.model, self.preset, self.light_theta, self.light_phi,
-                self.view_theta, self.view_phi, self.exposure, self.sky, self.log_radius, self.energy_compensation]
+                self.view_theta, self.view_phi, self.exposure, self.sky, self.environment, self.log_radius,
+                self.energy_compensation]
 
     @property
     def material(self) -> Material:
-        """The material the sliders show (``base_color`` linear)."""
-        values = {name: float(s.value) for name, s in self.sliders.items()}
-        return Material(base_color=self._base_color, **values, bright_base_color=True)
+        """The material the sliders show (``base_color`` linear), the parameters the model does
+        not read at their defaults (their sliders are greyed out)."""
+        return Material(base_color=self._base_color, **self._values(), bright_base_color=True)
+
+    def _values(self) -> dict[str, float]:
+        unread = unread_parameters(self.model.value)
+        return {name: float(PARAMETERS[name].default) if name in unread else float(s.value)  # type: ignore[arg-type]
+                for name, s in self.sliders.items()}
+
+    def _grey_out_unread(self) -> None:
+        unread = unread_parameters(self.model.value)
+        for name, slider in self.sliders.items():
+            slider.disabled = name in unread
 
     def _state(self) -> dict[str, Any]:
         return {
-            "material": (self._base_color,) + tuple(float(s.value) for s in self.sliders.values()),
+            "material": (self._base_color,) + tuple(self._values().values()),
             "model": self.model.value,
             "light": (float(self.light_theta.value), float(self.light_phi.value)),
             "view": (float(self.view_theta.value), float(self.view_phi.value)),
             "exposure": float(self.exposure.value),
             "sky": bool(self.sky.value),
+            "environment": self.environment.value,
             "log": bool(self.log_radius.value),
             "energy_compensation": bool(self.energy_compensation.value),
         }
@@ -395,6 +414,8 @@ class Explorer:
     def _changed(self, change: Mapping[str, Any]) -> None:
         if self._closed:
             return
+        if change["owner"] is self.model:
+            self._grey_out_unread()
         material_control = change["owner"] is self.base_color or change["owner"] in self.sliders.values()
         if material_control and not self._quiet and self.preset.value != CUSTOM:
             self._quietly(lambda: setattr(self.preset, "value", CUSTOM))
@@ -525,7 +546,7 @@ class Explorer:
         model = state["model"]
         n = self.resolution
         return _render.render_sphere(material, n, light=light, ambient=0.0 if state["sky"] else _AMBIENT, model=model,
-                                     environment="sky" if state["sky"] else None, samples=_SKY_SAMPLES,
+                                     environment=state["environment"] if state["sky"] else None, samples=_SKY_SAMPLES,
                                      energy_compensation=state["energy_compensation"])
 
     def _build_polar(self, Figure: type[Figure]) -> None:

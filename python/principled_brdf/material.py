@@ -47,6 +47,12 @@ _UNREAD_BY = {"disney2014": _READ_BY_2015, "disney2012": _READ_BY_2015, "disney2
               "disney2015_thin": ("subsurface",)}
 
 
+def unread_parameters(model: str) -> tuple[str, ...]:
+    """The parameters ``model`` does not read (which must stay at their defaults), e.g.
+    ``("subsurface", "diff_trans")`` for ``"disney2015"``."""
+    return _UNREAD_BY.get(model, ())
+
+
 
 def _owned_copy(array: Float64Array) -> Float64Array:
     """A read-only copy of ``array``; a broadcast view (stride-0 axes, np.broadcast_to)
@@ -212,7 +218,7 @@ class Material:
         """A ValueError naming the first parameter ``model`` does not read that is
         not at its default, or a ``specular`` the 2015 models cannot turn into an
         index of refraction (docs/model-2015.md, "Parameters")."""
-        for name in _UNREAD_BY.get(model, ()):
+        for name in unread_parameters(model):
             default = PARAMETERS[name].default
             self._require_everywhere(name, lambda array: array == default,
                                      f"model {model!r} does not read it and needs its default {default:g} "

@@ -119,7 +119,9 @@ def test_sphere_is_a_png_of_the_stated_size(explorer):
     ("exposure", 1.0, {"sphere"}),
     ("log_radius", True, {"polar"}),
     ("sky", False, {"sphere"}),
+    ("environment", "studio", {"sphere"}),
     ("model", "disney2012", set(OUTPUTS)),
+    ("model", "disney2015", set(OUTPUTS)),
     ("preset", "gold", set(OUTPUTS)),
     ("base_color", "#3060c0", set(OUTPUTS)),
 ])
@@ -129,6 +131,24 @@ def test_each_control_changes_the_pictures_that_show_it(explorer, control, value
     widget.value = value
     assert changed(before, snapshot(explorer)) == expected
     assert set(explorer.refresh()) == set()  # nothing left to draw
+
+
+def test_the_2015_models_read_their_parameters_and_grey_out_the_rest(explorer):
+    """spec_trans is greyed out (and held at 0) for the BRDFs; subsurface for the 2015 models, so that a
+    preset with subsurface stays drawable; glass in the studio passes light (the sphere is not dark)."""
+    assert explorer.sliders["spec_trans"].disabled and not explorer.sliders["subsurface"].disabled
+    explorer.sliders["spec_trans"].value = 1.0
+    assert float(explorer.material.spec_trans) == 0.0 and set(explorer.refresh()) == set()
+    with explorer.hold():
+        explorer.sliders["subsurface"].value = 0.5
+        explorer.model.value = "disney2015"
+        explorer.environment.value = "outdoor"
+    assert explorer.sliders["subsurface"].disabled and not explorer.sliders["spec_trans"].disabled
+    assert float(explorer.material.spec_trans) == 1.0 and float(explorer.material.subsurface) == 0.0
+    image = pixels(explorer.images["sphere"].value)
+    assert image[..., :3].mean() > 0.1
+    explorer.model.value = "disney2015_thin"
+    assert not explorer.sliders["diff_trans"].disabled
 
 
 def test_no_op_changes_redraw_nothing(explorer):
