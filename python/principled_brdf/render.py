@@ -190,6 +190,12 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     e.g. made by :meth:`Material.mix` with a mask); a leading shape ``S + (1, 1)``
     renders one sphere per material, ``S + (resolution, resolution, 3)``, in one
     kernel call. Background is 0. ``energy_compensation`` as in ``pb.eval``.
+
+    ``model="disney2015"`` renders a solid sphere of the 2015 BSDF and
+    ``"disney2015_thin"`` a thin shell: light the material sends into the sphere
+    goes on inside, every event drawn by ``pb.sample``, until it leaves
+    (docs/rendering-and-plots.md, "Light through the sphere"); the environment
+    and the key light light each point only from its side of its tangent plane.
     """
     light = _light_direction(light)
     lighting = environment_of(environment)
