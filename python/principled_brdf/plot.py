@@ -234,7 +234,7 @@ def slice_directions(resolution: int, phi_d: float = 90.0) -> tuple[FloatArray, 
 def brdf_slice(material: Material | str | _measured.MerlBRDF | Callable[..., Any], *, resolution: int = 256, phi_d: float = 90.0, channel: str = "luminance",
                log: bool = True, model: Model = "disney2014", vmin: float | None = None, vmax: float | None = None,
                percentile: float | None = None, exposure: float = 1.0, cmap: str = "inferno", colorbar: bool = True,
-               ax: Axes | None = None) -> Axes:
+               transmission: bool = False, ax: Axes | None = None) -> Axes:
     """The BRDF image slice f(θh, θd) at azimuth ``phi_d`` (Burley 2012, figures 3, 4 and 17).
 
     θh (half-vector angle from the normal, degrees) runs left to right from 0
@@ -261,8 +261,16 @@ def brdf_slice(material: Material | str | _measured.MerlBRDF | Callable[..., Any
     cells without data are masked like the horizon) or any callable ``f(wi, wo)``
     returning ``(..., 3)`` in 1/sr for float64 ``(..., 3)`` directions, e.g. a
     fitted material beside its measurements.
+
+    ``transmission=True`` (the 2015 models): the slice of the light that passes
+    through, ``f(mirror(wi), wo)`` with the light's direction mirrored below the
+    surface, at the (θh, θd) of the pair before the mirror; for the thin sheet
+    that is its transmitted lobe's own (θh, θd), for the solid a view of the
+    refraction's lobe in the same coordinates.
     """
     _validate.model_index(model)
+    if _validate.flag("transmission", transmission) and model not in _validate.BSDF_MODELS:
+        raise ValueError(f"transmission: model {model!r} transmits nothing; use a 2015 model")
     brdf = _brdf("material", material, model)
     n = _validate.resolution("resolution", resolution)
     rgb_mode = channel == "rgb"
@@ -279,7 +287,8 @@ def brdf_slice(material: Material | str | _measured.MerlBRDF | Callable[..., Any
     from matplotlib import colors, cm
 
     theta_h, theta_d, wi, wo = slice_directions(n, phi_d)
-    f = brdf.f(np.asarray(wi, np.float64), np.asarray(wo, np.float64))
+    light = np.asarray(wi, np.float64) * ([1.0, 1.0, -1.0] if transmission else 1.0)
+    f = brdf.f(light, np.asarray(wo, np.float64))
     valid = (wi[..., 2] > 0.0) & (wo[..., 2] > 0.0) & ~np.isnan(f).any(axis=-1)
     f = np.where(valid[..., None], f, 0.0)
     value = _project(f, weights)
@@ -298,7 +307,8 @@ def brdf_slice(material: Material | str | _measured.MerlBRDF | Callable[..., Any
     # exposure x f is mapped onto [bottom, top]: the scale of f itself is that divided by exposure
     norm = (colors.LogNorm if log else colors.Normalize)(vmin=bottom / exposure, vmax=top / exposure)
     extent = (0.0, 90.0, 0.0, 90.0)
-    title = f"BRDF slice, φd = {float(phi_d):g}°" + (f", exposure {exposure:g}" if exposure != 1.0 else "")
+    title = (("BSDF slice, transmission (light mirrored below)" if transmission else "BRDF slice")
+             + f", φd = {float(phi_d):g}°" + (f", exposure {exposure:g}" if exposure != 1.0 else ""))
 
     assert norm.vmin is not None  # set above (for type checkers: Normalize.vmin is float | None)
     if rgb_mode:
@@ -534,8 +544,9 @@ def albedo_curves(material: Material | str | _measured.MerlBRDF | Callable[..., 
         ax.plot(theta, mean, color=color, lw=1.8 if name == "total" else 1.2, label=label if name == "total" else name,
                 ls="-" if brdf.material is not None else "--")
         ax.fill_between(theta, mean - band, mean + band, color=color, alpha=0.25, lw=0)
-    ax.set_xlim(0.0, last)
-    if sphere:
+    from_below = bool(np.any(theta > 90.0))  # (the whole range only where some view is from inside or below)
+    ax.set_xlim(0.0, 180.0 if from_below else 90.0)
+    if from_below:
         ax.axvline(90.0, color="0.3", lw=0.8)
     ax.set_ylim(bottom=0.0)
     ax.set_xlabel("θo (degrees)")

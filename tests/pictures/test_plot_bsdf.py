@@ -64,3 +64,18 @@ def test_albedo_curves_split_reflectance_and_transmittance_from_either_side():
     with pytest.raises(ValueError, match="angles"):
         pb.plot.albedo_curves(pb.Material(), angles=[100.0])
     plt.close(fig)
+
+
+def test_brdf_slice_of_the_light_that_passes_through():
+    fig, ax = plt.subplots()
+    pb.plot.brdf_slice(LEAF, model="disney2015_thin", transmission=True, log=False, resolution=32, ax=ax)
+    plotted = np.ma.filled(ax.images[-1].get_array(), np.nan)
+    _, _, wi, wo = pb.plot.slice_directions(32, 90.0)
+    expected = pb.eval(LEAF, (wi * [1, 1, -1]).astype(np.float32), wo.astype(np.float32), model="disney2015_thin")
+    expected = expected @ np.array([0.2126, 0.7152, 0.0722])
+    shown = ~np.isnan(plotted)
+    assert shown.mean() > 0.5 and np.nanmax(plotted) > 0
+    np.testing.assert_allclose(plotted[shown], expected[shown], rtol=1e-5, atol=1e-7)
+    with pytest.raises(ValueError, match="transmission"):
+        pb.plot.brdf_slice(pb.Material(), transmission=True)
+    plt.close(fig)
