@@ -22,13 +22,15 @@ them, each a PNG in an ``ipywidgets.Image`` (``explorer.images[name]``):
     f (luminance, 1/sr) per lobe and in total in the plane of incidence of
     the view direction (θv, φv): wi sweeps the plane through the normal and
     wo; the light is drawn projected into that plane. ``log radius`` shows
-    four decades below the next power of ten above the peak.
+    four decades below the next power of ten above the peak. With the 2015
+    models the whole circle (the transmitted lobe below the surface), and
+    the view θ goes to 180° (from inside or below).
 ``"slice"``
     the (θh, θd) image slice at φd = 90° (``pb.plot.slice_directions``), log
     luminance, with the light/view pair's (θh, θd) marked.
 ``"albedo"``
     the directional albedo E(θo) per lobe and in total (``pb.albedo``, ±2
-    standard errors), with θv marked.
+    standard errors), with θv marked; to 180° with the 2015 models.
 
 Every number comes from the batched kernel. A picture is recomputed only when
 something it shows changes (a view angle does not re-render the sphere), and
@@ -103,6 +105,10 @@ _POLAR_STEPS = 360
 _POLAR_DECADES = 4
 _SLICE_RESOLUTION = 128
 _ALBEDO_ANGLES = np.concatenate([np.arange(0.0, 85.0, 5.0), [84.0, 87.0, 89.0]])  # denser where E(θo) turns
+# the 2015 models' (BSDFs): views from below too, mirrored about the horizon
+_ALBEDO_ANGLES_SPHERE = np.concatenate([_ALBEDO_ANGLES, 180.0 - _ALBEDO_ANGLES[::-1]])
+_HALF_DISC_AXES = (0.117, 0.028, 0.767, 1.023)  # the polar plot's Axes: a half disc of radius 135 px over the legend
+_DISC_AXES = (0.27, 0.2, 0.46, 0.6)  # the whole circle, radius 79 px, between the legend and the title
 _ALBEDO_SAMPLES = 1 << 12
 _SKY_SAMPLES = 32  # render_sphere uses 64; 32 shows little grain and keeps an update near 0.2 s
 _AMBIENT = 0.03  # times base_color, without the sky: the unlit side is not black
@@ -358,9 +364,12 @@ class Explorer:
                 for name, s in self.sliders.items()}
 
     def _grey_out_unread(self) -> None:
+        """The model's controls: the sliders of the parameters it does not read greyed out, and the
+        view from below (θ to 180°) for the 2015 models."""
         unread = unread_parameters(self.model.value)
         for name, slider in self.sliders.items():
             slider.disabled = name in unread
+        self.view_theta.max = 180.0 if self.model.value in _validate.BSDF_MODELS else 90.0
 
     def _state(self) -> dict[str, Any]:
         return {
@@ -415,7 +424,8 @@ class Explorer:
         if self._closed:
             return
         if change["owner"] is self.model:
-            self._grey_out_unread()
+            with self.hold():  # (a view from below comes back to 90° with a BRDF: one update)
+                self._grey_out_unread()
         material_control = change["owner"] is self.base_color or change["owner"] in self.sliders.values()
         if material_control and not self._quiet and self.preset.value != CUSTOM:
             self._quietly(lambda: setattr(self.preset, "value", CUSTOM))
@@ -554,7 +564,7 @@ class Explorer:
         self._canvas(fig)
         # The Axes becomes a square, the half disc (radius: half its side) centred in it: a radius of
         # 135 px, the horizon 75 px above the bottom (room for the legend); the title is a figure text.
-        ax = cast("PolarAxes", fig.add_axes((0.117, 0.028, 0.767, 1.023), projection="polar"))
+        ax = cast("PolarAxes", fig.add_axes(_HALF_DISC_AXES, projection="polar"))
         _upper_half_disc(ax)
         ax.set_thetagrids([-90, -60, -30, 0, 30, 60, 90])
         ax.set_rlabel_position(80)  # near the horizon on the side of wo
@@ -564,11 +574,23 @@ class Explorer:
         lines["wo"] = ax.plot([0, 0], [0, 1], **_KEY_STYLES["wo"])[0]
         lines["wi"] = ax.plot([0, 0], [0, 1], **_KEY_STYLES["wi"])[0]
         title = fig.text(0.5, 0.985, "", ha="center", va="top", fontsize=_FONT["axes.titlesize"])
-        self._polar = {"ax": ax, "t": t, "lines": lines, "legend": self._legend(fig), "title": title}
+        self._polar = {"ax": ax, "t": t, "lines": lines, "legend": self._legend(fig), "title": title, "span": 90.0}
         self._figures["polar"] = fig
 
+    def _polar_span(self, span: float) -> Float64Array:
+        """The polar plot's angles over the upper half disc (``span`` 90) or the whole circle (180)."""
+        ax = self._polar["ax"]
+        if self._polar["span"] != span:
+            ax.set_position(_HALF_DISC_AXES if span == 90.0 else _DISC_AXES)
+            ax.set_thetamin(-span)
+            ax.set_thetamax(span)
+            ax.set_thetagrids([-90, -60, -30, 0, 30, 60, 90] if span == 90.0 else [-135, -90, -45, 0, 45, 90, 135, 180])
+            self._polar["span"] = span
+        return np.radians((np.arange(_POLAR_STEPS) + 0.5) * (2.0 * span / _POLAR_STEPS) - span)
+
     def _draw_polar(self, material: Material, state: Mapping[str, Any]) -> bytes:
-        ax, t, lines = self._polar["ax"], self._polar["t"], self._polar["lines"]
+        ax, lines = self._polar["ax"], self._polar["lines"]
+        t = self._polar_span(180.0 if state["model"] in _validate.BSDF_MODELS else 90.0)
         theta_v, phi_v = state["view"]
         azimuth = np.array([math.cos(math.radians(phi_v)), math.sin(math.radians(phi_v))])
         wi = np.empty((t.size, 3))
@@ -590,7 +612,7 @@ class Explorer:
         for name in _LOBE_COLORS:
             visible = bool(np.any(curves[name] > 0.0)) or name == "total"
             lines[name].set_visible(visible)
-            lines[name].set_ydata(radius(curves[name]))
+            lines[name].set_data(t, radius(curves[name]))
             if visible:
                 shown.append(name)
         lines["wo"].set_data([math.radians(theta_v)] * 2, [0.0, r_max])
@@ -685,7 +707,11 @@ class Explorer:
     def _draw_albedo(self, material: Material, state: Mapping[str, Any]) -> bytes:
         a = self._albedo
         ax, lines = a["ax"], a["lines"]
-        result = _albedo(material, np.cos(np.radians(_ALBEDO_ANGLES)), samples=_ALBEDO_SAMPLES, seed=0,
+        sphere = state["model"] in _validate.BSDF_MODELS
+        angles = _ALBEDO_ANGLES_SPHERE if sphere else _ALBEDO_ANGLES
+        ax.set_xlim(0.0, 180.0 if sphere else 90.0)
+        ax.set_xticks([0, 45, 90, 135, 180] if sphere else [0, 30, 60, 90])
+        result = _albedo(material, np.cos(np.radians(angles)), samples=_ALBEDO_SAMPLES, seed=0,
                          model=state["model"], energy_compensation=state["energy_compensation"])
         curves: dict[str, tuple[FloatArray, FloatArray]] = {"total": (result.total, result.total_error)}
         curves.update({name: (value, error) for name, value, error in
@@ -698,20 +724,20 @@ class Explorer:
             mean = np.asarray(curves[name][0], dtype=np.float64) @ _LUMINANCE
             band = 2.0 * (np.asarray(curves[name][1], dtype=np.float64) @ _LUMINANCE)  # an upper bound
             visible = name == "total" or bool(np.any(mean > 0.0))
-            lines[name].set_ydata(mean)
+            lines[name].set_data(angles, mean)
             lines[name].set_visible(visible)
             if visible:
                 shown.append(name)
-                a["bands"][name] = ax.fill_between(_ALBEDO_ANGLES, mean - band, mean + band,
+                a["bands"][name] = ax.fill_between(angles, mean - band, mean + band,
                                                    color=_LOBE_COLORS[name], alpha=0.25, lw=0)
                 top = max(top, float((mean + band).max()))
         theta_v = state["view"][0]
         lines["view"].set_xdata([theta_v, theta_v])
         ax.set_ylim(0.0, top * 1.05)
-        index = int(np.argmin(np.abs(_ALBEDO_ANGLES - theta_v)))
+        index = int(np.argmin(np.abs(angles - theta_v)))
         total_at = float(np.asarray(result.total[index]) @ _LUMINANCE)
         ax.set_title(f"directional albedo, ±2 s.e. ({_ALBEDO_SAMPLES} samples)\n"
-                     f"E({_ALBEDO_ANGLES[index]:g}°) = {total_at:.3f}", pad=4)
+                     f"E({angles[index]:g}°) = {total_at:.3f}", pad=4)
         self._place_legend(a["legend"], tuple(shown) + ("θv",), ncol=3, frame=True, left=0.135, top=0.875)
         return self._savefig("albedo")
 

@@ -151,6 +151,28 @@ def test_the_2015_models_read_their_parameters_and_grey_out_the_rest(explorer):
     assert not explorer.sliders["diff_trans"].disabled
 
 
+def test_the_2015_models_are_seen_from_below_in_the_polar_plot_and_the_albedo(explorer):
+    explorer.sliders["spec_trans"].value = 1.0  # (greyed out: counts once the model reads it)
+    with explorer.hold():
+        explorer.model.value = "disney2015"
+        explorer.view_theta.value = 150.0  # from inside the solid
+    assert explorer.view_theta.value == 150.0
+    polar = explorer._polar
+    angles = np.asarray(polar["lines"]["total"].get_xdata())
+    assert np.isclose(np.degrees(angles.min()), -180.0, atol=1.0) and np.isclose(np.degrees(angles.max()), 180.0, atol=1.0)
+    transmitted = np.asarray(polar["lines"]["transmission"].get_ydata())
+    assert polar["lines"]["transmission"].get_visible() and transmitted.max() > 0
+    albedo_angles = np.asarray(explorer._albedo["lines"]["total"].get_xdata())
+    assert albedo_angles.max() == 180.0 and not np.any(albedo_angles == 90.0)
+    for name in ("polar", "slice", "albedo"):
+        width, height = png_size(explorer.images[name].value)
+        assert width > 200 and height > 150
+    explorer.model.value = "disney2014"  # back to a BRDF: the view comes back above the surface
+    assert explorer.view_theta.value == 90.0 and explorer.view_theta.max == 90.0
+    angles = np.asarray(explorer._polar["lines"]["total"].get_xdata())
+    assert np.degrees(angles.max()) < 90.0
+
+
 def test_no_op_changes_redraw_nothing(explorer):
     before = snapshot(explorer)
     explorer.sliders["roughness"].value = explorer.sliders["roughness"].value
