@@ -71,6 +71,29 @@ def glass(path: str) -> None:
     demo.write_picture(path, spheres, labels, columns=len(GLASS), row_titles=titles)
 
 
+# (label, model, parameters): materials that light passes through, and the leaf without it
+BACKLIT = tuple(row for row in demo.GLASS_ROW if row[1] == "disney2015_thin") + (
+    ("leaf, diff_trans 0", "disney2015_thin", dict(demo.GLASS_ROW[4][2], diff_trans=0.0)),
+    demo.GLASS_ROW[1], demo.GLASS_ROW[2],
+)
+# turned about the vertical axis so that the sun (outdoors) and the key light (studio), up and to the
+# left of the camera, stand behind the subject, 37° and 30° above the horizon
+BACKLIGHT_TURN = 130.0
+
+
+def backlit(path: str) -> None:
+    """Thin sheets and glass with the light behind them: the built-in maps turned by
+    Environment.turned, the sun or the key light shining through each sphere at the viewer."""
+    spheres, titles = [], []
+    for name, title in (("outdoor", "sun behind"), ("studio", "key light behind")):
+        lighting = pb.render.environment_of(name).turned(BACKLIGHT_TURN)
+        spheres += [pb.render.render_sphere(pb.Material(**params), 128, model=model, environment=lighting,
+                                            samples=1024) for _, model, params in BACKLIT]
+        titles.append(title)
+    labels = [label for label, _, _ in BACKLIT] + [""] * len(BACKLIT)
+    demo.write_picture(path, spheres, labels, columns=len(BACKLIT), row_titles=titles)
+
+
 def environment_maps(path: str) -> None:
     """The studio and outdoor maps side by side, tone mapped (each 256 x 512, a 2 x 2 mean of the map)."""
     panoramas = []
@@ -124,7 +147,7 @@ def main(directory: str, only: list[str] | None = None) -> None:
     os.makedirs(directory, exist_ok=True)
     pictures = [("demo", lambda path: demo.run(pairs=1 << 16, output=path, repeats=1, report=lambda message: None)),
                 ("presets", presets), ("metals", metals), ("environments", environments),
-                ("environment_maps", environment_maps), ("glass", glass), ("plots", plots), ("parameter_sweep", sweep),
+                ("environment_maps", environment_maps), ("glass", glass), ("backlit", backlit), ("plots", plots), ("parameter_sweep", sweep),
                 ("microfacet_family", family)]
     for name, draw in pictures:
         if only and name not in only:

@@ -224,9 +224,6 @@ EvalJob eval_job(const Float32Array& wi, int wi_layout, const Float32Array& wo, 
     fill_params(params, n, job.params, keep_alive, tables);
     job.model = model_from(options.model);
     job.output = output;
-    if ((output == Output::kDirectionGradient || output == Output::kDirectionVjp) && is_bsdf(job.model))
-        throw std::invalid_argument(std::string("model: derivatives in the directions are not implemented for model '") +
-                                    kModelNames[options.model] + "'");
     job.cosine = options.cosine;
     job.energy_compensation = options.energy_compensation;
     job.mode = mode_from(options.mode);

@@ -215,26 +215,42 @@ py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, co
     return py::make_tuple(value, jacobian);
 }
 
-// ∂f/∂(wi, wo) (N,3,6) for N packed rows as reference_eval_grad's, f times cos θl if cosine.
+// ∂f/∂(wi, wo) (N,3,6) for N packed rows as reference_eval_grad's, f times |cos θl| if cosine.
 py::array_t<double> reference_eval_direction_grad(const Float64Array& wi, const Float64Array& wo,
-                                                  const Float64Array& params, int model, bool cosine) {
+                                                  const Float64Array& params, int model, bool cosine, int mode) {
     const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
     require_rows(wi, n, 3, "wi");
     require_rows(wo, n, 3, "wo");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
     const Model which_model = model_from(model);
+    const TransportMode transport = mode_from(mode);
     py::array_t<double> jacobian({n, py::ssize_t(3), py::ssize_t(reference::kDirectionSlots)});
     const double* wi_data = wi.data();
     const double* wo_data = wo.data();
     double* jacobian_data = jacobian.mutable_data();
-    {
-        py::gil_scoped_release release;
-        reference::DirectionShadingCache prepared;
+    auto run = [&](auto& prepared, auto&& gradient_of) {
         for (py::ssize_t i = 0; i < n; ++i) {
             const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
-            const reference::DirectionGradient g =
-                    reference::eval_direction_grad(prepared.of(material_rows.row(i)), in, view, which_model, cosine);
+            const reference::DirectionGradient g = gradient_of(prepared.of(material_rows.row(i)), in, view);
             std::copy(g.jacobian.data(), g.jacobian.data() + 3 * reference::kDirectionSlots, jacobian_data + 3 * reference::kDirectionSlots * i);
+        }
+    };
+    auto bsdf = [&](const auto& s, const Eigen::Vector3d& in, const Eigen::Vector3d& view) {
+        return reference::eval_direction_grad(s, in, view, cosine, transport);
+    };
+    {
+        py::gil_scoped_release release;
+        if (which_model == Model::kDisney2015Thin) {
+            reference::ThinDirectionShading2015Cache prepared;
+            run(prepared, bsdf);
+        } else if (which_model == Model::kDisney2015) {
+            reference::DirectionShading2015Cache prepared;
+            run(prepared, bsdf);
+        } else {
+            reference::DirectionShadingCache prepared;
+            run(prepared, [&](const auto& s, const Eigen::Vector3d& in, const Eigen::Vector3d& view) {
+                return reference::eval_direction_grad(s, in, view, which_model, cosine);
+            });
         }
     }
     return jacobian;
@@ -363,8 +379,8 @@ void bind_reference(py::module_& m) {
           py::arg("mode") = 0,
           "Float64 reference f (N,3) and its Jacobian (N,3,P) over the model's P parameter slots, for packed validated rows.");
     m.def("reference_eval_direction_grad", &reference_eval_direction_grad, py::arg("wi"), py::arg("wo"), py::arg("params"),
-          py::arg("model"), py::arg("cosine") = false,
-          "Float64 reference derivatives (N,3,6) of f (times cos θl if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.");
+          py::arg("model"), py::arg("cosine") = false, py::arg("mode") = 0,
+          "Float64 reference derivatives (N,3,6) of f (times |cos θl| if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.");
     m.def("reference_sample", &reference_sample, py::arg("wo"), py::arg("u"), py::arg("params"), py::arg("model"),
           py::arg("sampler"), py::arg("energy_compensation") = false, py::arg("mode") = 0,
           "Float64 reference samples (wi (N,3), pdf (N,), weight (N,3), lobe (N,) int32) for validated rows;\n"

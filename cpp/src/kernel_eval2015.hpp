@@ -5,14 +5,19 @@
 // any layout.
 #pragma once  // (per translation unit)
 
-// What a batch needs of its material: the constants, over dual numbers for the derivatives.
+// What a batch needs of its material: the constants, over dual numbers for the derivatives
+// (with the parameters' tangents, or with none for the derivatives in the directions).
 template <Output output>
-using Prepared2015 = std::conditional_t<differentiates(output), GradientShading2015<Floats>, Shading2015<Floats>>;
+using Prepared2015 = std::conditional_t<
+        differentiates(output), GradientShading2015<Floats>,
+        std::conditional_t<in_directions(output), Shading2015<PassDual<Floats>>, Shading2015<Floats>>>;
 
 template <Output output>
 PB_KERNEL_INLINE Prepared2015<output> prepare2015(const RawMaterial& m, bool thin) {
     if constexpr (differentiates(output)) {
         return gradient_shading2015_of(m.slot, thin);
+    } else if constexpr (in_directions(output)) {
+        return constant_shading2015_of(m.slot, thin);
     } else {
         return shading2015_of(m.slot, thin);
     }
@@ -32,6 +37,15 @@ PB_KERNEL_INLINE void eval2015_batch(const EvalJob& job, std::int64_t i, const V
     } else if constexpr (output == Output::kVjp) {
         VjpSink<layouts> sink{job, i, load_vec3<layouts>(job.cotangent, i)};
         eval_gradient2015(wi, wo, s, job.mode, job.cosine, sink);
+        sink.finish();
+    } else if constexpr (output == Output::kDirectionGradient) {
+        DirectionJacobianStore<layouts> store{job, i};
+        Rgb<Floats> f = eval_direction_gradient2015(wi, wo, s, job.mode, job.cosine, store);
+        store.finish();
+        store_rgb<layouts>(job.out[0], i, f);
+    } else if constexpr (output == Output::kDirectionVjp) {
+        DirectionVjpSink<layouts> sink{job, i, load_vec3<layouts>(job.cotangent, i)};
+        eval_direction_gradient2015(wi, wo, s, job.mode, job.cosine, sink);
         sink.finish();
     } else if constexpr (output == Output::kPdf) {
         pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
@@ -108,9 +122,10 @@ std::int64_t eval2015_range_of(const EvalJob& job, std::int64_t begin, std::int6
                                   : eval2015_range_for<output, true>(job, begin, end);
 }
 
-// every output but the derivatives in the directions (the bindings refuse those for this model)
 inline std::int64_t eval2015_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     switch (job.output) {
+        case Output::kDirectionGradient: return eval2015_range_of<Output::kDirectionGradient>(job, begin, end);
+        case Output::kDirectionVjp: return eval2015_range_of<Output::kDirectionVjp>(job, begin, end);
         case Output::kGradient: return eval2015_range_of<Output::kGradient>(job, begin, end);
         case Output::kVjp: return eval2015_range_of<Output::kVjp>(job, begin, end);
         case Output::kLobes: return eval2015_range_of<Output::kLobes>(job, begin, end);

@@ -559,7 +559,7 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     if _direction_grad.asks_for_directions(wrt):
         return _direction_grad.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
                                          threads=threads, out=out, check=check, isa=isa,
-                                         energy_compensation=energy_compensation)
+                                         energy_compensation=energy_compensation, mode=mode)
     model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
     names = _gradient.gradient_names(model)
     wanted = _gradient.columns(wrt, names=names)

@@ -67,9 +67,9 @@ def reference_eval_grad(
     """Float64 reference f (N,3) and its Jacobian (N,3,P) over the model's P parameter slots, for packed validated rows."""
 
 def reference_eval_direction_grad(
-    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, cosine: bool = False
+    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, cosine: bool = False, mode: _Int = 0
 ) -> NDArray[np.float64]:
-    """Float64 reference derivatives (N,3,6) of f (times cos θl if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z."""
+    """Float64 reference derivatives (N,3,6) of f (times |cos θl| if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z."""
 
 def reference_sample(
     wo: _Float64In,

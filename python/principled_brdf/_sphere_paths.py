@@ -16,9 +16,11 @@ outside is unoccluded from the sphere's surface), and the two strategies are
 combined by the power heuristic (Veach 1997, eq. 9.13), as at the camera's
 hit. The sphere is the unit sphere of render.py,
 each point shaded in the same frame (normal, tangent along the latitude).
-A path's random numbers are a hash of its key (its pixel and sample), the
-seed and the event (SplitMix64, Steele et al. 2014): a sphere looks the same
-rendered alone or in a batch, and a picture the same on every run.
+The uniforms of an event inside are the path's sample's point of a 6-d
+low-discrepancy (Kronecker) sequence, shifted by a hash of its pixel, the seed
+and the event: the samples of a pixel spread evenly over each event's
+dimensions, a sphere looks the same rendered alone or in a batch, and a
+picture the same on every run.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ import typing
 
 import numpy as np
 
+from . import _low_discrepancy
 from ._batch import eval_pdf as _eval_pdf
 from ._batch import sample as _sample
 from .environment import Environment
@@ -53,23 +56,12 @@ def frames(normal: FloatArray) -> tuple[Float64Array, Float64Array]:
     return tangent, np.cross(n, tangent)
 
 
-def _splitmix64(x: np.ndarray) -> np.ndarray:
-    """The SplitMix64 output function of the state after ``x`` (uint64, wrapping)."""
-    z = x + np.uint64(0x9E3779B97F4A7C15)
-    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    return z ^ (z >> np.uint64(31))
-
-
-def hashed_uniforms(keys: np.ndarray, seed: int, event: int, columns: int) -> np.ndarray:
-    """``(P, columns)`` float32 uniforms in [0, 1) of uint64 ``keys`` for one ``event`` of a ``seed``."""
-    stream = _splitmix64(np.array([seed * 64 + event], dtype=np.uint64))
-    state = _splitmix64(keys.astype(np.uint64) ^ stream)
-    out = np.empty((len(keys), columns), np.float32)
-    for j in range(columns):
-        state = _splitmix64(state)
-        out[:, j] = (state >> np.uint64(40)).astype(np.float32) * np.float32(2.0**-24)
-    return out
+def inner_uniforms(sample: np.ndarray, pixel: np.ndarray, seed: int, event: int) -> Float32Array:
+    """``(P, 6)`` uniforms of one ``event`` inside for the paths of ``sample`` indices and
+    ``pixel`` indices: the 6-d Kronecker point of the sample, shifted by a hash of the pixel
+    and the event (:mod:`principled_brdf._low_discrepancy`)."""
+    shift = _low_discrepancy.hashed_uniforms(pixel, seed, event, 6)
+    return _low_discrepancy.shifted_points(sample, shift)
 
 
 def power_heuristic(pdf: FloatArray, other: FloatArray) -> Float64Array:
@@ -89,12 +81,12 @@ def _unit(v: Float64Array) -> Float64Array:
 
 def through_the_sphere(material_at: Callable[[np.ndarray], Material], element: np.ndarray, normal: FloatArray,
                        direction: FloatArray, throughput: FloatArray, radiance: Callable[[Float32Array], ArrayLike],
-                       model: Model, keys: np.ndarray, seed: int) -> Float64Array:
+                       model: Model, sample: np.ndarray, pixel: np.ndarray, seed: int) -> Float64Array:
     """The radiance ``(P, 3)`` each path brings back: paths entering the sphere at the camera's
     hit points ``normal`` (``(P, 3)``, camera space) along ``direction`` (``(P, 3)``, into the
     sphere) with ``throughput`` (``(P, 3)``, the first event's weight). ``material_at(element)``
     gives the material of the paths' elements; ``radiance(direction)`` the environment;
-    ``keys`` (``(P,)``) name the paths for their random numbers."""
+    ``sample`` and ``pixel`` (``(P,)`` integers) name the paths for their random numbers."""
     out = np.zeros((len(element), 3))
     path = np.arange(len(element))
     point = np.asarray(normal, dtype=np.float64)
@@ -108,7 +100,7 @@ def through_the_sphere(material_at: Callable[[np.ndarray], Material], element: n
         tangent, bitangent = frames(point)
         wo = _local(-travel, tangent, bitangent, point).astype(np.float32)
         material = material_at(element[path])
-        u = hashed_uniforms(keys[path], seed, bounce, 6)
+        u = inner_uniforms(sample[path], pixel[path], seed, bounce)
         if isinstance(radiance, Environment):  # the map's strategy: f |cos θl| L / pdf_light, weighted
             towards, light_pdf, light = radiance.sample(u[:, 4:6])
             local = _local(towards.astype(np.float64), tangent, bitangent, point)

@@ -127,6 +127,16 @@ class Environment:
         """The map in a ``.exr`` or ``.hdr`` file (:func:`read_map`)."""
         return cls(read_map(path), name=os.path.basename(os.fspath(path)))
 
+    def turned(self, degrees: float) -> Environment:
+        """The scene turned about the vertical axis by ``degrees`` (a whole number of the map's
+        columns, the nearest): what was at ``φ`` is now at ``φ + degrees`` (module docstring),
+        so ``turned(180)`` brings what was behind the viewer behind the subject, lighting it
+        from behind. The same radiance values, moved: no resampling."""
+        turn = _validate.real_number("degrees", degrees)
+        columns = self.image.shape[1]
+        shift = round(turn / 360.0 * columns) % columns
+        return Environment(np.roll(self.image, shift, axis=1), name=f"{self.name}, turned {turn:g}°")
+
     def __repr__(self) -> str:
         return f"Environment({self.name!r}, {self.image.shape[0]}x{self.image.shape[1]})"
 

@@ -26,7 +26,7 @@ try:
 except ImportError as error:  # pragma: no cover - the test extra installs jax
     raise ImportError("principled_brdf.jax needs JAX: pip install 'principled-brdf[jax]'") from error
 
-from . import _direction_grad, _interop
+from . import _interop
 
 if TYPE_CHECKING:
     from collections.abc import Mapping
@@ -103,7 +103,6 @@ def eval(material: Mapping[str, Any], wi: Any, wo: Any, **options: Any) -> jax.A
         raise TypeError(f"material: expected a mapping of parameter names to arrays, got {type(material).__name__}")
     names = _interop.parameter_names(material)
     options = _interop.check_options(options)
-    _direction_grad.require_direction_model(options.get("model", "disney2014"))
     wi, wo = jnp.asarray(wi), jnp.asarray(wo)
     dtype = jnp.float64 if wi.dtype == jnp.float64 else jnp.float32
     wi, wo = wi.astype(dtype), wo.astype(dtype)

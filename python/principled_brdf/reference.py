@@ -98,7 +98,7 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     parameters'; docs/gradients.md, "Derivatives in the directions")."""
     if _direction_grad.asks_for_directions(wrt):
         return _direction_grad.reference_eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
-                                                   energy_compensation=energy_compensation)
+                                                   energy_compensation=energy_compensation, mode=mode)
     if _validate.flag("energy_compensation", energy_compensation):
         raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
                                   "multiple-scattering lobe is not implemented)")

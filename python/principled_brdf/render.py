@@ -25,7 +25,7 @@ import zlib
 
 import numpy as np
 
-from . import _color, _sphere_paths, _validate
+from . import _color, _low_discrepancy, _sphere_paths, _validate
 from ._sphere_paths import power_heuristic as _power_heuristic
 from ._batch import eval as _eval
 from ._batch import eval_pdf as _eval_pdf
@@ -243,24 +243,16 @@ def sky_environment(direction: RealArrayLike, zenith: RealArrayLike = (0.65, 0.7
     return basis @ np.stack([ground, horizon - ground, zenith - horizon])
 
 
-# The Kronecker sequence of Roberts' generalised golden ratio in 3-d: x_k = frac(k α),
-# α_j = φ3^-(j+1) with φ3 the real root of x⁴ = x + 1 (the plastic number's analogue);
-# its points fill [0, 1)³ with low discrepancy for any count.
-_PHI3 = 1.2207440846057596
-_LATTICE_STEP = np.array([_PHI3 ** -1, _PHI3 ** -2, _PHI3 ** -3])
-
-
 def lattice_uniforms(count: int, shape: tuple[int, ...], seed: int = 0, first: int = 0) -> Float32Array:
     """``(count,) + shape + (3,)`` float32 uniforms: sample ``k`` of each element is the
-    Kronecker point ``frac(k α + s)``, ``s`` the element's random shift (Cranley-Patterson
-    rotation, from ``seed``), for ``k = first .. first + count - 1``. Every element gets a
-    well-spread set of points, and neighbouring elements uncorrelated ones."""
+    Kronecker point ``frac(k α + s)`` of Roberts' generalised golden ratio in 3-d
+    (``α_j = φ3^-(j+1)``, ``φ3`` the real root of ``x⁴ = x + 1``), ``s`` the element's random
+    shift (Cranley-Patterson rotation, from ``seed``), for ``k = first .. first + count - 1``.
+    Every element gets a well-spread set of points, and neighbouring elements uncorrelated ones."""
     elements = int(np.prod(shape, dtype=np.int64))
     shift = _random_uniforms(seed, elements).reshape(tuple(shape) + (3,))
-    steps = np.mod(np.arange(first, first + count, dtype=np.float64)[:, None] * _LATTICE_STEP, 1.0).astype(np.float32)
-    points = shift + steps.reshape((count,) + (1,) * len(shape) + (3,))
-    points -= points >= 1.0  # frac of a sum of two numbers in [0, 1)
-    return np.minimum(points, np.nextafter(np.float32(1.0), np.float32(0.0)))
+    index = np.arange(first, first + count, dtype=np.float64).reshape((count,) + (1,) * len(shape))
+    return _low_discrepancy.shifted_points(index, shift)
 
 
 def render_environment(material: Material, resolution: int = 256, environment: _EnvironmentArg = None,
@@ -323,11 +315,11 @@ def render_environment(material: Material, resolution: int = 256, environment: _
         entering = np.nonzero(~above[..., 0] & (drawn.pdf > 0.0))
         if len(entering[0]):
             element = np.ravel_multi_index(entering[1:], shape)
-            # a path's key: its sample and its pixel (not its sphere: a batch looks like its spheres alone)
-            keys = (start + entering[0]).astype(np.uint64) * np.uint64(inside.size) + np.ravel_multi_index(
-                entering[-2:], inside.shape).astype(np.uint64)
+            # a path is named by its sample and its pixel (not its sphere: a batch looks like its spheres alone)
+            pixel = np.ravel_multi_index(entering[-2:], inside.shape).astype(np.uint64)
             paths = _sphere_paths.through_the_sphere(material_at, element, normals[element], direction[entering],
-                                                     drawn.weight[entering], lighting, model, keys, seed)
+                                                     drawn.weight[entering], lighting, model,
+                                                     start + entering[0], pixel, seed)
             np.add.at(total.reshape(-1, 3), element, paths)
         if not is_map:
             radiance = np.asarray(lighting(direction))

@@ -23,7 +23,7 @@ try:
 except ImportError as error:  # pragma: no cover - the test extra installs torch
     raise ImportError("principled_brdf.torch needs PyTorch: pip install 'principled-brdf[torch]'") from error
 
-from . import _batch, _direction_grad, _interop, reference
+from . import _batch, _interop, reference
 from .material import Material
 
 if TYPE_CHECKING:
@@ -106,8 +106,6 @@ def eval(material: Mapping[str, Any] | Material, wi: torch.Tensor, wo: torch.Ten
     """
     names, values = _material_items(material)
     options = _interop.check_options(options)
-    if any(isinstance(d, torch.Tensor) and d.requires_grad for d in (wi, wo)):
-        _direction_grad.require_direction_model(options.get("model", "disney2014"))
     double = _is_double(wi, wo, *values)
     dtype = torch.float64 if double else torch.float32
     wi, wo, *values = (_tensor(name, v, dtype) for name, v in zip(["wi", "wo", *names], [wi, wo, *values]))

@@ -228,14 +228,3 @@ def test_the_directions_vjp_kernel_is_the_jacobians_contraction(isa):
         assert np.all(np.abs(np.concatenate([by_wi, by_wo], -1) - expected) <= bound)
     one_g = _direction_grad.vjp(m, wi, wo, g[0], isa=isa)  # one cotangent for every element
     np.testing.assert_array_equal(one_g[1], _direction_grad.vjp(m, wi, wo, np.broadcast_to(g[0], g.shape), isa=isa)[1])
-
-
-def test_a_model_without_direction_derivatives_is_named(monkeypatch):
-    """Models outside DIRECTION_MODELS (the BSDFs, when present) are refused by name."""
-    from principled_brdf import _direction_grad
-
-    monkeypatch.setitem(_direction_grad.MODELS, "disney2015", 2)
-    wi = np.float32([0.0, 0.6, 0.8])
-    for eval_grad in (pb.eval_grad, pb.reference.eval_grad):
-        with pytest.raises(ValueError, match="wi and wo are not implemented for model 'disney2015'"):
-            eval_grad(pb.Material(), wi, wi, wrt="wi", model="disney2015")

@@ -119,3 +119,14 @@ def test_without_jax_the_error_names_the_extra(monkeypatch):
     monkeypatch.delitem(sys.modules, "principled_brdf.jax")
     with pytest.raises(ImportError, match=r"pip install 'principled-brdf\[jax\]'"):
         importlib.import_module("principled_brdf.jax")
+
+
+def test_check_grads_of_the_2015_directions_through_glass():
+    """model="disney2015", half of the pairs through the interface: check_grads in wi and wo (float64)."""
+    rng = seeded_rng("jax 2015 directions")
+    wi, wo, material = split(interior_inputs(rng, 10))
+    wi = wi * np.where(np.arange(10) % 2 == 0, -1.0, 1.0)[:, None]
+    material["spec_trans"] = rng.uniform(0.3, 0.9, 10)
+    with enable_x64(True):
+        check_grads(lambda a, b: pbj.eval(material, a, b, model="disney2015", cosine=True),
+                    (jnp.asarray(wi), jnp.asarray(wo)), order=1, modes=["rev"], eps=1e-6)

@@ -184,3 +184,23 @@ def test_a_sphere_looks_the_same_alone_or_in_a_batch():
         np.testing.assert_allclose(batch[k], pb.render.render_sphere(GLOSSY.replace(roughness=r), 16,
                                                                      environment=studio, samples=8),
                                    rtol=1e-5, atol=1e-7)
+
+
+def test_a_turned_map_moves_its_lights_about_the_vertical_axis():
+    """turned(180) brings the sun from behind the viewer to behind the subject: the radiance
+    in the mirrored direction is the sun's; turns add, a whole turn is the map itself."""
+    outdoor = procedural_environments.outdoor(64)
+    sun = np.array(procedural_environments.SUN_DIRECTION) / np.linalg.norm(procedural_environments.SUN_DIRECTION)
+    behind = (sun * [-1.0, 1.0, -1.0]).astype(np.float32)[None]
+    turned = outdoor.turned(180)
+    np.testing.assert_array_equal(turned(behind), outdoor(sun.astype(np.float32)[None]))
+    assert turned(behind).max() > 100 * outdoor(behind).max()
+    np.testing.assert_array_equal(outdoor.turned(90).turned(-90).image, outdoor.image)
+    np.testing.assert_array_equal(outdoor.turned(360).image, outdoor.image)
+    # a quarter turn moves +z (behind the viewer) to -x: phi grows from +z through -x
+    quarter = outdoor.turned(90)
+    column = (np.arange(128) + 0.5) / 128
+    ring = uv_to_directions(np.stack([column, np.full(128, 0.75)], axis=-1))  # below the horizon: the tiles
+    np.testing.assert_array_equal(quarter(ring), np.roll(outdoor(ring), 32, axis=0))
+    with pytest.raises(ValueError, match="degrees"):
+        outdoor.turned(float("nan"))

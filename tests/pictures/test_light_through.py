@@ -93,3 +93,4 @@ def test_a_batch_of_2015_spheres_renders_each_as_alone():
     alone = pb.render.render_sphere(pb.Material(base_color=(1, 1, 1), spec_trans=1.0, roughness=0.2), 16,
                                     model="disney2015", environment="studio", samples=16)
     np.testing.assert_allclose(batch[0], alone, rtol=1e-5, atol=1e-6)
+

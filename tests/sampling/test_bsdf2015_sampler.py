@@ -96,3 +96,25 @@ def test_the_albedo_from_both_sides():
     assert np.all(brdf.transmittance == 0) and np.array_equal(brdf.reflectance, brdf.total)
     with pytest.raises(ValueError, match="cos_theta_o"):
         pb.albedo(pb.Material(), -0.5)
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_the_weights_of_white_glass_stay_below_the_interfaces_bound(isa):
+    """The interface split at each microfacet keeps a sample's weight f |cos θl| / pdf near
+    G2/G1 <= 1 on either branch, times 1/η_t² for the radiance refracted: <= 1 from outside, <= η²
+    from inside. A choice by the view's own Fresnel factor weighs a reflection off a steep
+    microfacet by F_D(wo·h) / F_D(cos θv), up to 1/F_D(cos θv) (25 for glass): fireflies."""
+    rng = seeded_rng("bsdf2015-weights", isa)
+    n = 1 << 18
+    wo = rng.normal(size=(n, 3))
+    wo = (wo / np.linalg.norm(wo, axis=1, keepdims=True)).astype(np.float32)
+    outside = wo[:, 2] > 0
+    for roughness in (0.1, 0.3, 0.6):
+        glass = pb.Material(base_color=(1, 1, 1), spec_trans=1.0, roughness=roughness, ior=1.5)
+        weight = pb.sample(glass, wo, seed=7, model="disney2015", isa=isa).weight.max(axis=1)
+        assert weight[outside].max() <= 1.0 + 1e-5, (roughness, weight[outside].max())
+        assert weight[~outside].max() <= 1.5**2 * (1.0 + 1e-5), (roughness, weight[~outside].max())
+        assert np.median(weight[outside]) > 0.4  # (not small: the draws land where f is; refracted, near 1/η²)
+    reference = pb.reference.sample(glass, wo[:4000].astype(np.float64), u=rng.uniform(size=(4000, 3)),
+                                    model="disney2015")
+    assert reference.weight[outside[:4000]].max() <= 1.0 + 1e-12

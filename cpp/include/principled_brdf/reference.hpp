@@ -341,11 +341,12 @@ inline Vector3d eval(const Shading2015<double>& s, const Vector3d& wi, const Vec
     return vector3d(eval_lobes2015(vec3(wi), vec3(wo), s, mode).total());
 }
 
-// P_k at wo of the sampled lobes (kSampledLobeNames).
+// P_k at wo of the sampled lobes (kSampledLobeNames); a solid's interface counted as its split at h = n.
 inline std::array<double, kSampledLobeNames.size()> lobe_probabilities(const Shading2015<double>& s, const Vector3d& wo) {
     const LobeWeights2015<double> w = lobe_weights2015(side_of(vec3(wo), vec3(wo), s), s);
-    return {w.cosine * w.inv_total, w.specular * w.inv_total, w.clearcoat * w.inv_total, w.transmission * w.inv_total,
-            w.diffuse_transmission * w.inv_total};
+    const double reflected = w.interface_reflection;
+    return {w.cosine * w.inv_total, (w.specular + reflected) * w.inv_total, w.clearcoat * w.inv_total,
+            (w.transmission - reflected) * w.inv_total, w.diffuse_transmission * w.inv_total};
 }
 
 // The mixture density of wi given wo over the whole sphere.

@@ -35,4 +35,17 @@ inline DirectionGradient eval_direction_grad(const DirectionShading& s, const Ve
                                        : direction_gradient_of<Model::kDisney2014>(s, vec3(wi), vec3(wo), cosine);
 }
 
+// The 2015 models' (model/bsdf2015_gradient.hpp): over the whole sphere, in `mode`.
+using DirectionShading2015 = Shading2015<PassDual<double>>;
+using DirectionShading2015Cache = RowCache<DirectionShading2015, &solid_constant_shading2015_of<double>>;
+using ThinDirectionShading2015Cache = RowCache<DirectionShading2015, &thin_constant_shading2015_of<double>>;
+
+inline DirectionGradient eval_direction_grad(const DirectionShading2015& s, const Vector3d& wi, const Vector3d& wo,
+                                             bool cosine, TransportMode mode) {
+    DirectionGradient out;
+    out.value = vector3d(f64::eval_direction_gradient2015(
+            vec3(wi), vec3(wo), s, mode, cosine, [&](int c, int k, double value) { out.jacobian(c, k) = value; }));
+    return out;
+}
+
 }  // namespace principled_brdf::reference

@@ -306,23 +306,28 @@ PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Vec3<F>& wi, const Vec3<F>& wo
 
 // ---------------------------------------------------------------- the sampling mixture (docs/sampling.md)
 // Four lobes, chosen with probabilities P_k = w_k / Σ w from estimates of
-// their albedo at the view: outside, w0 = w_D (Cdlum + 0.1 sheen lum(Csheen))
-// (cosine), w1 = max(lum(F_s at cos θv), 0.02) (specular reflection), w2 the
-// clearcoat's, w3 = w_T (1 - F_D(cos θv; η)) lum(sqrt(c)) (transmission);
-// inside only the interface exists: a half vector h is drawn first and the
-// draw reflects about it with probability F_D(wo·h; 1/η), else refracts
-// (the split of a smooth interface at every microfacet: the weight of a
-// reflection on the far side of the critical angle is not a ratio of two
-// Fresnel factors at different angles); the weights w1 = w_T F_D(cos θv; 1/η)
-// and w3 = w_T (1 - F_D(cos θv; 1/η)) report that split at h = n. The thin
-// sheet: the outside weights on either face, with w0 times 1 - dt, w3 with
-// lum(c), and w4 = w_D dt lum(c) (diffuse transmission). The reflected lobes
-// count only above the viewer's side and the transmission only below: a draw
-// that lands on the wrong side is no sample (pdf and weight 0).
+// their albedo at the view: w0 = w_D (Cdlum + 0.1 sheen lum(Csheen))
+// (cosine), w1 the specular reflection's, w2 the clearcoat's, w3 the
+// solid's interface (lobe 3). The interface is drawn as a smooth interface is
+// split at each microfacet: a half vector h is drawn first, and the draw
+// reflects about it with probability q(h) = F / (F + (1 - F) t), F =
+// F_D(wo·h; η_t), t = lum(sqrt(c)) outside and 1 inside, else refracts. So
+// the weight of a reflection off a steep microfacet is not a ratio of two
+// Fresnel factors at different angles (up to 1/F_D(cos θv): bright speckles
+// in rough glass lit from behind). w3 = w_T (F + (1 - F) t) at h = n, and w1 =
+// max(lum(F_s at cos θv) - w_T F_D(cos θv), 0.02): the specular reflection the
+// interface does not draw. Inside only the interface exists (w0 = w1 = w2 =
+// 0). The thin sheet: w1 = max(lum(F_s), 0.02), w0 times 1 - dt, w3 = w_T (1 -
+// F_D) lum(c) its microfacet transmission, and w4 = w_D dt lum(c) (diffuse
+// transmission). The reflected lobes count only above the viewer's side and
+// the transmission only below: a draw that lands on the wrong side is no
+// sample (pdf and weight 0).
 template <class F>
 struct LobeWeights2015 {
     F cosine, specular, clearcoat, transmission, diffuse_transmission;
     F inv_total;  // 0 where every weight is 0 (an opaque solid seen from inside)
+    F transmitted_luminance;  // t of q(h): lum(sqrt(c)) outside, 1 inside
+    F interface_reflection;   // w_T F_D(cos θv): the interface's share that reflects at h = n
 };
 
 template <class F>
@@ -332,18 +337,44 @@ PB_MODEL_INLINE LobeWeights2015<F> lobe_weights2015(const Side<F>& side, const S
     F fv = schlick_weight(cos_v);
     FresnelDielectric<F> fresnel = fresnel_dielectric_both(cos_v, side.eta_t);
     F exact = fresnel.reflectance;
-    F transmitted = s.transmission_weight * fresnel.transmittance * select(side.inside, one, s.transmission_luminance);
+    F t = select(side.inside, one, s.transmission_luminance);
     F grey = mul_add(s.dielectric, exact, s.schlick_grazing * fv);
-    F schlick_luminance = luminance_of(s.schlick_f0) * (one - fv);
+    F specular = luminance_of(s.schlick_f0) * (one - fv) + grey;
+    F transmitted = s.transmission_weight * fresnel.transmittance * t;
     LobeWeights2015<F> w;
+    w.transmitted_luminance = t;
+    w.interface_reflection = zero;
     w.cosine = select(side.inside, zero, s.brdf.diffuse.cosine_lobe_weight);
-    w.specular = select(side.inside, s.transmission_weight * exact, max(schlick_luminance + grey, F(0.02)));
     w.clearcoat = select(side.inside, zero, s.brdf.clearcoat.weight(fv));
-    w.transmission = transmitted;
-    w.diffuse_transmission = s.thin ? s.diffuse_transmission_luminance : zero;
+    if (s.thin) {
+        w.specular = max(specular, F(0.02));
+        w.transmission = transmitted;
+        w.diffuse_transmission = s.diffuse_transmission_luminance;
+    } else {
+        F reflected = s.transmission_weight * exact;
+        w.specular = select(side.inside, zero, max(specular - reflected, F(0.02)));
+        w.transmission = reflected + transmitted;
+        w.interface_reflection = reflected;
+        w.diffuse_transmission = zero;
+    }
     F total = w.cosine + w.specular + w.clearcoat + w.transmission + w.diffuse_transmission;
     w.inv_total = select(total > zero, one / total, zero);
     return w;
+}
+
+// The interface's chances at a microfacet of Fresnel factors F and T = 1 - F:
+// to reflect, F / (F + T t), and to refract, T t / (F + T t).
+template <class F>
+struct InterfaceSplit {
+    F reflects, refracts;
+};
+
+template <class F>
+PB_MODEL_INLINE InterfaceSplit<F> interface_split(const FresnelDielectric<F>& fresnel, F t) {
+    F through = fresnel.transmittance * t;
+    F total = fresnel.reflectance + through;
+    F inv_total = select(total > F(0.0), F(1.0) / total, F(0.0));
+    return {fresnel.reflectance * inv_total, through * inv_total};
 }
 
 // The transmission lobe's density in wi: the half vector's (visible normals,
@@ -374,17 +405,14 @@ PB_MODEL_INLINE F pdf2015(const Side<F>& side, const Geometry<F>& g, const LobeW
         F through = mul_add(w.diffuse_transmission * F(kInvPi), -side.wi.z,
                             w.transmission * thin_transmission_pdf(side, s.thin_ggx, sampler));
         pdf = select(side.wi.z < zero, through, pdf);
-    } else if (!s.opaque()) {
+    } else if (!s.opaque()) {  // the interface, split at the microfacet: h_r of the reflection, h_t of the refraction
         Refraction<F> r = refraction_of(side, b.specular.ggx);
-        F refracted = transmission_pdf(side, r, b.specular.ggx, sampler);
-        F mixture = w.inv_total * select(side.wi.z < zero, w.transmission * refracted, pdf);
-        if (any(side.inside)) {  // the interface alone, split at the microfacet
-            F reflects = fresnel_dielectric(g.cos_theta_d, side.eta_t);
-            F refracts = fresnel_dielectric_transmittance(r.wo_h * reciprocal_sqrt(r.h.h_len2), side.eta_t);
-            F interface = select(side.wi.z < zero, refracts * refracted, reflects * specular);
-            mixture = select(side.inside, select(s.transmission_weight > zero, interface, zero), mixture);
-        }
-        return select(scattered, mixture, zero);
+        MaskOf<F> below = side.wi.z < zero;
+        F cos_h = select(below, r.wo_h * reciprocal_sqrt(r.h.h_len2), g.cos_theta_d);
+        InterfaceSplit<F> split = interface_split(fresnel_dielectric_both(cos_h, side.eta_t), w.transmitted_luminance);
+        F interface = select(below, split.refracts * transmission_pdf(side, r, b.specular.ggx, sampler),
+                             split.reflects * specular);
+        pdf = mul_add(w.transmission, interface, pdf);
     }
     return select(scattered, w.inv_total * pdf, zero);
 }
@@ -403,6 +431,7 @@ template <class F>
 struct LobeChoice2015 {
     LobeChoice<F> reflected;  // the direction's draw (sample_direction's), for lanes not transmitting through a microfacet
     MaskOf<F> transmission, diffuse_transmission;
+    F within_transmission;  // u0 rescaled to [0, 1) within the transmission's share (the interface's split)
 };
 
 template <class F>
@@ -415,7 +444,8 @@ PB_MODEL_INLINE LobeChoice2015<F> choose_lobe2015(F u0, const LobeWeights2015<F>
     MaskOf<F> cosine = (scaled < w.cosine) | diffuse_transmission;
     // past the specular's share: the clearcoat when it has one, else the specular
     MaskOf<F> specular = !cosine & !transmission & ((scaled < w.cosine + w.specular) | (w.clearcoat <= zero));
-    return {{cosine, specular}, transmission, diffuse_transmission};
+    F within = (scaled - reflected_total) / select(transmission, w.transmission, F(1.0));
+    return {{cosine, specular}, transmission, diffuse_transmission, within};
 }
 
 // wi refracted from wo about the microfacet normal h = d / |d| with η_t (Snell's
@@ -464,23 +494,22 @@ PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u
         sheet.specular.ggx = s.thin_ggx;
         LobeChoice<F> specular{MaskOf<F>(false), MaskOf<F>(true)};
         wi = select(choice.transmission, mirrored(sample_direction(view.wo, u, specular, sheet, sampler).wi), wi);
-    } else if (any(choice.transmission | view.inside)) {
+    } else if (any(choice.transmission)) {
+        // the solid's interface: h drawn as the specular's, then a reflection about it with probability
+        // q(h) = F / (F + T t), else the refraction (the sampling mixture's comment)
         const Ggx<F>& ggx = s.brdf.specular.ggx;
         const auto [sin_phi, cos_phi] = sincos_turns(u.u1);
         Vec3<F> d = sampler == SpecularSampler::kDistribution ? ggx.sample_distribution(sin_phi, cos_phi, u.u2)
                                                                : ggx.sample_visible(view.wo, sin_phi, cos_phi, u.u2);
-        if (any(view.inside)) {  // the interface alone: reflect about h with probability F_D(wo·h; 1/η), u0 < F_D
-            F c = dot(view.wo, d) * reciprocal_sqrt(squared_length(d));
-            MaskOf<F> reflects = view.inside & (u.u0 < fresnel_dielectric(c, view.eta_t));
-            MaskOf<F> refracts = view.inside & !reflects;
-            F scale = F(2.0) * dot(view.wo, d) / squared_length(d);
-            Vec3<F> reflected{mul_sub(scale, d.x, view.wo.x), mul_sub(scale, d.y, view.wo.y), mul_sub(scale, d.z, view.wo.z)};
-            wi = select(reflects, reflected, wi);
-            choice.transmission = refracts | (!view.inside & choice.transmission);
-            choice.reflected.specular = reflects | (!view.inside & choice.reflected.specular);
-            choice.reflected.cosine = !view.inside & choice.reflected.cosine;
-        }
-        wi = select(choice.transmission, refract_about(view.wo, d, view.eta_t), wi);
+        F wo_d = dot(view.wo, d), d_len2 = squared_length(d);
+        InterfaceSplit<F> split =
+            interface_split(fresnel_dielectric_both(wo_d * reciprocal_sqrt(d_len2), view.eta_t), w.transmitted_luminance);
+        MaskOf<F> reflects = choice.transmission & (choice.within_transmission < split.reflects);
+        F scale = F(2.0) * wo_d / d_len2;
+        Vec3<F> reflected{mul_sub(scale, d.x, view.wo.x), mul_sub(scale, d.y, view.wo.y), mul_sub(scale, d.z, view.wo.z)};
+        wi = select(reflects, reflected, select(choice.transmission, refract_about(view.wo, d, view.eta_t), wi));
+        choice.transmission = choice.transmission & !reflects;
+        choice.reflected.specular = choice.reflected.specular | reflects;
     }
     // a draw counts only on its lobe's side: the reflected lobes' above, the transmission's below
     MaskOf<F> below = choice.transmission | choice.diffuse_transmission;

@@ -70,3 +70,52 @@ PB_MODEL_INLINE Rgb<F> eval_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, c
     }
     return value;
 }
+
+// ---------------------------------------------------------------- in the directions (docs/gradients.md)
+// The derivatives of f in wi and wo, as the 2014 model's (direction_gradient.hpp),
+// by the same dual numbers: the material's constants carry no tangents, and the
+// six components wi_x ... wo_z take the tangents kSlotsAPass at a time, in
+// kDirectionPasses2015 evaluations.
+inline constexpr int kDirectionComponents2015 = 6;  // wi_x, wi_y, wi_z, wo_x, wo_y, wo_z
+inline constexpr int kDirectionPasses2015 = (kDirectionComponents2015 + kSlotsAPass - 1) / kSlotsAPass;
+
+template <class F>
+PB_MODEL_INLINE Shading2015<PassDual<F>> constant_shading2015_of(const F* p, bool thin = false) {
+    PassDual<F> slots[kParamSlots];
+    for (int k = 0; k < kParamSlots; ++k) slots[k] = PassDual<F>(p[k]);
+    return shading2015_of(slots, thin);
+}
+
+template <class F>
+PB_MODEL_INLINE Shading2015<PassDual<F>> solid_constant_shading2015_of(const F* p) { return constant_shading2015_of(p, false); }
+template <class F>
+PB_MODEL_INLINE Shading2015<PassDual<F>> thin_constant_shading2015_of(const F* p) { return constant_shading2015_of(p, true); }
+
+// f (times |cos θl| if `cosine`), returned, and ∂f_c/∂w_k given to
+// `jacobian(c, k, value)` for every channel c and component k (wi_x ... wo_z);
+// 0 wherever f is (a direction in the tangent plane, or not finite).
+template <class F, class Sink>
+PB_MODEL_INLINE Rgb<F> eval_direction_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<PassDual<F>>& s,
+                                                   TransportMode mode, bool cosine, Sink&& jacobian) {
+    using D = PassDual<F>;
+    const F components[kDirectionComponents2015] = {wi.x, wi.y, wi.z, wo.x, wo.y, wo.z};
+    Rgb<F> value;
+    for (int q = 0; q < kDirectionPasses2015; ++q) {
+        D w[kDirectionComponents2015];
+        for (int k = 0; k < kDirectionComponents2015; ++k) {
+            const int tangent = k - q * kSlotsAPass;
+            w[k] = tangent >= 0 && tangent < kSlotsAPass ? D::variable(components[k], tangent) : D(components[k]);
+        }
+        Vec3<D> dwi{w[0], w[1], w[2]}, dwo{w[3], w[4], w[5]};
+        Rgb<D> f = eval_lobes2015(dwi, dwo, s, mode).total();
+        if (cosine) f = max(dwi.z, -dwi.z) * f;
+        auto put = [&](int c, const D& channel) {
+            for (int t = 0; t < kSlotsAPass && q * kSlotsAPass + t < kDirectionComponents2015; ++t)
+                jacobian(c, q * kSlotsAPass + t, channel.d[t]);
+            return channel.v;
+        };
+        Rgb<F> channels{put(0, f.r), put(1, f.g), put(2, f.b)};
+        if (q == 0) value = channels;
+    }
+    return value;
+}
