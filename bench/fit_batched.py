@@ -81,6 +81,9 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--eval-subsets", action="store_true")
+    parser.add_argument("--fit-only", action="store_true",
+                        help="only the whole fit (a 1024² texture: the per-element eval beside one iteration "
+                             "would hold every texel's parameters for every pair)")
     parser.add_argument("--subset-pairs", type=int, default=16384,
                         help="pairs a call for --eval-subsets (in L2; large enough that the call's Python "
                              "overhead is small)")
@@ -97,35 +100,48 @@ def main() -> None:
     pairs = count * n
     print(f"{args.texels} x {args.texels} texels x {n} pairs = {pairs / 1e6:.1f} M pairs")
 
-    # one iteration: the normal equations of every problem, every parameter, against one eval pass
+    if not args.fit_only:
+        one_iteration(wi, wo, truth, measured, args.repeats, args.threads)
+    whole_fit(wi, wo, measured, args.threads)
+
+
+def one_iteration(wi, wo, truth, measured, repeats: int, threads: int) -> None:
+    """The normal equations of every problem, every parameter, against one eval pass."""
+    count, n = len(truth.roughness), len(wi)
+    pairs = count * n
     wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
-    slots = np.ascontiguousarray(np.broadcast_to(pb.Material().packed(()).reshape(1, -1), (count, len(GRADIENT_NAMES))),
-                                 dtype=np.float32)
+    start = pb.Material().packed(()).reshape(-1)[:len(GRADIENT_NAMES)]  # the fitted models' slots
+    slots = np.ascontiguousarray(np.broadcast_to(start, (count, start.size)), dtype=np.float32)
     target = np.log1p(measured * np.maximum(wi[:, 2], 0)[:, None]).astype(np.float32)
     scale = np.ones_like(target)
+    gain = np.ones(count, np.float32)
     problems = np.arange(count, dtype=np.int64)
     every = list(range(len(GRADIENT_NAMES)))
-    equations = best_of(args.repeats, lambda: _core.normal_equations(
-        wi=wi32, wo=wo32, slots=slots, target=target, scale=scale, problems=problems, columns=every, loss=1,
-        cosine=True, model=0, threads=args.threads))
+    equations = best_of(repeats, lambda: _core.normal_equations(
+        wi=wi32, wo=wo32, slots=slots, target=target, scale=scale, gain=gain, problems=problems, columns=every, loss=1,
+        cosine=True, model=0, threads=threads))
     textured = pb.Material(**{name: np.broadcast_to(getattr(truth, name), (count, n, 3) if name == "base_color"
                               else (count, n)) for name in pb.PARAMETERS})
-    pb.eval(textured, wi32, wo32, threads=args.threads)  # (caches the per-element float32 copies)
-    per_element = best_of(args.repeats, lambda: pb.eval(textured, wi32, wo32, threads=args.threads))
-    uniform = best_of(args.repeats, lambda: pb.eval(pb.Material(roughness=0.4, clearcoat=0.2, sheen=0.2),
+    pb.eval(textured, wi32, wo32, threads=threads)  # (caches the per-element float32 copies)
+    per_element = best_of(repeats, lambda: pb.eval(textured, wi32, wo32, threads=threads))
+    uniform = best_of(repeats, lambda: pb.eval(pb.Material(roughness=0.4, clearcoat=0.2, sheen=0.2),
                                                     np.broadcast_to(wi32, (count, n, 3)),
-                                                    np.broadcast_to(wo32, (count, n, 3)), threads=args.threads))
+                                                    np.broadcast_to(wo32, (count, n, 3)), threads=threads))
     print(f"one iteration (13 parameters): {equations * 1e3:.1f} ms, {pairs / equations / 1e6:.1f} M pairs/s; "
           f"eval per-element material {per_element * 1e3:.1f} ms ({equations / per_element:.2f}x), "
           f"uniform material {uniform * 1e3:.1f} ms ({equations / uniform:.2f}x)")
     for columns, label in (([GRADIENT_NAMES.index("roughness")], "roughness"), ([0, 1, 2, 7], "base_color, roughness")):
-        t = best_of(args.repeats, lambda: _core.normal_equations(
-            wi=wi32, wo=wo32, slots=slots, target=target, scale=scale, problems=problems, columns=columns, loss=1,
-            cosine=True, model=0, threads=args.threads))
+        t = best_of(repeats, lambda: _core.normal_equations(
+            wi=wi32, wo=wo32, slots=slots, target=target, scale=scale, gain=gain, problems=problems, columns=columns, loss=1,
+            cosine=True, model=0, threads=threads))
         print(f"one iteration ({label}): {t * 1e3:.1f} ms ({t / per_element:.2f}x the per-element eval)")
 
+
+
+def whole_fit(wi, wo, measured, threads: int) -> None:
+    count, n = measured.shape[0], len(wi)
     start = time.perf_counter()
-    result = pb.fit(wi, wo, measured, threads=args.threads)
+    result = pb.fit(wi, wo, measured, threads=threads)
     elapsed = time.perf_counter() - start
     iterations = result.iterations
     print(f"fit of {len(result.names)} parameters: {elapsed:.2f} s, "
