@@ -122,23 +122,23 @@ def one_iteration(wi, wo, truth, measured, repeats: int, threads: int) -> None:
         cosine=True, model=0, threads=threads))
     textured = pb.Material(**{name: np.broadcast_to(getattr(truth, name), (count, n, 3) if name == "base_color"
                               else (count, n)) for name in pb.PARAMETERS})
-    pb.eval(textured, wi32, wo32, threads=threads)  # (caches the per-element float32 copies)
+    pb.eval(textured, wi32, wo32, threads=threads)  # (a first call, not timed)
     per_element = best_of(repeats, lambda: pb.eval(textured, wi32, wo32, threads=threads))
     uniform = best_of(repeats, lambda: pb.eval(pb.Material(roughness=0.4, clearcoat=0.2, sheen=0.2),
-                                                    np.broadcast_to(wi32, (count, n, 3)),
-                                                    np.broadcast_to(wo32, (count, n, 3)), threads=threads))
+                                               np.broadcast_to(wi32, (count, n, 3)),
+                                               np.broadcast_to(wo32, (count, n, 3)), threads=threads))
     print(f"one iteration (13 parameters): {equations * 1e3:.1f} ms, {pairs / equations / 1e6:.1f} M pairs/s; "
           f"eval per-element material {per_element * 1e3:.1f} ms ({equations / per_element:.2f}x), "
           f"uniform material {uniform * 1e3:.1f} ms ({equations / uniform:.2f}x)")
     for columns, label in (([GRADIENT_NAMES.index("roughness")], "roughness"), ([0, 1, 2, 7], "base_color, roughness")):
         t = best_of(repeats, lambda: _core.normal_equations(
-            wi=wi32, wo=wo32, slots=slots, target=target, scale=scale, gain=gain, problems=problems, columns=columns, loss=1,
-            cosine=True, model=0, threads=threads))
+            wi=wi32, wo=wo32, slots=slots, target=target, scale=scale, gain=gain, problems=problems, columns=columns,
+            loss=1, cosine=True, model=0, threads=threads))
         print(f"one iteration ({label}): {t * 1e3:.1f} ms ({t / per_element:.2f}x the per-element eval)")
 
 
-
 def whole_fit(wi, wo, measured, threads: int) -> None:
+    """pb.fit with its defaults, every texel."""
     count, n = measured.shape[0], len(wi)
     start = time.perf_counter()
     result = pb.fit(wi, wo, measured, threads=threads)
