@@ -78,14 +78,6 @@ struct DirectionVjpSink {
 template <Model model, Output output, Layouts layouts>
 PB_KERNEL_INLINE void eval_direction_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
                                            const DirectionShading& s) {
-    if constexpr (output == Output::kDirectionGradient) {
-        DirectionJacobianStore<layouts> store{job, i};
-        Rgb<Floats> f = eval_direction_gradient<model>(wi, wo, s, job.cosine, store);
-        store.finish();
-        store_rgb<layouts>(job.out[0], i, f);
-    } else {
-        DirectionVjpSink<layouts> sink{job, i, load_vec3<layouts>(job.cotangent, i)};
-        eval_direction_gradient<model>(wi, wo, s, job.cosine, sink);
-        sink.finish();
-    }
+    derivative_batch<output == Output::kDirectionGradient, DirectionJacobianStore<layouts>, DirectionVjpSink<layouts>,
+                     layouts>(job, i, [&](auto& target) { return eval_direction_gradient<model>(wi, wo, s, job.cosine, target); });
 }

@@ -183,20 +183,15 @@ PB_KERNEL_INLINE void eval_values_batch(const EvalJob& job, std::int64_t i, cons
     // select discards whatever the formulas gave below the surface (H may be 0)
     Mask above = above_surface(g);
     View<Floats> view = view_of<model, lobes>(wo, s);
-    if constexpr (output == Output::kGradient) {
+    if constexpr (differentiates(output)) {
         // x cos θl or x times 1 (the same bits), then 0 below the surface
         Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
         auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
-        JacobianStore<layouts> store{job, i};
-        Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked, store);
-        store.finish();
-        store_rgb<layouts>(job.out[0], i, {masked(f.r), masked(f.g), masked(f.b)});
-    } else if constexpr (output == Output::kVjp) {
-        Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
-        auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
-        VjpSink<layouts> sink{job, i, load_vec3<layouts>(job.cotangent, i)};
-        eval_gradient<model>(g, s, view, material.partials, masked, sink);
-        sink.finish();
+        derivative_batch<output == Output::kGradient, JacobianStore<layouts>, VjpSink<layouts>, layouts>(
+                job, i, [&](auto& target) {
+                    Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked, target);
+                    return Rgb<Floats>{masked(f.r), masked(f.g), masked(f.b)};
+                });
     } else if constexpr (output == Output::kPdf) {
         Floats pdf = mixture_pdf(g, s, view, lobe_weights(view.fv, s), job.sampler);
         select(above, pdf, Floats(0.0f)).store_unaligned(job.pdf + i);

@@ -29,24 +29,14 @@ template <Output output, Layouts layouts>
 PB_KERNEL_INLINE void eval2015_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
                                      const Prepared2015<output>& s) {
     auto weighted = [&](const Rgb<Floats>& c) { return job.cosine ? absolute(wi.z) * c : c; };
-    if constexpr (output == Output::kGradient) {
-        JacobianStore<layouts> store{job, i};
-        Rgb<Floats> f = eval_gradient2015(wi, wo, s, job.mode, job.cosine, store);
-        store.finish();
-        store_rgb<layouts>(job.out[0], i, f);
-    } else if constexpr (output == Output::kVjp) {
-        VjpSink<layouts> sink{job, i, load_vec3<layouts>(job.cotangent, i)};
-        eval_gradient2015(wi, wo, s, job.mode, job.cosine, sink);
-        sink.finish();
-    } else if constexpr (output == Output::kDirectionGradient) {
-        DirectionJacobianStore<layouts> store{job, i};
-        Rgb<Floats> f = eval_direction_gradient2015(wi, wo, s, job.mode, job.cosine, store);
-        store.finish();
-        store_rgb<layouts>(job.out[0], i, f);
-    } else if constexpr (output == Output::kDirectionVjp) {
-        DirectionVjpSink<layouts> sink{job, i, load_vec3<layouts>(job.cotangent, i)};
-        eval_direction_gradient2015(wi, wo, s, job.mode, job.cosine, sink);
-        sink.finish();
+    if constexpr (differentiates(output)) {
+        derivative_batch<output == Output::kGradient, JacobianStore<layouts>, VjpSink<layouts>, layouts>(
+                job, i, [&](auto& target) { return eval_gradient2015(wi, wo, s, job.mode, job.cosine, target); });
+    } else if constexpr (in_directions(output)) {
+        derivative_batch<output == Output::kDirectionGradient, DirectionJacobianStore<layouts>, DirectionVjpSink<layouts>,
+                         layouts>(job, i, [&](auto& target) {
+            return eval_direction_gradient2015(wi, wo, s, job.mode, job.cosine, target);
+        });
     } else if constexpr (output == Output::kPdf) {
         pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
     } else if constexpr (output == Output::kLobes) {

@@ -46,6 +46,23 @@ PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const
     }
 }
 
+// One batch at i of a derivative output: with `jacobian`, the Jacobian (a Store)
+// written beside f; else the cotangent's products (a Sink) alone.
+// `differentiate(target)` runs the forward pass into either and returns f.
+template <bool jacobian, class Store, class Sink, Layouts layouts, class Job, class Differentiate>
+PB_KERNEL_INLINE void derivative_batch(const Job& job, std::int64_t i, Differentiate&& differentiate) {
+    if constexpr (jacobian) {
+        Store store{job, i};
+        Rgb<Floats> f = differentiate(store);
+        store.finish();
+        store_rgb<layouts>(job.out[0], i, f);
+    } else {
+        Sink sink{job, i, load_vec3<layouts>(job.cotangent, i)};
+        differentiate(sink);
+        sink.finish();
+    }
+}
+
 // The direction check (DirectionCheck in batch.hpp). The fast test: true only
 // for lanes whose length the rule accepts.
 PB_KERNEL_INLINE Mask surely_unit_length(const Vec3<Floats>& w, const DirectionCheck& check) {

@@ -74,10 +74,9 @@ PB_MODEL_INLINE Rgb<F> eval_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, c
 // ---------------------------------------------------------------- in the directions (docs/gradients.md)
 // The derivatives of f in wi and wo, as the 2014 model's (direction_gradient.hpp),
 // by the same dual numbers: the material's constants carry no tangents, and the
-// six components wi_x ... wo_z take the tangents kSlotsAPass at a time, in
+// kDirectionSlots components wi_x ... wo_z take the tangents kSlotsAPass at a time, in
 // kDirectionPasses2015 evaluations.
-inline constexpr int kDirectionComponents2015 = 6;  // wi_x, wi_y, wi_z, wo_x, wo_y, wo_z
-inline constexpr int kDirectionPasses2015 = (kDirectionComponents2015 + kSlotsAPass - 1) / kSlotsAPass;
+inline constexpr int kDirectionPasses2015 = (kDirectionSlots + kSlotsAPass - 1) / kSlotsAPass;
 
 template <class F>
 PB_MODEL_INLINE Shading2015<PassDual<F>> constant_shading2015_of(const F* p, bool thin = false) {
@@ -98,11 +97,11 @@ template <class F, class Sink>
 PB_MODEL_INLINE Rgb<F> eval_direction_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<PassDual<F>>& s,
                                                    TransportMode mode, bool cosine, Sink&& jacobian) {
     using D = PassDual<F>;
-    const F components[kDirectionComponents2015] = {wi.x, wi.y, wi.z, wo.x, wo.y, wo.z};
+    const F components[kDirectionSlots] = {wi.x, wi.y, wi.z, wo.x, wo.y, wo.z};
     Rgb<F> value;
     for (int q = 0; q < kDirectionPasses2015; ++q) {
-        D w[kDirectionComponents2015];
-        for (int k = 0; k < kDirectionComponents2015; ++k) {
+        D w[kDirectionSlots];
+        for (int k = 0; k < kDirectionSlots; ++k) {
             const int tangent = k - q * kSlotsAPass;
             w[k] = tangent >= 0 && tangent < kSlotsAPass ? D::variable(components[k], tangent) : D(components[k]);
         }
@@ -110,7 +109,7 @@ PB_MODEL_INLINE Rgb<F> eval_direction_gradient2015(const Vec3<F>& wi, const Vec3
         Rgb<D> f = eval_lobes2015(dwi, dwo, s, mode).total();
         if (cosine) f = max(dwi.z, -dwi.z) * f;
         auto put = [&](int c, const D& channel) {
-            for (int t = 0; t < kSlotsAPass && q * kSlotsAPass + t < kDirectionComponents2015; ++t)
+            for (int t = 0; t < kSlotsAPass && q * kSlotsAPass + t < kDirectionSlots; ++t)
                 jacobian(c, q * kSlotsAPass + t, channel.d[t]);
             return channel.v;
         };
