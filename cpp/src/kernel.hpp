@@ -38,6 +38,7 @@ using Ints = xsimd::batch<std::int32_t, Arch>;
 constexpr std::int64_t kLanes = static_cast<std::int64_t>(Floats::size);
 
 #include "simd_ops.hpp"
+#include "simd_double_ops.hpp"
 
 // The model (docs/model.md), instantiated here for Floats.
 #define PB_MODEL_INLINE PB_KERNEL_INLINE

@@ -1,8 +1,15 @@
 // Part of kernel.hpp, included inside the per-arch namespace: one batch of the
 // derivatives of f in the directions (model/direction_gradient.hpp), for the
-// evaluation loop of kernel_eval.hpp: the Jacobian's 18 values an element
-// (Output::kDirectionGradient) or their products with a cotangent
-// (Output::kDirectionVjp).
+// evaluation loops of kernel_eval.hpp and kernel_eval2015.hpp: the Jacobian's
+// 18 values an element (Output::kDirectionGradient) or their products with a
+// cotangent (Output::kDirectionVjp).
+//
+// The model runs over double batches here (simd_double_ops.hpp), a half batch
+// at a time, and every output is rounded to float once: a derivative in a
+// direction sums terms of opposite signs (the Fresnel weights' and cos θd's in
+// a z column, say) whose sum can be a thousandth of the element's largest
+// column, and float sums would leave it a few roundings of that column wrong
+// (docs/gradients.md, "Accuracy").
 #pragma once  // (per translation unit)
 
 static_assert(kDirectionSlots == kDirectionComponents, "the model's direction slots are batch.hpp's components");
@@ -14,7 +21,27 @@ constexpr bool in_directions(Output output) {
     return output == Output::kDirectionGradient || output == Output::kDirectionVjp;
 }
 
-using DirectionShading = Shading<DirectionDual<Floats>>;
+// A batch's material constants over dual numbers, one set a half batch.
+template <class Shading>
+using Halves = std::array<Shading, kHalves>;
+using DirectionShading = Halves<Shading<DirectionDual<Doubles>>>;
+
+PB_KERNEL_INLINE std::array<Doubles, kParamSlots> half_of(const RawMaterial& m, int half) {
+    std::array<Doubles, kParamSlots> slots;
+    for (int k = 0; k < kParamSlots; ++k) slots[k] = half_of(m.slot[k], half);
+    return slots;
+}
+
+PB_KERNEL_INLINE Vec3<Doubles> half_of(const Vec3<Floats>& w, int half) {
+    return {half_of(w.x, half), half_of(w.y, half), half_of(w.z, half)};
+}
+
+// The constants of both halves, by shading_of(slots) (a model's or the 2015 solid's).
+template <class ShadingOf>
+PB_KERNEL_INLINE auto halves_of(const RawMaterial& m, ShadingOf&& shading_of) {
+    std::array<Doubles, kParamSlots> low = half_of(m, 0), high = half_of(m, 1);
+    return Halves<decltype(shading_of(low.data()))>{shading_of(low.data()), shading_of(high.data())};
+}
 
 template <Layouts layouts>
 PB_KERNEL_INLINE bool jacobian_by_rows(const EvalJob& job) {
@@ -74,10 +101,45 @@ struct DirectionVjpSink {
     }
 };
 
-// One batch at i of a direction output, its material's constants over dual numbers.
+// One batch at i of a direction output: `differentiate(half, wi, wo, jacobian)`
+// runs the forward pass of half a batch in double, gives its derivatives to
+// `jacobian(c, k, value)` and returns f; both halves are then rounded to float
+// and given to the Jacobian's store or the product's sink. The Jacobian's f
+// beside them is `value()`: eval's own float operations, so the same bits.
+template <Output output, Layouts layouts, class Differentiate, class Value>
+PB_KERNEL_INLINE void direction_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
+                                      Differentiate&& differentiate, Value&& value) {
+    derivative_batch<output == Output::kDirectionGradient, DirectionJacobianStore<layouts>, DirectionVjpSink<layouts>,
+                     layouts>(job, i, [&](auto& target) {
+        alignas(64) double rows[kDirectionJacobianWidth][kLanes];
+        for (int half = 0; half < kHalves; ++half) {
+            int at = half * kHalfLanes;
+            auto jacobian = [&](int c, int k, Doubles d) { d.store_aligned(rows[kDirectionSlots * c + k] + at); };
+            differentiate(half, half_of(wi, half), half_of(wo, half), jacobian);
+        }
+        for (int c = 0; c < 3; ++c)
+            for (int k = 0; k < kDirectionSlots; ++k) target(c, k, rounded_to_floats(rows[kDirectionSlots * c + k]));
+        if constexpr (output == Output::kDirectionGradient) {
+            return value();
+        } else {
+            return Rgb<Floats>{};
+        }
+    });
+}
+
+// One batch at i of a direction output of the 2012 and 2014 models.
 template <Model model, Output output, Layouts layouts>
 PB_KERNEL_INLINE void eval_direction_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
-                                           const DirectionShading& s) {
-    derivative_batch<output == Output::kDirectionGradient, DirectionJacobianStore<layouts>, DirectionVjpSink<layouts>,
-                     layouts>(job, i, [&](auto& target) { return eval_direction_gradient<model>(wi, wo, s, job.cosine, target); });
+                                           const Shading<Floats>& s, const DirectionShading& directions) {
+    auto differentiate = [&](int half, const Vec3<Doubles>& w_i, const Vec3<Doubles>& w_o, auto& jacobian) {
+        return eval_direction_gradient<model>(w_i, w_o, directions[half], job.cosine, jacobian);
+    };
+    auto value = [&] {  // as eval_values_batch's f
+        Geometry<Floats> g = geometry_of(wi, wo);
+        Mask above = above_surface(g);
+        Rgb<Floats> f = eval_lobes<model>(g, s, view_of<model>(wo, s)).total(s);
+        Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+        return select(above, job.cosine ? wi.z * f : f, zero);
+    };
+    direction_batch<output, layouts>(job, i, wi, wo, differentiate, value);
 }

@@ -4,7 +4,7 @@
 
 // What a batch needs of its material: the lobes' constants and, for the
 // Jacobian in the parameters, their partials, or for the derivatives in the
-// directions, the constants over dual numbers (nothing otherwise).
+// directions, the constants over dual numbers of double (nothing otherwise).
 struct NoPartials {};
 
 // The outputs that take derivatives in the parameters: the Jacobian and the vector-Jacobian product.
@@ -16,19 +16,20 @@ constexpr bool is_vjp(Output output) { return output == Output::kVjp || output =
 
 template <Output output>
 struct Prepared {
-    std::conditional_t<in_directions(output), DirectionShading, Shading<Floats>> shading;
+    Shading<Floats> shading;
     std::conditional_t<differentiates(output), MaterialPartials<Floats>, NoPartials> partials;
+    std::conditional_t<in_directions(output), DirectionShading, NoPartials> directions;
 };
 
 template <Output output>
 PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
     // built in place: assigning into a default-constructed one would copy the whole Shading per batch
     if constexpr (differentiates(output)) {
-        return {shading_of(m), material_partials_of(m.slot)};
+        return {shading_of(m), material_partials_of(m.slot), NoPartials{}};
     } else if constexpr (in_directions(output)) {
-        return {direction_shading_of(m.slot), NoPartials{}};
+        return {shading_of(m), NoPartials{}, halves_of(m, [](const Doubles* p) { return direction_shading_of(p); })};
     } else {
-        return {shading_of(m), NoPartials{}};
+        return {shading_of(m), NoPartials{}, NoPartials{}};
     }
 }
 
@@ -52,7 +53,7 @@ template <Model model, Output output, bool compensated>
 PB_KERNEL_INLINE PreparedOf<output, compensated> prepare_for(const RawMaterial& m) {
     if constexpr (compensated) {
         Shading<Floats> s = shading_of(m);
-        return {{s, NoPartials{}}, multiple_scattering_of(m.slot, s, model)};
+        return {{s, NoPartials{}, NoPartials{}}, multiple_scattering_of(m.slot, s, model)};
     } else {
         return prepare<output>(m);
     }
@@ -224,7 +225,7 @@ template <Model model, Output output, Layouts layouts, bool compensated, LobeSet
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
                                  const PreparedOf<output, compensated>& material) {
     if constexpr (in_directions(output)) {
-        eval_direction_batch<model, output, layouts>(job, i, wi, wo, material.shading);
+        eval_direction_batch<model, output, layouts>(job, i, wi, wo, material.shading, material.directions);
     } else {
         eval_values_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, material);
     }

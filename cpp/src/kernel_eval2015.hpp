@@ -5,19 +5,25 @@
 // any layout.
 #pragma once  // (per translation unit)
 
-// What a batch needs of its material: the constants, over dual numbers for the derivatives
-// (with the parameters' tangents, or with none for the derivatives in the directions).
+// The derivatives in the directions: the constants for f, and over dual numbers of double without tangents.
+struct DirectionShading2015 {
+    Shading2015<Floats> shading;
+    Halves<Shading2015<PassDual<Doubles>>> directions;
+};
+
+// What a batch needs of its material: the constants, over dual numbers for the
+// derivatives in the parameters (with their tangents).
 template <Output output>
-using Prepared2015 = std::conditional_t<
-        differentiates(output), GradientShading2015<Floats>,
-        std::conditional_t<in_directions(output), Shading2015<PassDual<Floats>>, Shading2015<Floats>>>;
+using Prepared2015 = std::conditional_t<differentiates(output), GradientShading2015<Floats>,
+                                        std::conditional_t<in_directions(output), DirectionShading2015, Shading2015<Floats>>>;
 
 template <Output output>
 PB_KERNEL_INLINE Prepared2015<output> prepare2015(const RawMaterial& m, bool thin) {
     if constexpr (differentiates(output)) {
         return gradient_shading2015_of(m.slot, thin);
     } else if constexpr (in_directions(output)) {
-        return constant_shading2015_of(m.slot, thin);
+        return DirectionShading2015{shading2015_of(m.slot, thin),
+                                    halves_of(m, [&](const Doubles* p) { return constant_shading2015_of(p, thin); })};
     } else {
         return shading2015_of(m.slot, thin);
     }
@@ -33,10 +39,11 @@ PB_KERNEL_INLINE void eval2015_batch(const EvalJob& job, std::int64_t i, const V
         derivative_batch<output == Output::kGradient, JacobianStore<layouts>, VjpSink<layouts>, layouts>(
                 job, i, [&](auto& target) { return eval_gradient2015(wi, wo, s, job.mode, job.cosine, target); });
     } else if constexpr (in_directions(output)) {
-        derivative_batch<output == Output::kDirectionGradient, DirectionJacobianStore<layouts>, DirectionVjpSink<layouts>,
-                         layouts>(job, i, [&](auto& target) {
-            return eval_direction_gradient2015(wi, wo, s, job.mode, job.cosine, target);
-        });
+        auto differentiate = [&](int half, const Vec3<Doubles>& w_i, const Vec3<Doubles>& w_o, auto& jacobian) {
+            return eval_direction_gradient2015(w_i, w_o, s.directions[half], job.mode, job.cosine, jacobian);
+        };
+        auto value = [&] { return weighted(eval_lobes2015(wi, wo, s.shading, job.mode).total()); };  // as f alone
+        direction_batch<output, layouts>(job, i, wi, wo, differentiate, value);
     } else if constexpr (output == Output::kPdf) {
         pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
     } else if constexpr (output == Output::kLobes) {

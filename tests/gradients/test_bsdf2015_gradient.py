@@ -237,13 +237,14 @@ def test_simd_direction_derivatives_match_the_reference(float32_direction_case, 
     assert np.all(np.isfinite(simd.jacobian))
     scale = np.maximum(np.abs(reference.jacobian), 1e-3 * np.abs(reference.jacobian).max(axis=-1, keepdims=True))
     error = np.abs(simd.jacobian - reference.jacobian) / np.where(scale > 0, scale, 1.0)
-    assert np.percentile(error, 99) <= 1e-4, np.percentile(error, 99)
-    # the square root of cos²θt (Fresnel's factor) amplifies float32's rounding by 1 / (2 cos²θt) in its
-    # derivative: near the critical angle the float32 derivatives have fewer digits (docs/gradients.md)
-    away = ~near_the_critical_angle(material, wi, wo, model)
-    assert away.mean() > 0.9
-    assert np.percentile(error[away], 99.99) <= 5e-4, np.percentile(error[away], 99.99)
-    assert error[away].max() <= 1e-2, error[away].max()
+    assert np.percentile(error, 99.99) <= 1e-4, np.percentile(error, 99.99)
+    assert error.max() <= 1e-2, error.max()
+    # each entry is the double sum rounded once, near the critical angle too, where the square
+    # root of cos²θt (Fresnel's factor) would amplify float32's roundings by 1 / (2 cos²θt)
+    normal = scale >= np.finfo(np.float32).tiny
+    assert np.all(error[normal] <= 1e-7), error[normal].max()
+    near = near_the_critical_angle(material, wi, wo, model)
+    assert model == "disney2015_thin" or near.sum() >= 500, near.sum()
     # with the parameters' columns: the same columns as alone, after them
     both = pb.eval_grad(material[:999], wi[:999], wo[:999], wrt=["wo", "spec_trans", "wi"], model=model,
                         mode="importance", isa=isa)

@@ -97,11 +97,11 @@ DIRECTION_MIX = {"cos>=0.05": dict(min_cos=0.05, grazing_fraction=0.0), "cos>=1e
 @pytest.mark.parametrize("directions", tuple(DIRECTION_MIX))
 def test_float32_direction_derivatives_against_float64(isa, model, directions):
     """Relative to max(|g64|, 1e-3 max_k |g64_k|) of the same element and channel (k over
-    the six direction columns), on the same float32 inputs: p99.99 <= 3e-4, max <= 1e-2
-    (docs/gradients.md, "Derivatives in the directions": measured 1.2e-4 to 1.8e-4)."""
+    the six direction columns), on the same float32 inputs: p99.99 <= 1e-4, max <= 1e-2
+    (the kernels sum in double: docs/gradients.md, "Derivatives in the directions")."""
     rng = seeded_rng("direction-simd", model, directions)
     n = 60_000
-    material = pb.Material(**random_material_arrays(rng, n))
+    material = pb.Material(**{k: np.asarray(v, np.float32) for k, v in random_material_arrays(rng, n).items()})
     wi, wo = (w.astype(np.float32) for w in random_direction_pairs(rng, n, **DIRECTION_MIX[directions]))
     cosine = directions == "cos>=1e-4"  # the cosine option on one of the two mixes
     g32 = pb.eval_grad(material, wi, wo, wrt=["wi", "wo"], model=model, cosine=cosine, isa=isa)
@@ -113,8 +113,11 @@ def test_float32_direction_derivatives_against_float64(isa, model, directions):
     scale = np.maximum(scale, 1e-3 * float(np.finfo(np.float32).tiny))
     error = np.abs(g32.jacobian - g64.jacobian) / np.where(scale > 0, scale, 1.0)
     assert np.all(np.isfinite(g32.jacobian))
-    assert np.percentile(error, 99.99) <= 3e-4, np.percentile(error, 99.99)
+    assert np.percentile(error, 99.99) <= 1e-4, np.percentile(error, 99.99)
     assert error.max() <= 1e-2, error.max()
+    # in float32's normal range each entry is the double sum rounded once
+    normal = scale >= np.finfo(np.float32).tiny
+    assert error[normal].max() <= 1e-7, error[normal].max()
     np.testing.assert_array_equal(g32.value, pb.eval(material, wi, wo, model=model, cosine=cosine, isa=isa))
 
 
