@@ -36,6 +36,26 @@ PB_KERNEL_INLINE Vec3<Doubles> half_of(const Vec3<Floats>& w, int half) {
     return {half_of(w.x, half), half_of(w.y, half), half_of(w.z, half)};
 }
 
+// The constants `c` over dual numbers with zero tangents: what the model's
+// constructor of them gives over the dual numbers, whose values are the
+// model's own operations on F, without its work on the zero tangents (most of
+// a batch's for per-element materials). Constants<F> holds F's and nothing
+// else (the sizes assert it), so its k-th F is the k-th Dual's value.
+template <class Dual, class F, template <class> class Constants>
+PB_KERNEL_INLINE Constants<Dual> with_zero_tangents(const Constants<F>& c) {
+    constexpr std::size_t count = sizeof(Constants<F>) / sizeof(F);
+    static_assert(sizeof(Constants<F>) == count * sizeof(F) && sizeof(Constants<Dual>) == count * sizeof(Dual),
+                  "the constants are F's alone");
+    Constants<Dual> lifted;
+    for (std::size_t k = 0; k < count; ++k) {
+        F value;
+        std::memcpy(&value, reinterpret_cast<const char*>(&c) + k * sizeof(F), sizeof(F));
+        Dual constant(value);
+        std::memcpy(reinterpret_cast<char*>(&lifted) + k * sizeof(Dual), &constant, sizeof(Dual));
+    }
+    return lifted;
+}
+
 // The constants of both halves, by shading_of(slots) (a model's or the 2015 solid's).
 template <class ShadingOf>
 PB_KERNEL_INLINE auto halves_of(const RawMaterial& m, ShadingOf&& shading_of) {

@@ -27,7 +27,9 @@ PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
     if constexpr (differentiates(output)) {
         return {shading_of(m), material_partials_of(m.slot), NoPartials{}};
     } else if constexpr (in_directions(output)) {
-        return {shading_of(m), NoPartials{}, halves_of(m, [](const Doubles* p) { return direction_shading_of(p); })};
+        return {shading_of(m), NoPartials{}, halves_of(m, [](const Doubles* p) {
+                    return with_zero_tangents<DirectionDual<Doubles>>(shading_of(p));
+                })};
     } else {
         return {shading_of(m), NoPartials{}, NoPartials{}};
     }
