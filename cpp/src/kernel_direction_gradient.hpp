@@ -9,7 +9,7 @@
 // direction sums terms of opposite signs (the Fresnel weights' and cos θd's in
 // a z column, say) whose sum can be a thousandth of the element's largest
 // column, and float sums would leave it a few roundings of that column wrong
-// (docs/gradients.md, "Accuracy").
+// (docs/gradients.md, "Derivatives in the directions").
 #pragma once  // (per translation unit)
 
 static_assert(kDirectionSlots == kDirectionComponents, "the model's direction slots are batch.hpp's components");
@@ -36,10 +36,10 @@ PB_KERNEL_INLINE Vec3<Doubles> half_of(const Vec3<Floats>& w, int half) {
     return {half_of(w.x, half), half_of(w.y, half), half_of(w.z, half)};
 }
 
-// The constants `c` over dual numbers with zero tangents: what the model's
-// constructor of them gives over the dual numbers, whose values are the
-// model's own operations on F, without its work on the zero tangents (most of
-// a batch's for per-element materials). Constants<F> holds F's and nothing
+// The constants `c` over dual numbers with zero tangents: what
+// direction_shading_of gives (shading_of over the dual numbers, whose values
+// are the same operations on F), without its work on the zero tangents (most
+// of a batch's for per-element materials). Constants<F> holds F's and nothing
 // else (the sizes assert it), so its k-th F is the k-th Dual's value.
 template <class Dual, class F, template <class> class Constants>
 PB_KERNEL_INLINE Constants<Dual> with_zero_tangents(const Constants<F>& c) {

@@ -1,8 +1,8 @@
 // What the model calls (docs/model.md), for batches of double: the number type
 // of the derivatives in the directions (kernel_direction_gradient.hpp), whose
 // sums cancel to a small fraction of their terms (docs/gradients.md). The same
-// names as simd_ops.hpp's for Floats and model/scalar_ops.hpp's for double,
-// each exact to double rounding.
+// names as simd_ops.hpp's for Floats and model/scalar_ops.hpp's for double:
+// IEEE double arithmetic, and xsimd's log, exp and expm1 (within an ulp or two).
 //
 // Included by kernel.hpp inside the per-arch namespace, before the model.
 #pragma once  // (per translation unit)
