@@ -3,7 +3,8 @@
 Every subcommand has ``--help``; bad arguments print a one-line error and
 exit with status 2. The numeric options are bounded so that a job fits in
 memory and ends: ``--pairs`` at most 2^27, ``--repeats`` 1 to 100 with
-pairs x repeats at most 2^31, ``--resolution`` 2 to 16384, ``--samples`` 1 to
+pairs x repeats at most 2^31, ``--resolution`` 2 to 16384 (the demo's spheres
+8 to 1024), ``--samples`` 1 to
 65536 per pixel with resolution² x samples at most 2^34 (with an environment),
 ``--exposure`` finite, > 0 and at most 1e20, ``--light`` three finite numbers
 not all 0, ``--light-intensity`` finite, >= 0 and at most 1e20, ``--param``
@@ -26,6 +27,7 @@ from . import _core
 from ._batch import FLOAT32_LIMITS
 from .material import PARAMETERS, Material
 from .environment import MAP_FORMATS
+from .demo import PICTURE_RESOLUTION
 from .render import ENVIRONMENT_NAMES, MAX_RESOLUTION, MAX_SAMPLE_WORK, MAX_SAMPLES
 
 if TYPE_CHECKING:
@@ -35,6 +37,7 @@ if TYPE_CHECKING:
 MAX_PAIRS = 1 << 27
 # Timed runs: each one evaluates every pair (the benchmark's numpy model at ~10 M pairs/s on two cores).
 MAX_REPEATS = 100
+MAX_DEMO_RESOLUTION = 1024  # pixels per sphere: 36 spheres, the glass row traced at 256 samples a pixel
 MAX_PAIR_WORK = 1 << 31  # pairs x repeats
 MAX_EXPOSURE = 1e20  # a linear picture times this stays inside float32 (its values are far below 1e18)
 
@@ -176,7 +179,7 @@ def _render_limits(args: argparse.Namespace) -> str | None:
 def _demo(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     from .demo import run
 
-    run(pairs=args.pairs, output=args.output, repeats=args.repeats, report=report)
+    run(pairs=args.pairs, output=args.output, repeats=args.repeats, resolution=args.resolution, report=report)
 
 
 def _render(args: argparse.Namespace, report: Callable[[str], object]) -> None:
@@ -230,6 +233,8 @@ def build_parser() -> argparse.ArgumentParser:
                       help=f"timed runs, best kept (default 5, at most {MAX_REPEATS})")
     demo.add_argument("--output", type=_image_path((".png",)), default="principled_brdf_demo.png",
                       help="picture to write (PNG)")
+    demo.add_argument("--resolution", type=_at_most(MAX_DEMO_RESOLUTION, "pixels", lower=8), default=PICTURE_RESOLUTION,
+                      help=f"pixels per sphere of the picture (default {PICTURE_RESOLUTION}, at most {MAX_DEMO_RESOLUTION})")
     demo.set_defaults(run=_demo, limits=_timing_limits)
 
     render = commands.add_parser("render", help="render a preset or parameters on a lit sphere (PNG, EXR, NPY)",

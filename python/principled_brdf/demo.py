@@ -45,7 +45,7 @@ GLASS_ENVIRONMENT = "outdoor"  # a sky, a sun and a tiled ground: what refractio
 
 
 def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats: int = 5,
-        report: Callable[[str], object] = print) -> dict[str, Any]:
+        resolution: int = PICTURE_RESOLUTION, report: Callable[[str], object] = print) -> dict[str, Any]:
     from . import __version__
 
     info = cpu_info()
@@ -94,7 +94,7 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
            f"{furnace[0]:.3f} single scattering, {furnace[1]:.3f} with energy_compensation")
     report(f"rendering {len(PICTURE_PRESETS)} presets, a roughness sweep of two metals, without and with "
            "energy compensation, and a row of glass and thin sheets ...")
-    images, labels, titles = picture_spheres()
+    images, labels, titles = picture_spheres(resolution)
     write_picture(output, images, labels, columns=len(PICTURE_PRESETS), row_titles=titles)
     report(f"wrote {output}: presets {', '.join(PICTURE_PRESETS)} (top); below, a white and a gold metal from "
            f"roughness {SWEEP_ROUGHNESS[0]:g} to {SWEEP_ROUGHNESS[-1]:g}, each without and with energy_compensation "

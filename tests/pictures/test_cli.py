@@ -44,13 +44,13 @@ def test_info(capsys):
 
 def test_demo_writes_a_picture_and_reports_throughput(tmp_path):
     output = tmp_path / "demo.png"
-    result = run("demo", "--pairs", "200000", "--repeats", "1", "--output", str(output))
+    result = run("demo", "--pairs", "200000", "--repeats", "1", "--resolution", "32", "--output", str(output))
     assert result.returncode == 0, result.stderr
     for phrase in ("M pairs/s", "roofline", "sample", "float64 reference", "max relative error"):
         assert phrase in result.stdout
     width, height = read_png_size(output)
     # row titles on the left; a label strip above the presets, each metal's first row and the glass row
-    assert width == 120 + 6 * 128 and height == 6 * 128 + 4 * 22 + 2 * 4
+    assert width == 120 + 6 * 32 and height == 6 * 32 + 4 * 22 + 2 * 4
 
 
 def test_render_preset_with_parameters(tmp_path, capsys):
