@@ -1,5 +1,5 @@
 // Per-instruction-set building blocks of the kernel: reciprocal, square root,
-// a fast reciprocal square root refined to float precision, and the (N, 3)
+// a reciprocal square root (AVX-512: rsqrt14 refined to float precision), and the (N, 3)
 // interleaved <-> structure-of-arrays transposes done in registers.
 //
 // Included by kernel.hpp inside the per-arch namespace, after `Floats` is
@@ -68,15 +68,22 @@ PB_KERNEL_INLINE Floats neg_mul_add(Floats a, Floats b, Floats c) { return xsimd
 // set. The kernels are bound by the multiply and FMA pipes; the divide and
 // square-root unit works beside them, so an exact 1/x or sqrt(x) is cheaper
 // there than an rcp or rsqrt estimate refined by a Newton step, which takes 3
-// or 4 of the pipes' slots.
+// or 4 of the pipes' slots. No kernel uses rcpps or rsqrtps: their estimates
+// are implementation-defined (Intel and AMD return different bits), and a
+// result refined from them would differ by vendor.
 PB_KERNEL_INLINE Floats reciprocal(Floats x) { return Floats(1.0f) / x; }
 // sqrt(x), 0 for x <= 0 (and for NaN on x86, where max returns its second operand)
 PB_KERNEL_INLINE Floats square_root(Floats x) { return xsimd::sqrt(xsimd::max(x, Floats(0.0f))); }
 // sqrt(x) for x >= 0 by construction (a sum of squares): no clamp
 PB_KERNEL_INLINE Floats square_root_nonnegative(Floats x) { return xsimd::sqrt(x); }
+#if !defined(__AVX512F__)
+PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) { return Floats(1.0f) / xsimd::sqrt(x); }
+#endif
 
 #if defined(__AVX512F__)
 
+// rsqrt14's estimate is specified bit for bit (the same on every vendor's AVX-512),
+// so the refined result is too.
 PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
     const __m512 estimate = _mm512_rsqrt14_ps(x);  // relative error < 2^-14
     // One Newton-Raphson step: y + (y / 2) (1 - x y²)
@@ -146,13 +153,6 @@ PB_KERNEL_INLINE void stream_interleaved(float* p, Floats x, Floats y, Floats z)
 
 #elif defined(__AVX2__)
 
-PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) {
-    const __m256 estimate = _mm256_rsqrt_ps(x);  // relative error < 1.5 * 2^-12
-    // One Newton-Raphson step: y + (y / 2) (1 - x y²)
-    const __m256 residual = _mm256_fnmadd_ps(_mm256_mul_ps(x, estimate), estimate, _mm256_set1_ps(1.0f));
-    return _mm256_fmadd_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), estimate), residual, estimate);
-}
-
 template <int k>
 PB_KERNEL_INLINE __m256i interleave_load_permutation() {
     return _mm256_load_si256(reinterpret_cast<const __m256i*>(kInterleave3Permutation<8, k, false>.lanes));
@@ -218,8 +218,6 @@ PB_KERNEL_INLINE void stream_interleaved(float* p, Floats x, Floats y, Floats z)
 }
 
 #else  // SSE2, NEON: exact division and square root, transposes through memory
-
-PB_KERNEL_INLINE Floats reciprocal_sqrt(Floats x) { return Floats(1.0f) / xsimd::sqrt(x); }
 
 PB_KERNEL_INLINE void load_interleaved(const float* p, Floats& x, Floats& y, Floats& z) {
     alignas(64) float xs[Floats::size], ys[Floats::size], zs[Floats::size];

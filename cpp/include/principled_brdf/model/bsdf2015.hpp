@@ -51,7 +51,7 @@ struct Shading2015 {
     Rgb<F> diffuse_transmission;
     F diffuse_transmission_luminance;
 
-    PB_MODEL_INLINE bool opaque() const { return !any(transmission_weight != F(0.0)); }
+    PB_MODEL_INLINE bool opaque() const { return !nonzero_anywhere(transmission_weight); }
 };
 
 // Both GGX alphas of a roughness, with the 2014 anisotropy (principled.hpp's shading_of).
@@ -161,7 +161,7 @@ PB_MODEL_INLINE Lobes2015<F> reflection2015(const Side<F>& side, const Geometry<
 
     // Fd + flatness (ss - f_L), f_L = (1 - FL/2)(1 - FV/2): (1 - flatness) f_L + flatness ss + f_R with f_L + f_R = Fd
     F diffuse = b.diffuse.template value<false>(g, schlick);
-    if (any(s.flatness != zero)) {
+    if (nonzero_anywhere(s.flatness)) {
         F lambert = neg_mul_add(F(0.5), schlick.fl, F(1.0)) * neg_mul_add(F(0.5), schlick.fv, F(1.0));
         diffuse = mul_add(s.flatness, b.diffuse.subsurface_shape(g, schlick) - lambert, diffuse);
     }

@@ -171,3 +171,13 @@ template <class F, int N>
 PB_MODEL_INLINE auto operator==(const Dual<F, N>& a, const Dual<F, N>& b) { return a.v == b.v; }
 template <class F, int N>
 PB_MODEL_INLINE auto operator!=(const Dual<F, N>& a, const Dual<F, N>& b) { return a.v != b.v; }
+
+// A term skipped where its weight is 0 in every lane has a derivative where the
+// weight's tangents are not 0 (the one-sided derivative at a parameter's bound,
+// e.g. clearcoat 0): the test counts them.
+template <class F, int N>
+PB_MODEL_INLINE bool nonzero_anywhere(const Dual<F, N>& x) {
+    bool nonzero = nonzero_anywhere(x.v);
+    for (int k = 0; k < N; ++k) nonzero = nonzero || nonzero_anywhere(x.d[k]);
+    return nonzero;
+}

@@ -69,7 +69,7 @@ struct DiffuseLobe {
         F fd = mul_add(fd90_minus_1, fresnel.fl, one) * mul_add(fd90_minus_1, fresnel.fv, one);
         // Skipped when 0 in every lane: for a uniform material the test has the
         // same outcome for every batch, and mix(fd, ss, 0) = fd bit for bit.
-        if (!with_subsurface || !any(subsurface != F(0.0))) return fd;
+        if (!with_subsurface || !nonzero_anywhere(subsurface)) return fd;
         return mix(fd, subsurface_shape(g, fresnel), subsurface);
     }
 
@@ -186,7 +186,7 @@ struct ClearcoatLobe {
 
     static constexpr double kSmithAlpha2 = 0.0625;  // Gr's alpha 0.25, squared
 
-    PB_MODEL_INLINE bool absent() const { return !any(scale != F(0.0)); }
+    PB_MODEL_INLINE bool absent() const { return !nonzero_anywhere(scale); }
 
     // the Smith denominator n·w + sqrt(...) = 2 n·w / G1(w) of wo at alpha 0.25 (1 when no lane has a clearcoat)
     PB_MODEL_INLINE F smith_wo(const Vec3<F>& wo) const {

@@ -8,6 +8,12 @@
 template <class F>
 using MaskOf = decltype(F() < F());
 
+// Whether x is nonzero in some lane: the test by which a part skips a term
+// that is 0 in every lane. Dual numbers (model/dual.hpp) overload it to count
+// their tangents too, so that a term whose weight is 0 keeps its derivative.
+template <class F>
+PB_MODEL_INLINE bool nonzero_anywhere(const F& x) { return any(x != F(0.0)); }
+
 template <class F>
 struct Vec3 {
     F x, y, z;
