@@ -224,8 +224,9 @@ class Material:
                                      f"model {model!r} does not read it and needs its default {default:g} "
                                      + ("(use flatness)" if name == "subsurface" else ""))
         if model in BSDF_MODELS:
-            self._require_everywhere("specular", lambda array: array < 12.5,
-                                     f"model {model!r} needs specular < 12.5 (a finite index of refraction)")
+            self._require_everywhere("specular", lambda array: array <= MAX_BSDF_SPECULAR,
+                                     f"model {model!r} needs specular <= {MAX_BSDF_SPECULAR:.6g} "
+                                     f"(an index of refraction up to MAX_IOR = {MAX_IOR:g})")
 
     def _require_everywhere(self, name: str, holds: Callable[[Float64Array], NDArray[np.bool_]], rule: str) -> None:
         array: Float64Array = getattr(self, name)
@@ -318,10 +319,24 @@ def _rebuilt(*values: RealArrayLike) -> Material:
 
 
 def specular_of_ior(ior: RealArrayLike) -> Float64Array:
-    """``specular`` for an index of refraction η >= 1: ``((η - 1)/(η + 1))² / 0.08`` (1.5 gives 0.5)."""
+    """``specular`` for an index of refraction 1 <= η <= :data:`MAX_IOR`: ``((η - 1)/(η + 1))² / 0.08``
+    (1.5 gives 0.5)."""
     eta = as_real_array("ior", ior)
-    require_in_domain("ior", eta, 1.0, np.inf)
-    return ((eta - 1.0) / (eta + 1.0)) ** 2 / 0.08
+    require_in_domain("ior", eta, 1.0, MAX_IOR)
+    return _specular_of_eta(eta)
+
+
+def _specular_of_eta(eta: Float64Array | float) -> Float64Array:
+    return np.asarray(((eta - 1.0) / (eta + 1.0)) ** 2 / 0.08)
+
+
+# The largest index of refraction the 2015 models take (and ``ior=`` accepts): up to it
+# the float32 kernels hold the model's accuracy bounds (docs/model-2015.md). Beyond it
+# ever more of the light from inside meets the interface near the critical angle
+# (cos θc = sqrt(1 - 1/η²)), where float32 cannot decide total internal reflection
+# (from η = 20 single pairs differ by 4 %), and from specular 12.5 on η is infinite.
+MAX_IOR = 10.0
+MAX_BSDF_SPECULAR = float(_specular_of_eta(MAX_IOR))
 
 
 class BrightColorWarning(UserWarning):
