@@ -29,7 +29,7 @@ import typing
 
 import numpy as np
 
-from . import _low_discrepancy
+from . import _low_discrepancy, _validate
 from ._batch import eval_pdf as _eval_pdf
 from ._batch import sample as _sample
 from .environment import Environment
@@ -71,6 +71,26 @@ def power_heuristic(pdf: FloatArray, other: FloatArray) -> Float64Array:
     return np.divide(p, p + q, out=np.zeros(p.shape), where=p > 0.0)
 
 
+def callable_radiance(environment: Callable[[Float32Array], ArrayLike], directions: Float32Array) -> np.ndarray:
+    """``environment(directions)`` of a callable ``L(direction)``, checked as a map's pixels are:
+    real RGB radiance of the directions' shape ``(..., 3)``, finite and >= 0 (its dtype kept);
+    otherwise an error naming ``environment`` and the first direction at fault."""
+    radiance = np.asarray(environment(directions))
+    if radiance.dtype.kind not in "biuf":
+        raise TypeError(f"environment: the callable returned {radiance.dtype} values, expected real RGB radiance")
+    if radiance.shape != directions.shape:
+        raise ValueError(f"environment: expected radiance of shape {directions.shape} (RGB for each direction) "
+                         f"from the callable, got {radiance.shape}")
+    if not _validate.all_within(radiance, 0.0, np.inf):
+        with np.errstate(invalid="ignore"):
+            bad = ~((radiance >= 0.0) & (radiance < np.inf))
+        i = _validate.first_true(bad)
+        direction = ", ".join(f"{float(x):.4g}" for x in directions.reshape(-1, 3)[i // 3])
+        raise ValueError(f"environment: the callable returned {float(radiance.ravel()[i])!r} at direction "
+                         f"[{direction}] (radiance is finite and >= 0)")
+    return radiance
+
+
 def _local(direction: Float64Array, tangent: Float64Array, bitangent: Float64Array, normal: Float64Array) -> Float64Array:
     return np.stack([np.sum(f * direction, axis=-1) for f in (tangent, bitangent, normal)], axis=-1)
 
@@ -102,7 +122,7 @@ def through_the_sphere(material_at: Callable[[np.ndarray], Material], element: n
         material = material_at(element[path])
         u = inner_uniforms(sample[path], pixel[path], seed, bounce)
         if isinstance(radiance, Environment):  # the map's strategy: f |cos θl| L / pdf_light, weighted
-            towards, light_pdf, light = radiance.sample(u[:, 4:6])
+            towards, light_pdf, light = radiance._sample_unchecked(u[:, 4:6])
             local = _local(towards.astype(np.float64), tangent, bitangent, point)
             value, bsdf_pdf = _eval_pdf(material, local.astype(np.float32), wo, cosine=True, model=model, check=False)
             share = np.divide(power_heuristic(light_pdf, bsdf_pdf), light_pdf, out=np.zeros(len(path)),
@@ -116,10 +136,10 @@ def through_the_sphere(material_at: Callable[[np.ndarray], Material], element: n
         if exits.any():
             outward = leaving[exits].astype(np.float32)
             if isinstance(radiance, Environment):
-                seen, light_pdf = radiance.lookup(outward)
+                seen, light_pdf = radiance._lookup_unchecked(outward)
                 arriving = seen * power_heuristic(drawn.pdf[exits], light_pdf)[:, None]
             else:
-                arriving = np.asarray(radiance(outward), dtype=np.float64)
+                arriving = callable_radiance(radiance, outward).astype(np.float64)
             out[path[exits]] += weight[exits] * arriving
         keep = ~exits & (drawn.pdf > 0.0)
         if bounce >= ROULETTE_AFTER:

@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ._batch import Lobes, random_uniforms, sample
-from ._validate import (BSDF_MODELS, LOBE_NAMES, as_real_array, broadcast_leading, integer_in, require_in_domain,
-                        seed_value)
+from ._validate import (BSDF_MODELS, LOBE_NAMES, as_real_array, broadcast_leading, element_name, first_true,
+                        integer_in, require_in_domain, seed_value)
 from .material import PARAMETERS, Material, _require_material
 
 if TYPE_CHECKING:
@@ -71,9 +71,11 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
     cos_o = as_real_array("cos_theta_o", cos_theta_o)
     whole_sphere = model in BSDF_MODELS
     require_in_domain("cos_theta_o", cos_o, -1.0 if whole_sphere else 0.0, 1.0)
-    if np.any(cos_o == 0.0):
-        raise ValueError("cos_theta_o: the albedo is defined for cos θo != 0" if whole_sphere
-                         else "cos_theta_o: the albedo is defined for cos θo > 0")
+    if np.any(cos_o == 0.0):  # wo in the surface
+        i = first_true(cos_o == 0.0)
+        domain = "[-1, 1] without 0" if whole_sphere else "(0, 1]"
+        raise ValueError(f"{element_name('cos_theta_o', i, cos_o.shape)}: {float(cos_o.ravel()[i])!r} is outside its "
+                         f"domain {domain}")
     count = integer_in("samples", samples, 2, MAX_SAMPLES)
     seed = seed_value(seed)
     leading = broadcast_leading(cos_theta_o=cos_o.shape, material=material.shape)

@@ -4,18 +4,20 @@ Every subcommand has ``--help``; bad arguments print a one-line error and
 exit with status 2. The numeric options are bounded so that a job fits in
 memory and ends: ``--pairs`` at most 2^27, ``--repeats`` 1 to 100 with
 pairs x repeats at most 2^31, ``--resolution`` 2 to 16384 (the demo's spheres
-8 to 1024), ``--samples`` 1 to
+8 to 682: its 36 spheres x resolution² x 256 samples at most 2^32), ``--samples`` 1 to
 65536 per pixel with resolution² x samples at most 2^34 (with an environment),
 ``--exposure`` finite, > 0 and at most 1e20, ``--light`` three finite numbers
 not all 0, ``--light-intensity`` finite, >= 0 and at most 1e20, ``--param``
 values inside their domains and what the kernels take (``roughness`` up to
 1e4, the others up to 1e20), ``--environment`` a built-in name or an existing
-``.exr``/``.hdr`` file, ``--tone`` one of the tone curves.
+``.exr``/``.hdr`` file, ``--tone`` one of the tone curves, ``--output`` a file
+that can be made in an existing folder (checked before any work).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import platform
 import sys
 import time
@@ -27,17 +29,17 @@ from . import _core
 from ._batch import FLOAT32_LIMITS
 from .material import PARAMETERS, Material
 from .environment import MAP_FORMATS
-from .demo import PICTURE_RESOLUTION
+from .demo import (MAX_PICTURE_RESOLUTION, MAX_PICTURE_WORK, MIN_PICTURE_RESOLUTION, PICTURE_RESOLUTION,
+                   PICTURE_SAMPLES, PICTURE_SPHERES)
 from .render import ENVIRONMENT_NAMES, MAX_RESOLUTION, MAX_SAMPLE_WORK, MAX_SAMPLES
 
 if TYPE_CHECKING:
-    from collections.abc import Callable, Sequence
+    from collections.abc import Callable, Iterator, Sequence
 
 # Each pair holds about 100 bytes across the benchmarks' arrays: 2**27 pairs is 13 GB.
 MAX_PAIRS = 1 << 27
 # Timed runs: each one evaluates every pair (the benchmark's numpy model at ~10 M pairs/s on two cores).
 MAX_REPEATS = 100
-MAX_DEMO_RESOLUTION = 1024  # pixels per sphere: 36 spheres, the glass row traced at 256 samples a pixel
 MAX_PAIR_WORK = 1 << 31  # pairs x repeats
 MAX_EXPOSURE = 1e20  # a linear picture times this stays inside float32 (its values are far below 1e18)
 
@@ -146,7 +148,8 @@ def _parameter(text: str) -> tuple[str, float | tuple[float, ...]]:
 
 
 def _image_path(formats: Sequence[str]) -> Callable[[str], str]:
-    """An output path whose extension is one of ``formats`` (the error names the extension)."""
+    """An output path whose extension is one of ``formats`` (the error names the extension), in a
+    folder where a file can be made (checked before any work, by making one there)."""
     def parse(text: str) -> str:
         import os
 
@@ -154,8 +157,33 @@ def _image_path(formats: Sequence[str]) -> Callable[[str], str]:
         if extension not in formats:
             raise argparse.ArgumentTypeError(f"cannot write {extension or 'a file without an extension'!r} images; "
                                              f"supported: {', '.join(formats)}")
+        problem = _unwritable(text)
+        if problem is not None:
+            raise argparse.ArgumentTypeError(f"cannot write {text!r}: {problem}")
         return text
     return parse
+
+
+def _unwritable(path: str) -> str | None:
+    """Why ``path`` cannot be written, or None: its folder must exist and take a new file (tried with
+    a temporary one: permissions alone do not say, e.g. for root or on a read-only file system),
+    and the path must not be a folder or a file that cannot be written."""
+    import os
+    import tempfile
+
+    folder = os.path.dirname(path) or os.curdir
+    if not os.path.isdir(folder):
+        return f"no such folder {folder!r}"
+    if os.path.isdir(path):
+        return "it is a folder"
+    if os.path.exists(path) and not os.access(path, os.W_OK):
+        return "permission denied"
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".principled_brdf_", suffix=".tmp"):
+            pass
+    except OSError as error:
+        return f"a file cannot be made in {folder!r} ({error.strerror or error})"
+    return None
 
 
 def _timing_limits(args: argparse.Namespace) -> str | None:
@@ -164,6 +192,17 @@ def _timing_limits(args: argparse.Namespace) -> str | None:
         return (f"argument --repeats: {args.repeats} runs of {args.pairs} pairs is beyond {MAX_PAIR_WORK} (2^31) pairs "
                 f"in all; at most {max(MAX_PAIR_WORK // args.pairs, 1)} repeats of this many pairs")
     return None
+
+
+def _demo_limits(args: argparse.Namespace) -> str | None:
+    """What is wrong with demo's options together, or None: the timing's work and the picture's,
+    spheres x pixels x samples at most MAX_PICTURE_WORK (render's limit, counting what its samples cost)."""
+    work = PICTURE_SPHERES * args.resolution * args.resolution * PICTURE_SAMPLES
+    if work > MAX_PICTURE_WORK:
+        return (f"argument --resolution: {PICTURE_SPHERES} spheres of {args.resolution}x{args.resolution} pixels at "
+                f"{PICTURE_SAMPLES} samples is {work} samples, beyond the picture's {MAX_PICTURE_WORK} (2^32); at "
+                f"most {MAX_PICTURE_RESOLUTION} pixels per sphere")
+    return _timing_limits(args)
 
 
 def _render_limits(args: argparse.Namespace) -> str | None:
@@ -176,10 +215,20 @@ def _render_limits(args: argparse.Namespace) -> str | None:
     return None
 
 
+@contextlib.contextmanager
+def _naming_the_output(path: str) -> Iterator[None]:
+    """An OSError inside (writing the output) as one naming ``--output``."""
+    try:
+        yield
+    except OSError as error:
+        raise OSError(f"argument --output: cannot write {path!r}: {error.strerror or error}") from None
+
+
 def _demo(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     from .demo import run
 
-    run(pairs=args.pairs, output=args.output, repeats=args.repeats, resolution=args.resolution, report=report)
+    with _naming_the_output(args.output):  # (the demo's one file is its picture)
+        run(pairs=args.pairs, output=args.output, repeats=args.repeats, resolution=args.resolution, report=report)
 
 
 def _render(args: argparse.Namespace, report: Callable[[str], object]) -> None:
@@ -197,7 +246,8 @@ def _render(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     image = render_sphere(material, resolution=args.resolution, light=args.light, light_intensity=args.light_intensity,
                           model=args.model, environment=environment, samples=args.samples,
                           energy_compensation=args.energy_compensation)
-    save_image(args.output, image, exposure=args.exposure, curve=args.tone)
+    with _naming_the_output(args.output):
+        save_image(args.output, image, exposure=args.exposure, curve=args.tone)
     report(f"wrote {args.output}")
 
 
@@ -233,9 +283,12 @@ def build_parser() -> argparse.ArgumentParser:
                       help=f"timed runs, best kept (default 5, at most {MAX_REPEATS})")
     demo.add_argument("--output", type=_image_path((".png",)), default="principled_brdf_demo.png",
                       help="picture to write (PNG)")
-    demo.add_argument("--resolution", type=_at_most(MAX_DEMO_RESOLUTION, "pixels", lower=8), default=PICTURE_RESOLUTION,
-                      help=f"pixels per sphere of the picture (default {PICTURE_RESOLUTION}, at most {MAX_DEMO_RESOLUTION})")
-    demo.set_defaults(run=_demo, limits=_timing_limits)
+    demo.add_argument("--resolution", type=_at_most(MAX_RESOLUTION, "pixels", lower=MIN_PICTURE_RESOLUTION),
+                      default=PICTURE_RESOLUTION,
+                      help=f"pixels per sphere of the picture (default {PICTURE_RESOLUTION}, {MIN_PICTURE_RESOLUTION} to "
+                           f"{MAX_PICTURE_RESOLUTION}: {PICTURE_SPHERES} spheres x resolution² x {PICTURE_SAMPLES} "
+                           f"samples at most 2^32)")
+    demo.set_defaults(run=_demo, limits=_demo_limits)
 
     render = commands.add_parser("render", help="render a preset or parameters on a lit sphere (PNG, EXR, NPY)",
                                  description="Render a material on a sphere lit by an environment (and a key light).")

@@ -5,16 +5,17 @@ sample against the reference, and write a picture."""
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _core, presets, reference
+from . import _core, _validate, presets, reference
 from .albedo import albedo
 from ._batch import cpu_info, eval as _eval, sample as _sample
 from .benchmark import best_seconds, random_pairs
 from .material import Material
-from .render import render_sphere, to_srgb8, write_png
+from .render import MAX_SAMPLE_WORK, render_sphere, to_srgb8, write_png
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -48,6 +49,8 @@ def run(pairs: int = 1 << 22, output: str = "principled_brdf_demo.png", repeats:
         resolution: int = PICTURE_RESOLUTION, report: Callable[[str], object] = print) -> dict[str, Any]:
     from . import __version__
 
+    resolution = _validate.resolution("resolution", resolution, MIN_PICTURE_RESOLUTION, MAX_PICTURE_RESOLUTION,
+                                      " pixels per sphere")
     info = cpu_info()
     report(f"principled-brdf {__version__}: {info['isa']} ({info['float_lanes']} float lanes), "
            f"{info['threads']} threads")
@@ -126,6 +129,15 @@ def picture_spheres(resolution: int = PICTURE_RESOLUTION) -> tuple[list[Float32A
 
 PICTURE_ENVIRONMENT = "studio"  # softboxes in a dark studio: metals read as the metal they are
 PICTURE_SAMPLES = 256  # map samples per pixel: no visible grain on a glossy metal under the softboxes
+#: The picture's spheres: the presets, each sweep metal without and with compensation, the glass row.
+PICTURE_SPHERES = len(PICTURE_PRESETS) + 2 * len(SWEEP_METALS) * len(SWEEP_ROUGHNESS) + len(GLASS_ROW)
+#: The most samples the picture takes in all (spheres x pixels x samples): a quarter of a render's
+#: MAX_SAMPLE_WORK, since a map's sample (a BSDF and a map direction) and the glass row's paths cost
+#: about four of the sky's; so the picture too ends within about half an hour on two cores.
+MAX_PICTURE_WORK = MAX_SAMPLE_WORK // 4
+#: The most pixels per sphere: PICTURE_SPHERES x resolution² x PICTURE_SAMPLES within MAX_PICTURE_WORK.
+MAX_PICTURE_RESOLUTION = math.isqrt(MAX_PICTURE_WORK // (PICTURE_SPHERES * PICTURE_SAMPLES))  # 682
+MIN_PICTURE_RESOLUTION = 8  # pixels per sphere
 
 
 def lit_sphere(material: Material, resolution: int = PICTURE_RESOLUTION, *, energy_compensation: bool = False,

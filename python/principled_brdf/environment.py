@@ -57,10 +57,17 @@ def directions_to_uv(directions: RealArrayLike) -> tuple[Float32Array, Float32Ar
     return np.stack([np.minimum(u, np.nextafter(np.float32(1.0), np.float32(0.0))), v], axis=-1), sin_theta
 
 
+def _path(value: object) -> str:
+    """A file's path (a str, bytes or ``os.PathLike``) as a str; TypeError naming ``path`` otherwise."""
+    if not isinstance(value, (str, bytes, os.PathLike)):
+        raise TypeError(f"path: expected a path to a .exr or .hdr file, got {type(value).__name__}")
+    return os.fsdecode(os.fspath(value))
+
+
 def read_map(path: str | os.PathLike[str]) -> Float32Array:
     """The linear RGB ``(H, W, 3)`` float32 pixels of a ``.exr`` (OpenEXR; channels ``RGB``
     or ``R``, ``G``, ``B``) or ``.hdr`` (Radiance RGBE, read by OpenCV) file."""
-    path = os.fspath(path)
+    path = _path(path)
     extension = os.path.splitext(path)[1].lower()
     if extension not in MAP_FORMATS:
         raise ValueError(f"environment: cannot read {extension or 'a file without an extension'!r} maps; "
@@ -101,7 +108,9 @@ class Environment:
     Calling it, ``environment(directions)``, gives the radiance ``(..., 3)`` float32 of
     camera-space unit directions ``(..., 3)`` (so it is also an ``L(direction)`` of
     :func:`principled_brdf.render.render_sphere`); :meth:`sample` draws directions in
-    proportion to luminance and :meth:`pdf` gives that density per steradian.
+    proportion to luminance and :meth:`pdf` gives that density per steradian. Their
+    arguments are checked as everywhere in the library (docs/bad-input.md): directions
+    finite and of unit length within 1e-3, uniforms in [0, 1], the shapes.
     """
 
     def __init__(self, image: RealArrayLike, name: str = "map") -> None:
@@ -125,7 +134,7 @@ class Environment:
     @classmethod
     def read(cls, path: str | os.PathLike[str]) -> Environment:
         """The map in a ``.exr`` or ``.hdr`` file (:func:`read_map`)."""
-        return cls(read_map(path), name=os.path.basename(os.fspath(path)))
+        return cls(read_map(path), name=os.path.basename(_path(path)))
 
     def turned(self, degrees: float) -> Environment:
         """The scene turned about the vertical axis by ``degrees`` (a whole number of the map's
@@ -141,7 +150,7 @@ class Environment:
         return f"Environment({self.name!r}, {self.image.shape[0]}x{self.image.shape[1]})"
 
     def __call__(self, directions: RealArrayLike) -> Float32Array:
-        uv, _ = directions_to_uv(directions)
+        uv, _ = directions_to_uv(_validate.directions("directions", directions))
         return self._radiance[self.distribution.cell(uv)]
 
     def pdf(self, directions: RealArrayLike) -> Float64Array:
@@ -150,13 +159,25 @@ class Environment:
 
     def lookup(self, directions: RealArrayLike) -> tuple[Float32Array, Float64Array]:
         """``(radiance (..., 3), pdf (...))`` of ``directions``: the call and :meth:`pdf` at once."""
+        return self._lookup_unchecked(_validate.directions("directions", directions))
+
+    def _lookup_unchecked(self, directions: FloatArray) -> tuple[Float32Array, Float64Array]:
+        """:meth:`lookup` of directions the caller made unit vectors (the renderers' own)."""
         uv, sin_theta = directions_to_uv(directions)
         pixel = self.distribution.cell(uv)  # the map's pixels are the distribution's cells
         return self._radiance[pixel], self._per_steradian(self._density[pixel], sin_theta)
 
     def sample(self, u: RealArrayLike) -> tuple[Float32Array, Float64Array, Float32Array]:
         """``(directions (..., 3), pdf per steradian (...), radiance (..., 3))`` for uniforms
-        ``u`` of shape ``(..., 2)`` in [0, 1)."""
+        ``u`` of shape ``(..., 2)`` in [0, 1]."""
+        uniforms = _validate.as_real_array("u", u)
+        if uniforms.ndim == 0 or uniforms.shape[-1] != 2:
+            raise ValueError(f"u: expected uniforms of shape (..., 2), got {uniforms.shape}")
+        _validate.require_in_domain("u", uniforms, 0.0, 1.0)
+        return self._sample_unchecked(uniforms)
+
+    def _sample_unchecked(self, u: FloatArray) -> tuple[Float32Array, Float64Array, Float32Array]:
+        """:meth:`sample` of uniforms ``(..., 2)`` the caller made (the renderers' own)."""
         uv, pixel = self.distribution.sample_cells(u)
         directions = uv_to_directions(uv)
         sin_theta = np.hypot(directions[..., 0], directions[..., 2])

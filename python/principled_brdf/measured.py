@@ -77,13 +77,23 @@ def wiwo_to_half_diff(wi: RealArrayLike,
     return theta_h, phi_h, theta_d, phi_d
 
 
+def _angles(name: str, value: object) -> Float64Array:
+    """Angles in radians: real numbers (not True/False, which are no angle), finite; TypeError or
+    ValueError naming the argument."""
+    angles = _validate.as_real_array(name, value)
+    given = np.asarray(value)  # (as_real_array read it: no error here)
+    if given.dtype == np.bool_:
+        raise TypeError(f"{name}: expected an angle in radians (a real number or an array of them), got "
+                        f"{'booleans' if given.ndim else type(value).__name__}")
+    _validate.require_finite(name, angles)
+    return angles
+
+
 def half_diff_to_wiwo(theta_h: RealArrayLike, phi_h: RealArrayLike, theta_d: RealArrayLike,
                       phi_d: RealArrayLike) -> tuple[Float64Array, Float64Array]:
     """(wi, wo) ``(..., 3)`` from Rusinkiewicz's angles, the inverse of :func:`wiwo_to_half_diff`."""
-    angles: list[Float64Array] = []
-    for name, value in (("theta_h", theta_h), ("phi_h", phi_h), ("theta_d", theta_d), ("phi_d", phi_d)):
-        angles.append(_validate.as_real_array(name, value))
-        _validate.require_finite(name, angles[-1])
+    angles = [_angles(name, value) for name, value in
+              (("theta_h", theta_h), ("phi_h", phi_h), ("theta_d", theta_d), ("phi_d", phi_d))]
     theta_h, phi_h, theta_d, phi_d = np.broadcast_arrays(*angles)
     diff = np.stack([np.sin(theta_d) * np.cos(phi_d), np.sin(theta_d) * np.sin(phi_d), np.cos(theta_d)], axis=-1)
     half = np.stack([np.sin(theta_h) * np.cos(phi_h), np.sin(theta_h) * np.sin(phi_h), np.cos(theta_h)], axis=-1)
@@ -128,10 +138,9 @@ def merl_pairs(phi_h: float = 0.0, *, step: int | tuple[int, int, int] = 1) -> t
     or along (θh, θd, φd) (three), in the same order as ``MerlBRDF.values(step=...)``:
     a coarse subset of the table, e.g. ``step=(1, 3, 12)`` keeps every θh cell (the
     specular peak's) and 1 in 36 of the others."""
-    phi = _validate.as_real_array("phi_h", phi_h)
+    phi = _angles("phi_h", phi_h)
     if phi.ndim != 0:
         raise ValueError(f"phi_h: expected one angle in radians, got shape {phi.shape}")
-    _validate.require_finite("phi_h", phi)
     # half_diff_to_wiwo's arithmetic on the grid's axes: the angles' sines and cosines are taken
     # once per axis and broadcast, which gives its bits at a fraction of its cost
     along_h, along_d, along_p = (np.arange(size, dtype=np.float64)[cells] + 0.5 for size, cells
@@ -267,6 +276,8 @@ def save_merl(path: str | os.PathLike[str],
     """Writes a MERL ``.binary`` file: ``brdf`` a :class:`MerlBRDF`, or any callable
     ``f(wi, wo) -> (..., 3)`` in 1/sr (e.g. ``lambda wi, wo: pb.reference.eval(m, wi, wo)``),
     evaluated at the cells' centres. NaN (missing) is written as -1."""
+    if isinstance(path, (bool, np.bool_)) or not isinstance(path, (str, bytes, os.PathLike, int)):
+        raise TypeError(f"path: expected a path or an open file descriptor (int), got {type(path).__name__}")
     if isinstance(brdf, MerlBRDF):
         table = brdf.table
     elif callable(brdf):

@@ -450,7 +450,7 @@ def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealAr
     resolution)``). ``light``: direction towards the light in camera space
     (x right, y up, z to the viewer), ``light_intensity`` its irradiance
     scale (0 turns it off; by default 3 with the sky or no environment, 0 with
-    a map). ``environment``: ``"sky"`` (default,
+    a map or a callable). ``environment``: ``"sky"`` (default,
     :func:`pb.render.sky_environment`), ``"studio"``, ``"outdoor"``, a
     ``.exr``/``.hdr`` map or an array, a callable ``L(w)`` (camera-space
     directions ``(..., 3)`` to RGB radiance), or None / False for the light

@@ -21,6 +21,7 @@ gets a radiance of about 1, the tone curves' mid-upper range.
 from __future__ import annotations
 
 import functools
+import math
 import typing
 
 import numpy as np
@@ -30,12 +31,15 @@ from . import _validate, environment
 if typing.TYPE_CHECKING:
     from collections.abc import Callable
 
-    from ._typing import Float64Array, FloatArray
+    from ._typing import Float64Array, FloatArray, RealArrayLike
 
-__all__ = ["BUILT_IN", "DEFAULT_HEIGHT", "SUPERSAMPLING", "SUN_DIRECTION", "SUN_RADIUS", "built_in", "studio", "outdoor",
-           "studio_radiance", "outdoor_radiance"]
+__all__ = ["BUILT_IN", "DEFAULT_HEIGHT", "MAX_HEIGHT", "SUPERSAMPLING", "SUN_DIRECTION", "SUN_RADIUS", "built_in",
+           "studio", "outdoor", "studio_radiance", "outdoor_radiance"]
 
 DEFAULT_HEIGHT = 512  # map rows (columns: twice as many); 0.35° a pixel
+#: The most rows a built-in map may have: height x 2 height pixels within ``environment.MAX_MAP_PIXELS``
+#: (2^26; the map is then 1.6 GB of float64 while it is made).
+MAX_HEIGHT = math.isqrt(environment.MAX_MAP_PIXELS // 2)  # 5792
 SUPERSAMPLING = 2  # directions averaged per pixel along each axis
 
 
@@ -71,8 +75,13 @@ def _softbox(d: FloatArray, centre: tuple[float, float, float], half_width: floa
     return np.where(ahead, inside * falloff, 0.0)
 
 
-def studio_radiance(d: FloatArray) -> Float64Array:
-    """The studio's RGB radiance ``(..., 3)`` of unit directions ``(..., 3)`` (module docstring)."""
+def studio_radiance(d: RealArrayLike) -> Float64Array:
+    """The studio's RGB radiance ``(..., 3)`` of unit directions ``(..., 3)`` (module docstring),
+    checked as everywhere in the library (finite, of unit length within 1e-3)."""
+    return _studio(_validate.directions("d", d))
+
+
+def _studio(d: FloatArray) -> Float64Array:
     y = d[..., 1]
     # the surround: a dark cyclorama, a little lighter towards the top
     surround = 0.012 + 0.01 * np.clip(y, 0.0, 1.0)
@@ -95,8 +104,13 @@ SUN_DIRECTION = (-0.55, 0.6, 0.45)  # towards the sun: up and to the left of the
 SUN_RADIUS = np.radians(1.5)
 
 
-def outdoor_radiance(d: FloatArray) -> Float64Array:
-    """The outdoor scene's RGB radiance ``(..., 3)`` of unit directions ``(..., 3)`` (module docstring)."""
+def outdoor_radiance(d: RealArrayLike) -> Float64Array:
+    """The outdoor scene's RGB radiance ``(..., 3)`` of unit directions ``(..., 3)`` (module docstring),
+    checked as everywhere in the library (finite, of unit length within 1e-3)."""
+    return _outdoor(_validate.directions("d", d))
+
+
+def _outdoor(d: FloatArray) -> Float64Array:
     y = d[..., 1]
     elevation = np.clip(y, 0.0, 1.0)
     zenith, horizon = np.array([0.05, 0.11, 0.32]), np.array([0.42, 0.48, 0.58])
@@ -147,17 +161,25 @@ def _cached(name: str, height: int) -> environment.Environment:
     return environment.Environment(_map(_RADIANCE[name], height), name=name)
 
 
+def _height(value: object) -> int:
+    """Map rows: an integer from 2 to :data:`MAX_HEIGHT`, checked before the map is made."""
+    return _validate.integer_in("height", value, 2, MAX_HEIGHT, f" rows (a map of height x 2 height pixels, at most "
+                                                               f"{environment.MAX_MAP_PIXELS})")
+
+
 def studio(height: int = DEFAULT_HEIGHT) -> environment.Environment:
-    """The studio (module docstring) as a ``(height, 2 height)`` map (made once per height)."""
-    return _cached("studio", _validate.integer_in("height", height, 2, 8192, " rows"))
+    """The studio (module docstring) as a ``(height, 2 height)`` map (made once per height;
+    ``height`` from 2 to :data:`MAX_HEIGHT`)."""
+    return _cached("studio", _height(height))
 
 
 def outdoor(height: int = DEFAULT_HEIGHT) -> environment.Environment:
-    """The outdoor scene (module docstring) as a ``(height, 2 height)`` map (made once per height)."""
-    return _cached("outdoor", _validate.integer_in("height", height, 2, 8192, " rows"))
+    """The outdoor scene (module docstring) as a ``(height, 2 height)`` map (made once per height;
+    ``height`` from 2 to :data:`MAX_HEIGHT`)."""
+    return _cached("outdoor", _height(height))
 
 
-_RADIANCE = {"studio": studio_radiance, "outdoor": outdoor_radiance}
+_RADIANCE = {"studio": _studio, "outdoor": _outdoor}
 #: The built-in environments by name.
 BUILT_IN: dict[str, Callable[..., environment.Environment]] = {"studio": studio, "outdoor": outdoor}
 

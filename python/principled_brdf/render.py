@@ -33,7 +33,7 @@ from ._batch import random_uniforms as _random_uniforms
 from ._batch import sample as _sample
 from .environment import MAP_FORMATS as _MAP_FORMATS
 from .environment import Environment
-from .material import Material
+from .material import Material, _require_material
 from .procedural_environments import BUILT_IN as _BUILT_IN
 from .procedural_environments import built_in as _built_in
 
@@ -59,7 +59,9 @@ __all__ = ["render_sphere", "render_environment", "sky_environment", "environmen
            "TONE_CURVES", "REINHARD_WHITE", "FILMIC_WHITE"]
 
 DEFAULT_LIGHT = (-0.5, 0.6, 0.75)  # towards the light, camera space (x right, y up, z to the viewer)
-DEFAULT_LIGHT_INTENSITY = 3.0  # the key light's irradiance with the sky or no environment (a map brings its own lights)
+# the key light's irradiance by default with the sky or no environment; 0 with any other environment (a map
+# or a callable L(direction)), which brings its own lights
+DEFAULT_LIGHT_INTENSITY = 3.0
 #: The environments named by a string: the simple gradient and the built-in maps.
 ENVIRONMENT_NAMES = ("sky",) + tuple(_BUILT_IN)
 
@@ -176,11 +178,12 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     Lit by ``environment`` (:func:`environment`: ``"sky"``, the default, a simple
     gradient; ``"studio"`` or ``"outdoor"``; a ``.exr``/``.hdr`` file or an ``(H, W, 3)``
     latitude-longitude map; a callable ``L(direction)`` from camera-space directions
-    ``(..., 3)`` to RGB radiance; None) and by a directional key light (``light``:
-    direction towards it in camera space, x right, y up, z to the viewer;
-    ``light_intensity``: its irradiance, by default :data:`DEFAULT_LIGHT_INTENSITY`
-    with the sky, a callable or no environment and 0 with a map, which brings its own
-    lights). The environment's integral is :func:`render_environment`'s (``samples``
+    ``(..., 3)`` to RGB radiance, finite and >= 0; None or False: no environment) and
+    by a directional key light (``light``: direction towards it in camera space, x right,
+    y up, z to the viewer; ``light_intensity``: its irradiance, by default
+    :data:`DEFAULT_LIGHT_INTENSITY` with the sky or no environment and 0 with any other
+    environment, a map or a callable, which brings its own lights; given, it lights any
+    environment). The environment's integral is :func:`render_environment`'s (``samples``
     per pixel, by default :data:`DEFAULT_SAMPLES` for the sky or a callable and
     :data:`DEFAULT_MAP_SAMPLES` for a map, fewer where that would pass the limit; ``seed``; 1 to :data:`MAX_SAMPLES`, and
     pixels x samples at most :data:`MAX_SAMPLE_WORK`). ``ambient``: an optional constant ``ambient * base_color``
@@ -201,7 +204,7 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     lighting = environment_of(environment)
     is_map = isinstance(lighting, Environment)
     if light_intensity is None:
-        light_intensity = 0.0 if is_map else DEFAULT_LIGHT_INTENSITY
+        light_intensity = DEFAULT_LIGHT_INTENSITY if lighting is None or lighting is sky_environment else 0.0
     if samples is None:  # (for a map, no more than MAX_SAMPLE_WORK allows at this size)
         pixels = _pixels(material, _validate.resolution("resolution", resolution))
         samples = max(1, min(DEFAULT_MAP_SAMPLES, MAX_SAMPLE_WORK // pixels)) if is_map else DEFAULT_SAMPLES
@@ -255,12 +258,13 @@ def lattice_uniforms(count: int, shape: tuple[int, ...], seed: int = 0, first: i
     return _low_discrepancy.shifted_points(index, shift)
 
 
-def render_environment(material: Material, resolution: int = 256, environment: _EnvironmentArg = None,
+def render_environment(material: Material, resolution: int = 256, environment: _EnvironmentArg = "sky",
                        samples: int = DEFAULT_SAMPLES, seed: int = 0, model: Model = "disney2014", *,
                        energy_compensation: bool = False) -> Float64Array:
     """Linear RGB ``(resolution, resolution, 3)`` (or ``S + (resolution, resolution, 3)`` as
     :func:`render_sphere`): the sphere lit by ``environment`` alone (as :func:`environment_of`
-    reads it; default :func:`sky_environment`), per pixel ``∫ f L(wi) |cos θl| dωi``.
+    reads it: ``"sky"``, the default, :func:`sky_environment`; None or False, no
+    environment, gives a black picture), per pixel ``∫ f L(wi) |cos θl| dωi``.
 
     The estimate uses ``samples`` points of :func:`lattice_uniforms` per pixel, shifted per
     pixel from ``seed``: deterministic, and far less noisy than independent samples. For a
@@ -271,10 +275,13 @@ def render_environment(material: Material, resolution: int = 256, environment: _
     the BSDF samples alone. ``samples``: 1 to :data:`MAX_SAMPLES`, and pixels (every sphere
     of a batch) x samples at most :data:`MAX_SAMPLE_WORK`. ``energy_compensation`` as in
     ``pb.sample``."""
-    # (False, which environment_of maps to None, is not checked here: calling it fails as before)
-    lighting = typing.cast("_Environment", sky_environment if environment is None else environment_of(environment))
+    lighting = environment_of(environment)
     resolution = _validate.resolution("resolution", resolution)
     samples = _samples(samples, _pixels(material, resolution))
+    if lighting is None:  # no environment, no light: a black picture, of the checked arguments' shape
+        _validate.model_and_mode(_require_material("material", material), model, "radiance", energy_compensation)
+        shape = _validate.broadcast_leading(material=material.shape, resolution=(resolution, resolution))
+        return np.zeros(shape + (3,))
     inside, to_local = sphere_frames(resolution)
     wo = to_local((0.0, 0.0, 1.0))
     # to_local(e_k)[..., j] = frame_j[k]: the tangent, bitangent and normal (j = 0, 1, 2) in camera space
@@ -322,17 +329,15 @@ def render_environment(material: Material, resolution: int = 256, environment: _
                                                      start + entering[0], pixel, seed)
             np.add.at(total.reshape(-1, 3), element, paths)
         if not is_map:
-            radiance = np.asarray(lighting(direction))
-            if radiance.shape != direction.shape:
-                raise ValueError(f"environment: expected RGB radiance of shape {direction.shape}, got {radiance.shape}")
+            radiance = _sphere_paths.callable_radiance(lighting, direction)
             total += np.where(above, drawn.weight * radiance, 0.0).sum(axis=0, dtype=np.float64)
             continue
         environment_map = typing.cast(Environment, lighting)
-        radiance, light_pdf = environment_map.lookup(direction)
+        radiance, light_pdf = environment_map._lookup_unchecked(direction)
         weight = np.where(above, drawn.weight * _power_heuristic(drawn.pdf, light_pdf)[..., None], 0.0)
         total += (weight * radiance).sum(axis=0, dtype=np.float64)
         # the map's strategy: directions per pixel (shared by the spheres of a batch), from two of the point's axes
-        towards, light_pdf, radiance = environment_map.sample(points[..., 1:])
+        towards, light_pdf, radiance = environment_map._sample_unchecked(points[..., 1:])
         local = to_shading(towards).reshape((count,) + spheres + inside.shape + (3,))
         value, bsdf_pdf = _eval_pdf(material, local, wo, cosine=True, **options)
         value = np.where(local[..., 2:3] > 0.0, value, 0.0)

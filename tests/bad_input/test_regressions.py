@@ -882,7 +882,7 @@ def exit_status(capsys, args):
     (["bench", "--repeats", "1e8"], "--repeats", "positive integer"),
     (["demo", "--pairs", str(1 << 27), "--repeats", "17"], "--repeats", "at most 16 repeats"),
     (["demo", "--resolution", "4"], "--resolution", "at least 8 pixels"),
-    (["demo", "--resolution", "4096"], "--resolution", "at most 1024 pixels"),
+    (["demo", "--resolution", "4096"], "--resolution", "at most 682 pixels per sphere"),
 ])
 def test_cli_numeric_options_are_bounded(capsys, tmp_path, no_work, args, option, message):
     output = tmp_path / "x.png"
