@@ -4,5 +4,5 @@
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=_common.sh
 source "$(dirname "$0")/_common.sh"  # repo root, $python, the build lock
-"$python" -m pip install -q --disable-pip-version-check --no-build-isolation --no-deps ".[test,plot]"
+"$python" -m pip install -q --disable-pip-version-check --no-build-isolation --no-deps .
 "$python" -c "import principled_brdf" >/dev/null

