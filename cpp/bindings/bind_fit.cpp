@@ -30,15 +30,17 @@ void require_shape(const py::array& a, const std::vector<py::ssize_t>& shape, co
 }
 
 // (normal, gradient, cost) of problems[j] (NormalEquationsJob, batch.hpp):
-// (count, P (P + 1) / 2), (count, P) and (count,) float64 arrays.
+// (count, P (P + 1) / 2), (count, P) and (count,) float64 arrays; `slots`
+// (B, gradient_slots(model)) the problems' materials.
 py::tuple normal_equations(const Float32Array& wi, const Float32Array& wo, const Float32Array& slots,
                            const Float32Array& target, const Float32Array& scale, const Int64Array& problems,
                            const py::object& columns, int loss, bool cosine, int model, int threads, const std::string& isa,
                            const py::object& gain) {
     if (target.ndim() != 3 || target.shape(2) != 3) throw std::invalid_argument("target: expected a (B, N, 3) array");
     const py::ssize_t count = target.shape(0), pairs = target.shape(1);
+    const Model which_model = model_from(model);
     require_shape(scale, {count, pairs, 3}, "scale");
-    require_shape(slots, {count, kGradientSlots}, "slots");
+    require_shape(slots, {count, gradient_slots(which_model)}, "slots");
     const bool per_problem = wi.ndim() == 3;
     for (const Float32Array* w : {&wi, &wo}) {
         if (per_problem) {
@@ -70,8 +72,7 @@ py::tuple normal_equations(const Float32Array& wi, const Float32Array& wo, const
     job.scale = scale.data();
     job.gain = gain.is_none() ? nullptr : gains.data();
     job.problems = problems.data();
-    job.model = model_from(model);
-    if (is_bsdf(job.model)) throw std::invalid_argument("model: the fitting solver takes the 2012 and 2014 models");
+    job.model = which_model;
     job.loss = static_cast<Loss>(loss);
     job.cosine = cosine;
     job.columns = columns_from(columns, job.model);

@@ -6,14 +6,16 @@
 // the loss's derivative; JᵀJ's per-lane sums take a tile at a time, a few
 // entries held in registers over the tile's batches (the sums are the same
 // as batch by batch: each entry adds its batches in order). The lanes are
-// added up in float64, in lane order, when the problem is done.
+// added up in float64, in lane order, when the problem is done. The 2012 and
+// 2014 models take eval_gradient's columns (kGradientSlots of them), the 2015
+// models eval_gradient2015's (every slot of the table).
 #pragma once  // (per translation unit)
 
 // Batches whose columns are kept before JᵀJ's sums take them.
 constexpr int kNormalTile = 4;
 
 // A batch's wanted columns, by channel and column (eval_gradient's sink writes them).
-using BatchColumns = float[3][kGradientSlots][kLanes];
+using BatchColumns = float[3][kParamSlots][kLanes];
 
 struct NormalSink {
     const Columns& columns;
@@ -27,7 +29,7 @@ struct NormalSink {
 // One problem's per-lane sums.
 struct NormalSums {
     alignas(64) float normal[kNormalWidth][kLanes];
-    alignas(64) float gradient[kGradientSlots][kLanes];
+    alignas(64) float gradient[kParamSlots][kLanes];
     alignas(64) double cost[kLanes];
 
     explicit NormalSums(int width) {
@@ -47,32 +49,59 @@ PB_KERNEL_INLINE ChannelResidual channel_residual(Loss loss, Floats x, Floats ta
     return {(x - target) * scale, scale};
 }
 
+// A problem's material, prepared for its derivatives: the 2015 models' pass
+// by pass (model/bsdf2015_gradient.hpp), the others' with their partials.
+template <Model model>
+using NormalMaterial = std::conditional_t<is_bsdf(model), GradientShading2015<Floats>, Prepared<Output::kGradient>>;
+
+template <Model model>
+PB_KERNEL_INLINE NormalMaterial<model> prepare_normal(const NormalEquationsJob& job, const RawMaterial& m) {
+    if constexpr (is_bsdf(model)) {
+        return gradient_shading2015_of(m.slot, job.model == Model::kDisney2015Thin);
+    } else {
+        return prepare<Output::kGradient>(m);
+    }
+}
+
+// f of one batch, as eval_grad gives it (times cos θl with job.cosine, |cos θl|
+// for the 2015 models; the BRDFs 0 below the surface), its wanted columns to `sink`.
+template <Model model>
+PB_KERNEL_INLINE Rgb<Floats> normal_batch_gradient(const NormalEquationsJob& job, const NormalMaterial<model>& material,
+                                                   const Vec3<Floats>& wi, const Vec3<Floats>& wo, NormalSink& sink) {
+    if constexpr (is_bsdf(model)) {
+        return eval_gradient2015(wi, wo, material, TransportMode::kRadiance, job.cosine, sink);
+    } else {
+        const Shading<Floats>& s = material.shading;
+        Geometry<Floats> g = geometry_of(wi, wo);
+        Mask above = above_surface(g);
+        View<Floats> view = view_of<model>(wo, s);
+        // as eval_grad's: x cos θl or x times 1, then 0 below the surface
+        Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
+        auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
+        Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked, sink);
+        return {masked(f.r), masked(f.g), masked(f.b)};
+    }
+}
+
 // One batch of kLanes pairs of a problem: its cost and Jᵀr into the sums, its
 // scaled columns ∂r_c/∂p_k into `column` for JᵀJ (add_normal_tile). wi, wo,
 // target and scale point at the batch's first pair ((kLanes, 3) each), gain
 // is the problem's g.
 template <Model model>
-PB_KERNEL_INLINE void add_normal_batch(const NormalEquationsJob& job, const Prepared<Output::kGradient>& material,
+PB_KERNEL_INLINE void add_normal_batch(const NormalEquationsJob& job, const NormalMaterial<model>& material,
                                        const float* wi_data, const float* wo_data, const float* target_data,
                                        const float* scale_data, Floats gain, BatchColumns& column, NormalSums& sums) {
     Vec3<Floats> wi, wo;
     load_interleaved(wi_data, wi.x, wi.y, wi.z);
     load_interleaved(wo_data, wo.x, wo.y, wo.z);
-    const Shading<Floats>& s = material.shading;
-    Geometry<Floats> g = geometry_of(wi, wo);
-    Mask above = above_surface(g);
-    View<Floats> view = view_of<model>(wo, s);
-    // as eval_grad's: x cos θl or x times 1, then 0 below the surface
-    Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
-    auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
     NormalSink sink{job.columns, column};
-    Rgb<Floats> f = eval_gradient<model>(g, s, view, material.partials, masked, sink);
+    Rgb<Floats> f = normal_batch_gradient<model>(job, material, wi, wo, sink);
     Rgb<Floats> target, scale;
     load_interleaved(target_data, target.r, target.g, target.b);
     load_interleaved(scale_data, scale.r, scale.g, scale.b);
     ChannelResidual channel[3];
     for (int c = 0; c < 3; ++c) {
-        channel[c] = channel_residual(job.loss, gain * masked(channel_of(f, c)), channel_of(target, c), channel_of(scale, c));
+        channel[c] = channel_residual(job.loss, gain * channel_of(f, c), channel_of(target, c), channel_of(scale, c));
         channel[c].slope *= gain;  // ∂r/∂f = u'(g f) g s
     }
 
@@ -137,10 +166,11 @@ template <Model model>
 void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
     const std::int64_t b = job.problems[j];
     const std::int64_t n = job.pairs;
+    constexpr int stored = gradient_slots(model);  // a row of job.slots
     RawMaterial m;
-    for (int s = 0; s < kGradientSlots; ++s) m.slot[s] = Floats(job.slots[b * kGradientSlots + s]);
-    for (int s = kGradientSlots; s < kParamSlots; ++s) m.slot[s] = Floats(static_cast<float>(default_of(Param(s))));
-    Prepared<Output::kGradient> material = prepare<Output::kGradient>(m);
+    for (int s = 0; s < stored; ++s) m.slot[s] = Floats(job.slots[b * stored + s]);
+    for (int s = stored; s < kParamSlots; ++s) m.slot[s] = Floats(static_cast<float>(default_of(Param(s))));
+    NormalMaterial<model> material = prepare_normal<model>(job, m);
     Floats gain(job.gain != nullptr ? job.gain[b] : 1.0f);
     const std::int64_t directions = job.per_problem_directions ? 3 * n * b : 0;
     const float* wi = job.wi + directions;
@@ -191,6 +221,8 @@ inline void normal_equations_range(const NormalEquationsJob& job, std::int64_t b
     for (std::int64_t j = begin; j < end; ++j) {
         if (job.model == Model::kDisney2012) {
             normal_equations_of<Model::kDisney2012>(job, j);
+        } else if (is_bsdf(job.model)) {  // the solid and the thin sheet (prepare_normal tells them apart)
+            normal_equations_of<Model::kDisney2015>(job, j);
         } else {
             normal_equations_of<Model::kDisney2014>(job, j);
         }

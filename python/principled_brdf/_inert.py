@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._gradient import DIFFERENTIABLE, GRADIENT_NAMES
+from ._gradient import GRADIENT_NAMES_2015
 from .material import PARAMETERS
 
 _FIRST_ORDER_CHANGE = 1e-8  # of max |f|: below float32's resolution (6e-8)
@@ -34,7 +34,7 @@ if TYPE_CHECKING:
 
     from ._typing import Float64Array
 
-    # f and ∂f/∂slot at the slot values (13,) over one problem's samples: (n, 3), (n, 3, 13)
+    # f and ∂f/∂slot at the slot values (P,) over one problem's samples: (n, 3), (n, 3, P), P = 13 or 16
     Evaluate = Callable[[Float64Array], tuple[Float64Array, Float64Array]]
     Value = Callable[[Float64Array], Float64Array]
 
@@ -42,7 +42,7 @@ if TYPE_CHECKING:
 def _whole_parameters(slots: Sequence[int]) -> list[list[int]]:
     """The fitted slots grouped by parameter (base_color's three together)."""
     groups = []
-    for info in DIFFERENTIABLE.values():
+    for info in PARAMETERS.values():
         group = [k for k in range(info.first_slot, info.first_slot + info.slots) if k in slots]
         if group:
             groups.append(group)
@@ -51,7 +51,7 @@ def _whole_parameters(slots: Sequence[int]) -> list[list[int]]:
 
 def reset(values: Float64Array, start: Float64Array, slots: Sequence[int], evaluate: Evaluate,
           value: Value) -> list[str] | None:
-    """Sets back to ``start``, in ``values`` (13,) in place, the fitted parameters (``slots``)
+    """Sets back to ``start``, in ``values`` (P,) in place, the fitted parameters (``slots``)
     whose derivative is (next to) zero at every sample, when f (``value``) is then unchanged
     to 1e-6 of its largest value; returns the names of those that moved visibly (by more than
     1e-6), or None when nothing was set back."""
@@ -67,7 +67,7 @@ def reset(values: Float64Array, start: Float64Array, slots: Sequence[int], evalu
         moved[group] = start[group]
     if not np.max(np.abs(value(moved) - f), initial=0.0) <= _SAME_F * float(np.max(np.abs(f), initial=0.0)):
         return None
-    shown = [GRADIENT_NAMES[group[0]].removesuffix("_r") for group in inert
+    shown = [GRADIENT_NAMES_2015[group[0]].removesuffix("_r") for group in inert
              if np.max(np.abs(values[group] - start[group])) > _SHOWN_CHANGE]
     values[:] = moved
     return shown
@@ -75,8 +75,8 @@ def reset(values: Float64Array, start: Float64Array, slots: Sequence[int], evalu
 
 def candidates(value: NDArray[np.floating[Any]], jacobian: NDArray[np.floating[Any]], present: NDArray[np.bool_],
                values: Float64Array, start: Float64Array, slots: Sequence[int]) -> NDArray[np.bool_]:
-    """Which of B problems ``reset`` may change: f ``(B, n, 3)``, its Jacobian ``(B, n, 3, 13)``,
-    ``present`` ``(B, n)`` the samples to look at, ``values`` and ``start`` ``(B, 13)``. A superset
+    """Which of B problems ``reset`` may change: f ``(B, n, 3)``, its Jacobian ``(B, n, 3, P)``,
+    ``present`` ``(B, n)`` the samples to look at, ``values`` and ``start`` ``(B, P)``. A superset
     (twice reset's first-order bound), so that a problem left out is one reset would leave."""
     here = present[..., None]
     scale = np.max(np.where(here, np.abs(value), 0.0), axis=(1, 2), initial=0.0)

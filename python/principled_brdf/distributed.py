@@ -18,13 +18,15 @@ numbers and numpy blocks and pickle by reference to this module.
 from __future__ import annotations
 
 import importlib
+import re
 import typing
+
+from collections.abc import Mapping as _Mapping
 
 import numpy as np
 
-from . import _validate
+from . import _gradient, _validate
 from ._batch import eval as _eval
-from ._gradient import DIFFERENTIABLE as _DIFFERENTIABLE, GRADIENT_NAMES
 from .material import PARAMETERS, Material
 
 if typing.TYPE_CHECKING:
@@ -56,14 +58,51 @@ def _texture(name: str, value: object, leading: tuple[int, ...], chunks: tuple[t
     return array.rechunk(chunks + tuple((size,) for size in trailing))
 
 
+# An error message naming an element: "name[i, j, ...]: ..." (docs/bad-input.md)
+_ELEMENT = re.compile(r"^(\w+)\[(\d+(?:, \d+)*)\](.*)$", re.DOTALL)
+
+
+def _tile_start(block_info: dict[Any, Any] | None, axes: int) -> tuple[int, ...]:
+    """The index in the whole texture of a tile's first texel (map_blocks' block_info)."""
+    if block_info is None:  # (called outside map_blocks)
+        return (0,) * axes
+    return tuple(int(begin) for begin, _ in block_info[None]["array-location"][:axes])
+
+
+def _in_texture(error: Exception, tile_start: tuple[int, ...], tile_shape: tuple[int, ...],
+                per_texel: tuple[str, ...], flattened: bool) -> Exception:
+    """``error`` with the element of a tile's block it names (``name[i, j, ...]``, for a name
+    in ``per_texel``) named by its index in the whole texture: the tile's start plus the
+    texel's index in the tile (its first axes, or with ``flattened`` its first index, which
+    counts the tile's texels in order, as a fit's batch of problems); any other error as it is."""
+    match = _ELEMENT.match(str(error))
+    if match is None or match.group(1) not in per_texel:
+        return error
+    index = [int(i) for i in match.group(2).split(", ")]
+    if flattened:
+        index = [int(i) for i in np.unravel_index(index[0], tile_shape)] + index[1:]
+    texel = [begin + i for begin, i in zip(tile_start, index)] + index[len(tile_start):]
+    return type(error)(f"{match.group(1)}[{', '.join(str(i) for i in texel)}]{match.group(3)}")
+
+
 def _eval_tile(wi: np.ndarray, wo: np.ndarray, *blocks: np.ndarray, names: tuple[str, ...],
-               uniform: dict[str, Any], model: str, cosine: bool, threads: int | None, check: bool) -> np.ndarray:
-    """One tile: numpy blocks in, pb.eval out (module level, so that tasks pickle by reference)."""
+               uniform: dict[str, Any], model: str, cosine: bool, threads: int | None, check: bool,
+               block_info: dict[Any, Any] | None = None) -> np.ndarray:
+    """One tile: numpy blocks in, pb.eval out (module level, so that tasks pickle by reference);
+    an error names a bad texel by its index in the whole texture."""
     params = dict(uniform)
     for name, block in zip(names, blocks):
         params[name] = block if PARAMETERS[name].slots == 3 else block[..., 0]
-    return _eval(Material(**params), wi, wo, model=typing.cast("Model", model), cosine=cosine, threads=threads,
-                 check=check)
+    try:
+        return _eval(Material(**params), wi, wo, model=typing.cast("Model", model), cosine=cosine, threads=threads,
+                     check=check)
+    except (ValueError, TypeError) as error:
+        tile = wi.shape[:-1]
+        per_texel = names + ("wi",) + (("wo",) if wo.ndim > 1 else ())
+        renamed = _in_texture(error, _tile_start(block_info, len(tile)), tile, per_texel, flattened=False)
+        if renamed is error:
+            raise
+        raise renamed from error
 
 
 def eval(material: Material, wi: object, wo: object, *, textures: dict[str, object] | None = None,
@@ -85,6 +124,8 @@ def eval(material: Material, wi: object, wo: object, *, textures: dict[str, obje
     if not material.is_uniform:
         raise ValueError("material: expected uniform parameters; give per-texel ones in textures")
     _validate.model_index(model)
+    if textures is not None and not isinstance(textures, _Mapping):
+        raise TypeError(f"textures: expected a mapping {{name: array}}, got {type(textures).__name__}")
     wi_array = dask_array.asarray(wi)
     if wi_array.ndim < 2 or wi_array.shape[-1] != 3:
         raise ValueError(f"wi: expected a texture of directions (H, W, 3), got shape {wi_array.shape}")
@@ -120,7 +161,7 @@ def eval(material: Material, wi: object, wo: object, *, textures: dict[str, obje
 class TextureFit(typing.NamedTuple):
     """What :func:`fit` returns: lazy dask arrays over the texture's ``(H, W)``."""
 
-    slots: da.Array  # (H, W, 13) float64: the fitted values in the parameter slots (GRADIENT_NAMES' order)
+    slots: da.Array  # (H, W, P) float64: the fitted values in the model's derivative slots (pb.fit's slots)
     cost: da.Array  # (H, W) float64
     success: da.Array  # (H, W) bool
 
@@ -128,19 +169,29 @@ class TextureFit(typing.NamedTuple):
         """The fitted texture as a per-texel Material (computes the slots)."""
         slots = np.asarray(compute(self.slots, progress=False)[0])
         values = {name: slots[..., info.first_slot:info.first_slot + info.slots] if info.slots == 3
-                  else slots[..., info.first_slot] for name, info in _DIFFERENTIABLE.items()}
+                  else slots[..., info.first_slot] for name, info in PARAMETERS.items()
+                  if info.first_slot < slots.shape[-1]}
         return Material(**values, bright_base_color=True)
 
 
-def _fit_tile(measured: np.ndarray, wi: np.ndarray, wo: np.ndarray, *, options: dict[str, Any]) -> np.ndarray:
+def _fit_tile(measured: np.ndarray, wi: np.ndarray, wo: np.ndarray, *, options: dict[str, Any],
+              block_info: dict[Any, Any] | None = None) -> np.ndarray:
     """One tile of texels: pb.fit of its (B, N, 3) problems; the slots, the cost and success
-    packed as (th, tw, 15) float64 (module level, so that tasks pickle by reference)."""
+    packed as (th, tw, P + 2) float64 (module level, so that tasks pickle by reference); an
+    error names a bad texel by its index in the whole texture."""
     from .fit import fit as _fit
 
     tile = measured.shape[:-2]
     problems = measured.reshape((-1,) + measured.shape[-2:])
     directions = [w if w.ndim == 2 else w.reshape(problems.shape) for w in (wi, wo)]
-    result = _fit(directions[0], directions[1], problems, **options)
+    try:
+        result = _fit(directions[0], directions[1], problems, **options)
+    except (ValueError, TypeError) as error:
+        per_texel = ("measured",) + tuple(name for name, w in (("wi", wi), ("wo", wo)) if w.ndim > 2)
+        renamed = _in_texture(error, _tile_start(block_info, len(tile)), tile, per_texel, flattened=True)
+        if renamed is error:
+            raise
+        raise renamed from error
     packed = np.concatenate([np.atleast_2d(result.slots), np.atleast_1d(result.cost)[:, None],
                              np.atleast_1d(result.success)[:, None].astype(np.float64)], axis=1)
     return packed.reshape(tile + (packed.shape[-1],))
@@ -176,12 +227,13 @@ def fit(wi: object, wo: object, measured: object, **options: Any) -> TextureFit:
             pair_arguments.append(directions)
     if "weights" in options and options["weights"] is not None and np.shape(options["weights"]) != (n,):
         raise ValueError(f"weights: expected one weight per pair, shape ({n},), got {np.shape(options['weights'])}")
-    width = len(GRADIENT_NAMES) + 2
+    model = options.get("model", "disney2014")
+    _validate.model_index(model)
+    slots = len(_gradient.gradient_names(model))  # pb.fit's slots for the model
     packed = dask_array.map_blocks(_fit_tile, measured_array, *pair_arguments, options=options,
-                                   dtype=np.float64, chunks=tiles + ((width,),),
+                                   dtype=np.float64, chunks=tiles + ((slots + 2,),),
                                    drop_axis=[len(leading) + 1], meta=np.empty((0,) * len(leading) + (0,)))
-    return TextureFit(packed[..., :len(GRADIENT_NAMES)], packed[..., len(GRADIENT_NAMES)],
-                      packed[..., len(GRADIENT_NAMES) + 1] > 0.5)
+    return TextureFit(packed[..., :slots], packed[..., slots], packed[..., slots + 1] > 0.5)
 
 
 def compute(*arrays: Any, progress: bool = True) -> tuple[Any, ...]:

@@ -26,8 +26,9 @@ import numpy as np
 from . import _gradient, _inert, _solver, _validate
 from ._loss_scale import log_scale, log_scales
 from ._batch import eval, eval_grad
-from ._gradient import DIFFERENTIABLE as _DIFFERENTIABLE, GRADIENT_NAMES
-from .material import PARAMETERS, Material
+from ._gradient import GRADIENT_NAMES_2015
+from ._validate import BSDF_MODELS
+from .material import MAX_BSDF_SPECULAR, PARAMETERS, Material, unread_parameters
 from . import reference
 
 if TYPE_CHECKING:
@@ -38,8 +39,8 @@ if TYPE_CHECKING:
 
     from ._typing import Float64Array, Model, RealArrayLike
 
-    # fitted slots, costs, iterations, success, messages, residuals: per problem
-    # and per problem the parameters set back to their start (module _inert)
+    # fitted slots, costs, iterations, success, messages, residuals and the
+    # parameters set back to their start (module _inert): per problem
     _FitArrays = tuple[Float64Array, Float64Array, NDArray[np.int64], NDArray[np.bool_], list[str], Float64Array,
                        list[list[str]]]
 
@@ -47,9 +48,15 @@ __all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES", "METHODS"]
 
 # Default bounds for fitting: the domains, with the unbounded parameters held
 # to [0, 1] as the BRDF Explorer's sliders are (pass bounds= to widen them).
-FIT_BOUNDS = {name: (max(info.lower, 0.0), min(info.upper, 1.0)) for name, info in _DIFFERENTIABLE.items()}
+FIT_BOUNDS = {name: (max(info.lower, 0.0), info.upper if math.isfinite(info.upper) else 1.0)
+              for name, info in PARAMETERS.items()}
 LOSSES = ("scaled_log", "log", "relative", "linear")
 METHODS = ("batched", "scipy")
+# Without init=, the losses named here also fit from a second start and keep, per problem, the
+# result of the lower cost (docs/fitting.md#starts): from the default dielectric start the
+# relative loss settles on a dark dielectric of a rough conductor's data (Beckmann copper,
+# α 0.5: metallic 0, 91 % of the albedo missing) where a metal start reaches a lower cost.
+_SECOND_STARTS: dict[str, dict[str, Any]] = {"relative": {"metallic": 1.0}}
 # The batched solver stops when a taken step lowers the cost by less than this
 # fraction: the float32 kernels' cost is exact to about 1e-7 of itself.
 _FTOL = {"float32": 1e-7, "float64": 1e-10}
@@ -75,7 +82,7 @@ class FitResult:
 
     # (a single problem: cost, iterations and success are numpy scalars, message a str)
     material: Material  # the fitted material (per element along the batch axis for a batch)
-    slots: Float64Array  # (..., 13) its values in the parameter slots (GRADIENT_NAMES' order)
+    slots: Float64Array  # (..., P) its values in the model's derivative slots (eval_grad's names: 13, 16 for 2015)
     cost: np.float64 | Float64Array  # 0.5 * sum of squared (weighted) residuals, per problem
     residuals: Float64Array  # (..., N, 3) unweighted, at the fitted material; NaN where measured is NaN
     iterations: np.int64 | NDArray[np.int64]  # evaluations of the derivatives, per problem
@@ -86,6 +93,7 @@ class FitResult:
 
     def summary(self) -> str:
         rows = np.atleast_2d(self.slots)
+        width = rows.shape[1]
         lines = []
         for row, values in enumerate(rows):
             converged = bool(np.atleast_1d(self.success)[row])
@@ -94,7 +102,7 @@ class FitResult:
                          f"{int(np.atleast_1d(self.iterations)[row])} iterations, "
                          f"cost {float(np.atleast_1d(self.cost)[row]):.6g}")
             shown = []
-            for name, info in _DIFFERENTIABLE.items():
+            for name, info in _parameters_in(width).items():
                 v = values[info.first_slot:info.first_slot + info.slots]
                 shown.append(f"{name}=({', '.join(f'{c:.4g}' for c in v)})" if info.slots == 3 else f"{name}={v[0]:.4g}")
             lines.append("  " + ", ".join(shown))
@@ -123,53 +131,90 @@ def _bound_pair(name: str, pair: object) -> tuple[float, float]:
     return values[0], values[1]
 
 
+def _domain(name: str, model: Model) -> tuple[float, float]:
+    """A parameter's domain under ``model``: the 2015 models turn specular into an index of
+    refraction, which MAX_IOR bounds."""
+    info = PARAMETERS[name]
+    if name == "specular" and model in BSDF_MODELS:
+        return info.lower, MAX_BSDF_SPECULAR
+    return info.lower, info.upper
+
+
 def _slot_bounds(
-    bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None,
+    bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None, model: Model, width: int,
 ) -> tuple[Float64Array, Float64Array]:
+    """(lower, upper) of the ``width`` slots of ``model``'s derivatives."""
     merged = dict(FIT_BOUNDS)
     if bounds is not None and not isinstance(bounds, _Mapping):
         raise TypeError(f"bounds: expected a mapping {{name: (lower, upper)}}, got {type(bounds).__name__}")
     for name, pair in (bounds or {}).items():
-        if name not in _DIFFERENTIABLE:
+        if name not in FIT_BOUNDS:
             raise ValueError(f"bounds: unknown parameter {name!r}")
         low, high = _bound_pair(name, pair)
-        info = PARAMETERS[name]
-        if not (info.lower <= low <= high <= info.upper):
+        domain = _domain(name, model)
+        if not (domain[0] <= low <= high <= domain[1]):
             raise ValueError(f"bounds[{name!r}]: ({low}, {high}) is not an interval inside its domain "
-                             f"[{info.lower}, {info.upper}]")
+                             f"[{domain[0]}, {domain[1]}]" + (f" under model {model!r}" if name == "specular" else ""))
         merged[name] = (low, high)
-    lower = np.empty(len(GRADIENT_NAMES))
-    upper = np.empty(len(GRADIENT_NAMES))
-    for name, info in _DIFFERENTIABLE.items():
+    lower = np.empty(width)
+    upper = np.empty(width)
+    for name, info in _parameters_in(width).items():
         lower[info.first_slot:info.first_slot + info.slots] = merged[name][0]
         upper[info.first_slot:info.first_slot + info.slots] = merged[name][1]
     return lower, upper
 
 
-def _initial_slots(init: Material | dict[str, Any] | None) -> Float64Array:
+def _parameters_in(width: int) -> dict[str, Any]:
+    """The parameters held by the first ``width`` slots (13: the 2012 and 2014 models', 16: all)."""
+    return {name: info for name, info in PARAMETERS.items() if info.first_slot < width}
+
+
+def _fitted_slots(fit: object, model: Model, width: int) -> list[int]:
+    """The slots ``fit`` names (default: every parameter ``model`` reads), in the table's order."""
+    unread = unread_parameters(model)
+    owners = [name for name, info in _parameters_in(len(GRADIENT_NAMES_2015)).items() for _ in range(info.slots)]
+    if fit is None:
+        return [k for k in range(width) if owners[k] not in unread]
+    requested = _gradient.columns(fit, "fit", names=GRADIENT_NAMES_2015)
+    for k in requested:
+        if owners[k] in unread:
+            hint = " (fit flatness instead)" if owners[k] == "subsurface" else ""
+            raise ValueError(f"fit: model {model!r} does not read {owners[k]!r}{hint}")
+    return requested
+
+
+def _initial_slots(init: Material | dict[str, Any] | None, model: Model, width: int) -> Float64Array:
     if init is None:
         init = Material()
     if isinstance(init, dict):
         init = Material(**init)
     if not isinstance(init, Material) or not init.is_uniform:
         raise TypeError("init: expected a uniform principled_brdf.Material or a dict of its parameters")
-    init.require_read_by("disney2014")  # (the fitted models read the same parameters)
-    return np.asarray(init.packed(()), dtype=np.float64).reshape(-1)[:len(GRADIENT_NAMES)]
+    init.require_read_by(model)
+    return np.asarray(init.packed(()), dtype=np.float64).reshape(-1)[:width]
 
 
 def _material_of(slot_values: Float64Array) -> Material:
-    """A material from slot values ``(..., 13)``, uniform when one row."""
+    """A material from slot values ``(..., P)`` (13 or 16 slots), uniform when one row."""
     values: dict[str, Any] = {}  # Material's keywords
-    for name, info in _DIFFERENTIABLE.items():
+    for name, info in _parameters_in(slot_values.shape[-1]).items():
         block = slot_values[..., info.first_slot:info.first_slot + info.slots]
         values[name] = block if info.slots == 3 else block[..., 0]
     return Material(**values)
 
 
+def _cosine_factors(wi: NDArray[Any], cosine: bool, model: Model) -> Float64Array:
+    """The losses' c per pair: cos θl clamped to 0 below the surface (where a BRDF is 0), |cos θl|
+    for the 2015 BSDFs (as eval's cosine=True), or 1 without ``cosine``."""
+    if not cosine:
+        return np.ones(wi.shape[:-1])
+    return np.abs(wi[..., 2]) if model in BSDF_MODELS else np.maximum(wi[..., 2], 0.0)
+
+
 def _residual_and_jacobian(value: Float64Array, jacobian: Float64Array, measured: Float64Array,
                            cos_theta: Float64Array, loss: str, scale: Float64Array,
                            level: float) -> tuple[Float64Array, Float64Array]:
-    """Residuals r (n, 3) and dr/dslot (n, 3, 13) for one problem; ``scale`` the relative
+    """Residuals r (n, 3) and dr/dslot (n, 3, P) for one problem; ``scale`` the relative
     loss's divisors (n, 3), ``level`` the log losses' s (1/sr)."""
     if loss in ("log", "scaled_log"):
         model = value * cos_theta[:, None] / level
@@ -255,19 +300,25 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     texels of a texture; ``wi``, ``wo`` may then be ``(B, N, 3)`` too). NaN
     marks a missing sample; values beyond float32's range are refused (no
     material reaches them). ``init``: the start (a uniform Material or a dict;
-    default ``Material()``), which also holds the parameters not in ``fit``
-    (names; default all, ``base_color`` as three channels, except that
-    ``anisotropic`` is held at its start when the pairs cannot determine it:
-    every half vector in one plane through the normal, as a MERL table's
-    pairs; the result's ``notes`` and ``summary()`` say so).
+    default ``Material()``, and for the ``"relative"`` loss a metal as well,
+    the lower cost kept per problem), which also holds the parameters not in
+    ``fit`` (names; default every parameter ``model`` reads, ``base_color``
+    as three channels, except that ``anisotropic`` is held at its start when
+    the pairs cannot determine it: every half vector in one plane through the
+    normal, as a MERL table's pairs; the result's ``notes`` and ``summary()``
+    say so). ``model``: any of eval's, the same for every method; the 2015
+    models fit ``spec_trans`` and ``flatness`` too (and ``diff_trans`` for
+    ``"disney2015_thin"``), and ``slots`` then holds 16 slots (eval_grad's
+    columns for the model).
     ``loss``: ``"scaled_log"`` (the default: ``log(1 + f c / s) - log(1 + m c / s)``,
-    c = cos θl if ``cosine`` else 1, s the median of the problem's m c but at
-    least a tenth of their mean: logarithmic over the specular peak's decades,
-    the same for a bright and a dim material), ``"log"`` (the same with
-    s = 1/sr),
+    c = cos θl (|cos θl| for the 2015 models) if ``cosine`` else 1, s the
+    median of the problem's m c but at least a tenth of their mean:
+    logarithmic over the specular peak's decades, the same for a bright and a
+    dim material), ``"log"`` (the same with s = 1/sr),
     ``"relative"`` (``(f - m) / max(m, 1e-3 max m, 1e-9)``, max m over the
     problem's samples: the floors keep zero measurements finite, and a black
-    problem, every m = 0, fits f towards 0) or ``"linear"`` (``(f - m) c``).
+    problem, every m = 0, fits f towards 0; it fits metals too dark:
+    docs/fitting.md#losses) or ``"linear"`` (``(f - m) c``).
     ``weights`` ``(N,)`` or ``(B, N)`` (0 to 1e30) scale each pair's squared
     residuals. ``bounds``: ``{name: (lower, upper)}`` over :data:`FIT_BOUNDS`
     (the domains, with the unbounded parameters held to [0, 1]); a parameter
@@ -339,60 +390,98 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
             raise ValueError(f"{_validate.element_name('weights', i, weights.shape)}: {float(weights.ravel()[i])!r} "
                              f"is not a weight (expected finite values from 0 to {_MAX_WEIGHT:g})")
         weights = np.broadcast_to(weights, (count, n))
-    requested = _gradient.columns(fit, "fit")
+    _validate.model_index(model)  # eval_grad takes the name
+    names = _gradient.gradient_names(model)
+    requested = _fitted_slots(fit, model, len(names))
     notes: list[str] = []
-    anisotropic = GRADIENT_NAMES.index("anisotropic")
+    anisotropic = names.index("anisotropic")
     if fit is None and not _determines_anisotropy(wi, wo):
         requested.remove(anisotropic)
         notes.append(_ANISOTROPY_HELD)
-    lower, upper = _slot_bounds(bounds)
-    start = _initial_slots(init)
-    start[requested] = np.clip(start[requested], lower[requested], upper[requested])
+    lower, upper = _slot_bounds(bounds, model, len(names))
+    starts = [_initial_slots(init, model, len(names))]
+    if init is None and loss in _SECOND_STARTS:
+        starts.append(_initial_slots(_SECOND_STARTS[loss], model, len(names)))
+    for start in starts:
+        start[requested] = np.clip(start[requested], lower[requested], upper[requested])
     slots = [k for k in requested if lower[k] < upper[k]]  # equal bounds hold a parameter (clipped to it above)
-    _validate.model_index(model)  # checked before any work; eval_grad takes the name
 
-    if method == "batched":
-        if wi.ndim != wo.ndim:  # one of them per problem: both
-            wi, wo = np.ascontiguousarray(wi_rows), np.ascontiguousarray(wo_rows)
+    def solve(start: Float64Array) -> _FitArrays:
+        if method == "scipy":
+            return _fit_scipy(wi_rows, wo_rows, problems, weights, start, lower, upper, slots, loss, cosine, model,
+                              precision, max_iterations)
+        if wi.ndim == wo.ndim:
+            pair_wi, pair_wo = wi, wo
+        else:  # one of them per problem: both
+            pair_wi, pair_wo = np.ascontiguousarray(wi_rows), np.ascontiguousarray(wo_rows)
         # a few million samples at a time: the solver's arrays stay small whatever the texture
         # (a problem's result does not depend on the problems solved with it)
-        parts = [_fit_batched(wi[rows] if wi.ndim == 3 else wi, wo[rows] if wo.ndim == 3 else wo, problems[rows],
-                              None if weights is None else weights[rows], start, lower, upper, slots, loss, cosine,
-                              model, precision, max_iterations, thread_count)
-                 for begin in range(0, max(count, 1), _batch_problems(n))
-                 for rows in [slice(begin, min(count, begin + _batch_problems(n)))]]
-        fitted, costs, iterations, success = (np.concatenate([part[k] for part in parts]) for k in range(4))
-        messages = [message for part in parts for message in part[4]]
-        residuals_out = np.concatenate([part[5] for part in parts])
-        reset_names = [names for part in parts for names in part[6]]
-    else:
-        fitted, costs, iterations, success, messages, residuals_out, reset_names = _fit_scipy(
-            wi_rows, wo_rows, problems, weights, start, lower, upper, slots, loss, cosine, model, precision,
-            max_iterations)
+        parts = []
+        for begin in range(0, max(count, 1), _batch_problems(n)):
+            rows = slice(begin, min(count, begin + _batch_problems(n)))
+            parts.append(_fit_batched(pair_wi[rows] if pair_wi.ndim == 3 else pair_wi,
+                                      pair_wo[rows] if pair_wo.ndim == 3 else pair_wo, problems[rows],
+                                      None if weights is None else weights[rows], start, lower, upper, slots, loss,
+                                      cosine, model, precision, max_iterations, thread_count))
+        return _joined(parts)
+
+    fitted, costs, iterations, success, messages, residuals_out, reset_names = _lowest_cost([solve(s) for s in starts])
     if (note := _inert.note(reset_names, count)) is not None:
         notes.append(note)
 
     take: Callable[[NDArray[Any]], Any] = (lambda a: a) if batched else (lambda a: a[0])
     return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
                      residuals=take(residuals_out), iterations=take(iterations), success=take(success),
-                     message=tuple(messages) if batched else messages[0], names=tuple(GRADIENT_NAMES[k] for k in slots),
+                     message=tuple(messages) if batched else messages[0], names=tuple(names[k] for k in slots),
                      notes=tuple(notes))
+
+
+def _joined(parts: list[_FitArrays]) -> _FitArrays:
+    """The results of consecutive parts of a batch as one."""
+    return (np.concatenate([part[0] for part in parts]), np.concatenate([part[1] for part in parts]),
+            np.concatenate([part[2] for part in parts]), np.concatenate([part[3] for part in parts]),
+            [message for part in parts for message in part[4]], np.concatenate([part[5] for part in parts]),
+            [reset for part in parts for reset in part[6]])
+
+
+def _lowest_cost(results: list[_FitArrays]) -> _FitArrays:
+    """Per problem, the result (of fits from several starts) of the lowest cost, the first of equal ones."""
+    best = results[0]
+    for other in results[1:]:
+        better = other[1] < best[1]
+        pick = [other if b else best for b in better]
+        best = (np.where(better[:, None], other[0], best[0]), np.where(better, other[1], best[1]),
+                np.where(better, other[2], best[2]), np.where(better, other[3], best[3]),
+                [chosen[4][row] for row, chosen in enumerate(pick)], np.where(better[:, None, None], other[5], best[5]),
+                [chosen[6][row] for row, chosen in enumerate(pick)])
+    return best
 
 
 def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[Any], weights: Float64Array | None,
                start: Float64Array, lower: Float64Array, upper: Float64Array, slots: list[int], loss: str,
                cosine: bool, model: Model, precision: str, max_iterations: int) -> _FitArrays:
-    """One problem after another by scipy's trust-region reflective least squares."""
+    """One problem after another by scipy's trust-region reflective least squares.
+
+    It solves for u = 1 + (x - lower) / span, in [1, 2], rather than x: scipy's trust region
+    starts at the radius of its (scaled) start, which for parameters that all start on their
+    lower bound 0 (clearcoat, sheen; scipy first moves them 1e-10 inside) is about 1e-10. No
+    float32 evaluation resolves a step that small, and it stopped there at once; u's first
+    radius is the size of the box."""
     try:
         from scipy.optimize import least_squares
     except ImportError as error:  # pragma: no cover - scipy is in the test and fit extras
         raise ImportError("pb.fit(method='scipy') needs scipy: pip install 'principled-brdf[fit]'") from error
     count = problems.shape[0]
-    fitted = np.empty((count, len(GRADIENT_NAMES)))
+    fitted = np.empty((count, len(start)))
     costs, iterations, success, messages = np.empty(count), np.empty(count, np.int64), np.empty(count, bool), []
     residuals_out = np.full(problems.shape, np.nan)
-    reset_names: list[list[str]] = []  # per problem, the parameters set back to their start
+    reset_names: list[list[str]] = [[] for _ in range(count)]  # per problem, the parameters set back to their start
     dtype = np.float32 if precision == "float32" else np.float64
+    low, span = lower[slots], upper[slots] - lower[slots]
+
+    def x_of(u: Float64Array) -> Float64Array:
+        return np.clip(low + (u - 1.0) * span, low, upper[slots])
+
     with _one_blas_thread():
         for row in range(count):
             target = problems[row]
@@ -404,7 +493,7 @@ def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[A
             wi_p = np.ascontiguousarray(wi_rows[row][present], dtype=dtype)
             wo_p = np.ascontiguousarray(wo_rows[row][present], dtype=dtype)
             m = target[present]
-            cos_theta = np.maximum(wi_rows[row][present][:, 2], 0.0) if cosine else np.ones(len(m))
+            cos_theta = _cosine_factors(wi_rows[row][present], cosine, model)
             scale = np.maximum(m, max(_RELATIVE_FLOOR_FRACTION * float(m.max()), _RELATIVE_FLOOR))
             level = log_scale(m, cos_theta) if loss == "scaled_log" else 1.0
             root_weight = np.sqrt(weights[row][present])[:, None] if weights is not None else np.ones((len(m), 1))
@@ -433,13 +522,13 @@ def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[A
                 messages.append(_NOTHING_FITTED)
                 residuals_out[row][present] = residual
                 continue
-            solution = least_squares(lambda x: (evaluate(x)[0] * root_weight).reshape(-1), start[slots],
-                                     jac=lambda x: (evaluate(x)[1] * root_weight[..., None]).reshape(-1, len(slots)),
-                                     bounds=(lower[slots], upper[slots]), method="trf", x_scale="jac",
-                                     max_nfev=max_iterations)
-            values[slots] = solution.x
+            solution = least_squares(
+                lambda u: (evaluate(x_of(u))[0] * root_weight).reshape(-1), 1.0 + (start[slots] - low) / span,
+                jac=lambda u: (evaluate(x_of(u))[1] * span * root_weight[..., None]).reshape(-1, len(slots)),
+                bounds=(1.0, 2.0), method="trf", x_scale="jac", max_nfev=max_iterations)
+            values[slots] = x_of(solution.x)
             moved = _inert.reset(values, start, slots, *_evaluators(wi_rows[row][present], wo_rows[row][present], model, precision))
-            reset_names.append(moved or [])
+            reset_names[row] = moved or []
             fitted[row] = values
             costs[row] = solution.cost if moved is None else \
                 0.5 * float(np.sum((evaluate(values[slots].copy())[0] * root_weight) ** 2))
@@ -458,8 +547,7 @@ def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], wei
     present: NDArray[np.bool_] = ~np.any(np.isnan(problems), axis=-1)  # (B, N)
     has_data = np.any(present, axis=1)
     m = np.where(present[..., None], problems, 0.0)
-    cos_theta = np.maximum(wi[..., 2], 0.0) if cosine else np.ones(wi.shape[:-1])
-    cos_theta = np.broadcast_to(cos_theta, (count, n))[..., None]
+    cos_theta = np.broadcast_to(_cosine_factors(wi, cosine, model), (count, n))[..., None]
     root_weight = (np.sqrt(weights) if weights is not None else np.ones((count, n)))[..., None]
     floor = np.maximum(_RELATIVE_FLOOR_FRACTION * m.max(axis=(1, 2)), _RELATIVE_FLOOR)[:, None, None]
     # the log losses' s per problem (1/sr for "log")
@@ -483,14 +571,14 @@ def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], wei
     # each problem's scale divided by its largest (the same minimum; float32 sums stay in range)
     top = scale.max(axis=(1, 2))
     scale = scale / np.where(top > 0.0, top, 1.0)[:, None, None]
-    full_start = np.broadcast_to(start, (count, len(GRADIENT_NAMES))).copy()
+    full_start = np.broadcast_to(start, (count, len(start))).copy()
     solved = np.flatnonzero(has_data).astype(np.int64)
     slot_index = np.asarray(slots, dtype=np.int64)
     fitted = full_start.copy()
     iterations = np.zeros(count, np.int64)
     success = np.zeros(count, bool)
     messages = [_NO_DATA] * count
-    reset_names: list[list[str]] = []
+    reset_names: list[list[str]] = [[] for _ in range(count)]
     if slots and len(solved):
         if precision == "float32":
             equations = _solver.float32_equations(
@@ -509,7 +597,9 @@ def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], wei
         success[solved] = solution.success
         for j, row in enumerate(solved):
             messages[row] = solution.message[j]
-        reset_names = _reset_inert(fitted, full_start, slots, solved, wi, wo, present, model, precision, threads)
+        for row, names in zip(solved, _reset_inert(fitted, full_start, slots, solved, wi, wo, present, model,
+                                                    precision, threads)):
+            reset_names[row] = names
     elif len(solved):
         success[solved] = True
         for row in solved:
@@ -526,7 +616,7 @@ def _reset_inert(fitted: Float64Array, start: Float64Array, slots: list[int], so
     problems at a time in one call, then the check of each problem that may have a
     parameter without effect (_inert.candidates), on its present samples."""
     n = present.shape[1]
-    chunk = max(1, (1 << 22) // max(1, n * 3 * len(GRADIENT_NAMES)))
+    chunk = max(1, (1 << 22) // max(1, n * 3 * fitted.shape[1]))
     names: list[list[str]] = []
     for begin in range(0, len(solved), chunk):
         rows = solved[begin:begin + chunk]
@@ -584,7 +674,8 @@ def _residuals_at(fitted: Float64Array, wi: NDArray[Any], wo: NDArray[Any], prob
 
 def _evaluators(wi: Float64Array, wo: Float64Array, model: Model, precision: str) -> tuple[
         Callable[[Float64Array], tuple[Float64Array, Float64Array]], Callable[[Float64Array], Float64Array]]:
-    """f and ∂f/∂slot (13 columns), and f alone, at slot values (13,) over the pairs, in the fit's precision."""
+    """f and ∂f/∂slot (a column per slot, 13 or 16), and f alone, at slot values over the pairs, in the
+    fit's precision."""
     if precision == "float32":
         def gradient(values: Float64Array) -> Any:
             return eval_grad(_material_of(values), wi, wo, model=model, check=False)

@@ -14,8 +14,9 @@ Two figures compare a fitted material with the BRDF that made the measurement:
   direction, where an off-specular peak moves by a few hundredths of a
   degree between distributions of one width.)
 
-The measurements: microfacet BRDFs of other models (``pb.synthetic``) and the
-library's own model with 5 % multiplicative noise. ``python
+The measurements: microfacet BRDFs of other models (``pb.synthetic``), Lambert +
+Blinn-Phong plastics (``blinn_phong_plastic``) and the library's own model with 5 %
+multiplicative noise. ``python
 tests/fitting/fit_quality.py`` prints the table of docs/fitting.md (every
 case × loss).
 """
@@ -32,6 +33,21 @@ VIEWS = np.radians([0.0, 30.0, 45.0, 60.0])
 NOISE = 0.05
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 OWN = pb.Material(base_color=(0.2, 0.5, 0.7), roughness=0.35, specular=0.6, sheen=0.3, clearcoat=0.5)
+
+
+def blinn_phong_plastic(diffuse, exponent, specular=0.04):
+    """A Lambertian body under a normalised Blinn-Phong lobe, f = ρd/π + ks (n + 8)/(8π) (n·h)^n:
+    a plastic of the games' shading models, with neither Fresnel factor nor shadowing (NaN below
+    the horizon like the others)."""
+    diffuse = np.asarray(diffuse, dtype=np.float64)
+
+    def f(wi, wo):
+        h = wi + wo
+        cos_h = np.maximum(h[..., 2], 0.0) / np.linalg.norm(h, axis=-1)
+        lobe = specular * (exponent + 8.0) / (8.0 * np.pi) * cos_h**exponent
+        value = diffuse / np.pi + lobe[..., None]
+        return np.where(((wi[..., 2] > 0) & (wo[..., 2] > 0))[..., None], value, np.nan)
+    return f
 
 
 def own_model(wi, wo):
@@ -55,6 +71,9 @@ LIMITS = {
     "aluminium, Beckmann α 0.06": (pb.synthetic.conductor("aluminium", 0.06), 0.0),
     "dusty dielectric, Beckmann α 0.05": (pb.synthetic.dusty_dielectric(0.05), 0.0),
     "gold, Beckmann α 0.6": (pb.synthetic.conductor("gold", 0.6), 0.0),
+    "copper, Beckmann α 0.5": (pb.synthetic.conductor("copper", 0.5), 0.0),
+    "red plastic, Lambert + Blinn-Phong n 50": (blinn_phong_plastic((0.5, 0.1, 0.05), 50.0), 0.0),
+    "grey plastic, Lambert + Blinn-Phong n 10": (blinn_phong_plastic((0.3, 0.3, 0.3), 10.0, 0.1), 0.0),
 }
 
 

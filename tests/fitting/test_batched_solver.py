@@ -24,7 +24,7 @@ def pairs(n, key="batched"):
     return random_direction_pairs(seeded_rng(key), n, min_cos=0.05)
 
 
-def numpy_normal_equations(rows, wi, wo, target, scale, columns, loss, cosine, gain=None):
+def numpy_normal_equations(rows, wi, wo, target, scale, columns, loss, cosine, gain=None, model="disney2014"):
     """JᵀJ (upper triangle by rows), Jᵀr and Σ r² of r = (u(g f) - t) s, u(x) = x or log(1 + x),
     from pb.reference.eval_grad (float64), transcribed here."""
     normal, gradient, cost = [], [], []
@@ -32,7 +32,7 @@ def numpy_normal_equations(rows, wi, wo, target, scale, columns, loss, cosine, g
         material = pb.Material(**{name: row[info.first_slot:info.first_slot + info.slots] if info.slots == 3
                                   else row[info.first_slot] for name, info in pb.PARAMETERS.items()
                                   if info.first_slot < len(row)})  # (the fitted models' parameters)
-        g = pb.reference.eval_grad(material, wi, wo, cosine=cosine)
+        g = pb.reference.eval_grad(material, wi, wo, cosine=cosine, model=model)
         gb = 1.0 if gain is None else gain[b]
         f, jacobian = gb * g.value, gb * g.jacobian[..., columns]
         if loss == "log":
@@ -79,6 +79,40 @@ def test_the_kernels_normal_equations_are_numpys(isa, loss, cosine):
         gradient_size = np.sqrt(diagonal * expected[2][:, None])
         assert np.all(np.abs(gradient - expected[1]) <= 1e-4 * gradient_size + 1e-12)
         np.testing.assert_allclose(cost, expected[2], rtol=1e-5)
+
+
+@pytest.mark.parametrize("isa", tuple(pb.cpu_info()["available"]))
+@pytest.mark.parametrize("model", ("disney2015", "disney2015_thin"))
+def test_the_kernels_normal_equations_of_the_2015_models_are_numpys(isa, model):
+    # every slot of the table (spec_trans, flatness, diff_trans too), the light on the whole sphere
+    rng = seeded_rng("normal-equations-2015", model)
+    n, count = 203, 2
+    wi, wo = pairs(n, "normal-equations-2015")
+    wi[::3, 2] *= -1.0  # a third of the light below the surface: the transmission
+    own = dict(TRUTH, subsurface=0.0, spec_trans=0.4, flatness=0.3, diff_trans=0.6 if model.endswith("thin") else 0.0)
+    rows = np.array([pb.Material(**own).packed(()).reshape(-1)] * count)
+    rows[1, GRADIENT_NAMES.index("roughness")] = 0.7
+    rows = rows.astype(np.float32).astype(np.float64)
+    target = rng.uniform(0.0, 0.5, (count, n, 3)).astype(np.float32).astype(np.float64)
+    scale = rng.uniform(0.5, 1.0, (count, n, 3)).astype(np.float32).astype(np.float64)
+    gain = np.float32([0.5, 2.0]).astype(np.float64)
+    wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
+    model_code = pb._validate.model_index(model)
+    for columns in (list(range(16)), [0, 7, 13, 14, 15]):
+        for loss in ("linear", "log"):
+            normal, gradient, cost = _core.normal_equations(
+                wi=wi32, wo=wo32, slots=rows.astype(np.float32), target=target.astype(np.float32),
+                scale=scale.astype(np.float32), problems=np.array([1, 0], np.int64), columns=columns,
+                loss=LOSS_CODES[loss], cosine=True, model=model_code, isa=isa, gain=gain.astype(np.float32))
+            order = [1, 0]
+            expected = numpy_normal_equations(rows[order], wi32.astype(np.float64), wo32.astype(np.float64),
+                                              target[order], scale[order], columns, loss, True, gain[order], model)
+            diagonal = np.stack([expected[0][:, k * len(columns) - k * (k - 1) // 2] for k in range(len(columns))], 1)
+            size = np.sqrt(np.einsum("bk,bl->bkl", diagonal, diagonal))[:, *np.triu_indices(len(columns))]
+            assert np.all(np.abs(normal - expected[0]) <= 1e-4 * size + 1e-12), (columns, loss)
+            gradient_size = np.sqrt(diagonal * expected[2][:, None])
+            assert np.all(np.abs(gradient - expected[1]) <= 1e-4 * gradient_size + 1e-12), (columns, loss)
+            np.testing.assert_allclose(cost, expected[2], rtol=1e-5)
 
 
 def test_the_float64_paths_normal_equations_are_numpys():

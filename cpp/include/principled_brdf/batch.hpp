@@ -170,7 +170,7 @@ struct EvalJob {
 // fitting solver: problem b's residuals over its pairs n and channels c are
 //     r = (u(g f) - t) s,  u(x) = x (Loss::kLinear) or log(1 + x) (Loss::kLog),
 // with f = f_c(wi_n, wo_n) of the problem's material (times cos θl with
-// `cosine`), g = gain[b] (1 without gains), t = target[b, n, c] and
+// `cosine`, |cos θl| for the 2015 models), g = gain[b] (1 without gains), t = target[b, n, c] and
 // s = scale[b, n, c] (the caller folds the loss, its per-problem level, the
 // weights and missing samples, s = 0, into g, t and s). Per problem,
 // over the wanted columns k <= l (P = columns.count of them):
@@ -180,14 +180,14 @@ struct EvalJob {
 // not depend on the other problems of the call nor on the thread count.
 enum class Loss : int { kLinear = 0, kLog = 1 };
 
-inline constexpr int kNormalWidth = kGradientSlots * (kGradientSlots + 1) / 2;
+inline constexpr int kNormalWidth = kParamSlots * (kParamSlots + 1) / 2;  // the most entries (the 2015 models')
 
 struct NormalEquationsJob {
     const float* wi = nullptr;  // (N, 3) shared by every problem, or (B, N, 3) with per_problem_directions
     const float* wo = nullptr;
     bool per_problem_directions = false;
     std::int64_t pairs = 0;               // N
-    const float* slots = nullptr;         // (B, kGradientSlots): each problem's material (a 2012 or 2014 model's)
+    const float* slots = nullptr;         // (B, gradient_slots(model)): each problem's material
     const float* target = nullptr;        // (B, N, 3)
     const float* scale = nullptr;         // (B, N, 3)
     const float* gain = nullptr;          // (B,), or null for 1
