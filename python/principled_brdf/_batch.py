@@ -32,6 +32,7 @@ from ._validate import (
     integer,
     model_and_mode,
     model_index,
+    require_finite,
     require_float32,
     require_in_domain,
     sampler_index,
@@ -86,9 +87,11 @@ class Sample(NamedTuple):
     """What :func:`sample` and ``pb.reference.sample`` return."""
 
     wi: FloatArray  # (..., 3) drawn direction towards the light
-    pdf: FloatArray  # (...) mixture density in solid angle; 0 at or below the horizon
-    weight: FloatArray  # (..., 3) f(wi, wo) cos θl / pdf; 0 where pdf is 0
-    lobe: NDArray[np.int32]  # (...) int32, an index into SAMPLED_LOBE_NAMES: 0 cosine, 1 primary specular, 2 clearcoat
+    pdf: FloatArray  # (...) mixture density in solid angle; 0 where the draw is no sample (docs/sampling.md)
+    weight: FloatArray  # (..., 3) f(wi, wo) |cos θl| / pdf; 0 where pdf is 0
+    # (...) int32, an index into SAMPLED_LOBE_NAMES: 0 cosine, 1 primary specular, 2 clearcoat,
+    # 3 transmission, 4 diffuse_transmission (the last two: the 2015 models)
+    lobe: NDArray[np.int32]
 
 
 _LAYOUTS = ("aos", "soa")
@@ -605,14 +608,12 @@ def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent
     if not isinstance(precision, str) or precision not in ("float32", "float64"):
         raise ValueError(f"precision: expected 'float32' or 'float64', got {precision!r}")
     soa = _layout(layout) == "soa"
-    g = np.asarray(as_real_array("cotangent", cotangent))
-    if g.dtype != np.float32:
-        g = g.astype(np.float64)
+    # a float32 cotangent is read as it is, anything else as float64
+    given_float32 = isinstance(cotangent, np.ndarray) and cotangent.dtype == np.float32
+    g = np.asarray(cotangent) if given_float32 else as_real_array("cotangent", cotangent)
     if g.ndim == 0 or g.shape[0 if soa else -1] != 3:
         raise ValueError(f"cotangent: expected shape {'(3, ...)' if soa else '(..., 3)'} like f, got {g.shape}")
-    if not np.isfinite(g).all():
-        i = int(np.flatnonzero(~np.isfinite(g))[0])
-        raise ValueError(f"{element_name('cotangent', i, g.shape)}: {float(g.ravel()[i])!r} is not finite")
+    require_finite("cotangent", g)  # the rule of every backward pass (docs/bad-input.md)
     if precision == "float64":
         from . import reference  # (imports this module)
 
@@ -656,10 +657,15 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
         specular_sampler: SpecularSampler = "visible", layout: Layout = "aos", threads: SupportsIndex | None = None,
         check: bool = True, isa: str | None = None, energy_compensation: bool = False) -> Float32Array:
     """The density (solid angle) with which :func:`sample` draws ``wi`` given ``wo``:
-    the lobe mixture of docs/sampling.md, float32 ``(...)``; 0 when
-    either direction is at or below the horizon. It does not depend on the model
-    (``model`` is checked and accepted, as every call takes it) unless
-    ``energy_compensation``, whose lobe's mixture weight reads the model's tables."""
+    the lobe mixture of docs/sampling.md for ``model``, float32 ``(...)``.
+
+    The 2012 and 2014 models share one density, 0 when either direction is at
+    or below the horizon, unless ``energy_compensation``, whose lobe's mixture
+    weight reads the model's tables. The 2015 models (``"disney2015"``,
+    ``"disney2015_thin"``) each have their own, over the whole sphere: the
+    reflecting lobes where ``wi`` lies on the viewer's side, the transmission
+    where it lies on the other (docs/sampling.md, "The 2015 solid" and
+    "The 2015 thin sheet")."""
     model_id = model_and_mode(material, model, energy_compensation=energy_compensation)[0]
     by_model = energy_compensation or model in BSDF_MODELS  # else the pdf is the 2014 model's
     (density,) = _evaluate(material, wi, wo, model_id if by_model else 0, False, layout, threads, check, isa,
@@ -753,10 +759,15 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     ``f_k(wi, wo) cos θl / pdf``, from the same pass (they sum to ``weight``).
     ``energy_compensation=True``: f includes the multiple-scattering lobe, drawn
     by the cosine lobe (its weight joins that lobe's chance, ``lobe`` 0).
-    ``model="disney2015"``: ``wi`` anywhere on the sphere, ``lobe`` 3 for the
-    transmission (4: the thin sheet's diffuse transmission); weight ``f |cos θl| / pdf`` with ``f`` in ``mode``; a
-    transmission draw the microfacet reflects totally is no sample (``wi`` 0,
-    pdf and weight 0).
+    ``model="disney2015"`` or ``"disney2015_thin"``: ``wi`` anywhere on the
+    sphere, ``lobe`` 3 for the transmission (4: the thin sheet's diffuse
+    transmission); weight ``f |cos θl| / pdf`` with ``f`` in ``mode``. At the
+    solid's interface a draw splits at its microfacet: under total internal
+    reflection there it reflects (``lobe`` 1). A refraction at a microfacet
+    facing away from ``wo``, which only ``specular_sampler="distribution"``
+    draws, is no sample (``wi`` 0, pdf and weight 0); a draw that lands on the
+    wrong side of the surface for its lobe keeps its ``wi`` with pdf and
+    weight 0 (docs/sampling.md).
     """
     model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
     sampler = sampler_index(specular_sampler)

@@ -311,7 +311,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     ``"disney2015_thin"``), and ``slots`` then holds 16 slots (eval_grad's
     columns for the model).
     ``loss``: ``"scaled_log"`` (the default: ``log(1 + f c / s) - log(1 + m c / s)``,
-    c = cos θl (|cos θl| for the 2015 models) if ``cosine`` else 1, s the
+    c = cos θl (``|cos θl|`` for the 2015 models) if ``cosine`` else 1, s the
     median of the problem's m c but at least a tenth of their mean:
     logarithmic over the specular peak's decades, the same for a bright and a
     dim material), ``"log"`` (the same with s = 1/sr),

@@ -209,9 +209,10 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
         energy_compensation: bool = False) -> Float64Array:
     """The mixture density ``P0 pdf0 + P1 pdf1 + P2 pdf2`` of ``wi`` given ``wo``, float64 ``(...)``.
 
-    0 unless both directions lie strictly above the horizon. It does not depend on
-    ``model`` (accepted for symmetry with :func:`sample`; only the weights do)
-    unless ``energy_compensation``, whose lobe's weight reads the model's tables.
+    For the 2012 and 2014 models: 0 unless both directions lie strictly above the
+    horizon, and the same for both models unless ``energy_compensation``, whose
+    lobe's weight reads the model's tables. The 2015 models each have their own
+    mixture over the whole sphere, with the transmission's terms (docs/sampling.md).
     """
     _require_material("material", material)
     model_id = _validate.model_and_mode(material, model, energy_compensation=energy_compensation)[0]

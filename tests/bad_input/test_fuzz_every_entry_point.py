@@ -37,7 +37,8 @@ ARGUMENT_NAMES = ("wi", "wo", "u", "out", "material", "model", "mode", "layout",
                   "out[0]", "out[1]", "measured", "weights", "bounds", "fit", "init", "loss", "max_iterations",
                   "precision", "normal", "tangent", "frame", "theta", "phi", "theta_h", "phi_h", "theta_d", "phi_d",
                   "color", "linear", "exposure", "curve", "table", "brdf", "interpolation", "theta_o", "phi_d",
-                  "angles", "channel", "lobes", *pb.PARAMETERS)
+                  "angles", "channel", "lobes", "environment", "directions", "d", "path", "height",
+                  *pb.PARAMETERS)
 
 
 def assert_names_an_argument(error: Exception) -> None:
@@ -687,3 +688,130 @@ def test_fuzz_plot_arguments(data, entry):
         outcome(call)
     finally:
         plt.close("all")
+
+
+ENVIRONMENT_MAP = pb.environment.Environment(np.random.default_rng(11).uniform(0.0, 3.0, size=(8, 16, 3)))
+UNIFORM_FAULTS = {"good": lambda u: u, "nan": lambda u: np.where(u > 0.9, np.nan, u), "above": lambda u: u + 0.5,
+                  "below": lambda u: u - 0.5, "ends": lambda u: np.round(u), "one_column": lambda u: u[..., :1],
+                  "scalar": lambda u: 0.5, "str": lambda u: u.astype(str)}
+RADIANCE_FAULTS = {"good": lambda r: r, "nan": lambda r: np.where(r > 0.5, np.nan, r), "negative": lambda r: r - 0.5,
+                   "inf": lambda r: np.where(r > 0.5, np.inf, r), "flat": lambda r: r[..., 0], "wide": lambda r: np.repeat(r, 2, axis=-1),
+                   "int": lambda r: (r > 0.5).astype(np.int64), "str": lambda r: r.astype(str)}
+
+
+@FUZZ
+@given(data=st.data(), seed=st.integers(0, 2**32 - 1),
+       entry=st.sampled_from(("sample", "pdf", "call", "lookup", "studio_radiance", "outdoor_radiance", "callable",
+                              "map_height")))
+def test_fuzz_environments(data, seed, entry):
+    """Environment maps, the built-in radiance functions and callable environments: hostile uniforms,
+    directions, radiance and sizes are refused naming the argument; what is accepted is finite."""
+    rng = rng_from(seed)
+    leading = data.draw(LEADING)
+    if entry == "sample":
+        uniforms = UNIFORM_FAULTS[data.draw(st.sampled_from(list(UNIFORM_FAULTS)))](rng.random(tuple(leading) + (2,)))
+        result = outcome(lambda: ENVIRONMENT_MAP.sample(uniforms))
+    elif entry in ("pdf", "call", "lookup"):
+        directions = data.draw(direction_argument(leading, rng))
+        method = {"pdf": ENVIRONMENT_MAP.pdf, "call": ENVIRONMENT_MAP, "lookup": ENVIRONMENT_MAP.lookup}[entry]
+        result = outcome(lambda: method(directions))
+    elif entry in ("studio_radiance", "outdoor_radiance"):
+        directions = data.draw(direction_argument(leading, rng))
+        result = outcome(lambda: getattr(pb.procedural_environments, entry)(directions))
+    elif entry == "callable":
+        fault = RADIANCE_FAULTS[data.draw(st.sampled_from(list(RADIANCE_FAULTS)))]
+        model = data.draw(st.sampled_from(("disney2014", "disney2015")))
+        material = pb.Material(spec_trans=1.0) if model == "disney2015" else pb.Material()
+
+        def environment(direction):
+            return fault(np.random.default_rng(7).random(np.shape(direction)))
+
+        result = outcome(lambda: pb.render.render_sphere(material, 4, model=model, environment=environment, samples=2))
+    else:
+        height = data.draw(st.sampled_from((1, 2.5, True, "8", pb.procedural_environments.MAX_HEIGHT + 1, 10**9)))
+        result = outcome(lambda: pb.procedural_environments.studio(height))
+        assert result is None, f"studio({height!r}) was accepted"
+    if result is not None:
+        for array in result if isinstance(result, tuple) else [result]:
+            assert np.isfinite(np.asarray(array, dtype=np.float64)).all(), f"{entry}: non-finite result"
+
+
+# ------------------------------------------------------------------ the PyTorch and JAX operations
+
+INTEROP_FUZZ = settings(derandomize=True, max_examples=60, deadline=None, database=None,
+                        suppress_health_check=list(HealthCheck))
+INTEROP_OPTIONS = {"model": ("disney2014", "disney2012", "disney2015", "bogus"), "cosine": (False, True, 1),
+                   "mode": ("radiance", "importance", "light")}
+
+
+def framework_value(framework, value, kind):
+    """``value`` as given, or a float numpy array made the framework's tensor/array (any float dtype)."""
+    if kind == "as_given" or not isinstance(value, np.ndarray) or value.dtype.kind != "f":
+        return value
+    if framework == "torch":
+        import torch
+
+        return torch.tensor(np.array(value), dtype=getattr(torch, value.dtype.name))
+    import jax.numpy as jnp
+
+    return jnp.asarray(value)
+
+
+@INTEROP_FUZZ
+@given(data=st.data(), leading=LEADING, seed=st.integers(0, 2**32 - 1), framework=st.sampled_from(("torch", "jax")),
+       cotangent_fault=st.sampled_from(("none", "none", "nan", "inf")))
+def test_fuzz_torch_and_jax_eval(data, leading, seed, framework, cotangent_fault):
+    """pbt.eval and pbj.eval with hostile materials, directions, dtypes and options, and their
+    backward passes with hostile cotangents: a ValueError/TypeError naming an argument, or
+    finite values that agree with the float64 reference and finite gradients."""
+    module = pytest.importorskip(f"principled_brdf.{framework}")
+    rng = rng_from(seed)
+    kinds = ("as_given", "as_given", "framework")
+    material = {name: framework_value(framework, value, data.draw(st.sampled_from(kinds)))
+                for name, value in data.draw(material_argument(int(np.prod(leading)), rng)).items()}
+    wi = framework_value(framework, data.draw(direction_argument(leading, rng)), data.draw(st.sampled_from(kinds)))
+    wo = framework_value(framework, data.draw(direction_argument(leading, rng)), data.draw(st.sampled_from(kinds)))
+    opts = {name: data.draw(st.sampled_from(values)) for name, values in INTEROP_OPTIONS.items()
+            if data.draw(st.booleans())}
+    result = outcome(lambda: module.eval(material, wi, wo, **opts))
+    if result is None:
+        return
+    value = np.asarray(result, np.float64)
+    assert np.isfinite(value).all(), "non-finite output for accepted input"
+    as_numpy = lambda v: np.asarray(v, np.float64) if hasattr(v, "dtype") and v.dtype.kind != "f" else np.asarray(v)  # noqa: E731
+    a, b = (np.asarray(np.asarray(w), np.float32) for w in (wi, wo))
+    checked = pb.Material(**{name: as_numpy(v) for name, v in material.items()}, bright_base_color=True)
+    expected = pb.reference.eval(checked, a, b, model=opts.get("model", "disney2014"), cosine=bool(opts.get("cosine")),
+                                 mode=opts.get("mode", "radiance"))
+    assert_matches_reference(value, expected, *np.broadcast_arrays(a, b))
+    cotangent = inject(np.ones(value.shape), cotangent_fault, rng)
+    gradients = outcome(lambda: framework_gradients(framework, module, material, wi, wo, opts, cotangent))
+    if cotangent_fault != "none" and value.size:
+        assert gradients is None, "a non-finite cotangent was accepted"
+    for gradient in gradients or []:
+        assert np.isfinite(np.asarray(gradient, np.float64)).all(), "non-finite gradient for accepted input"
+
+
+def framework_gradients(framework, module, material, wi, wo, opts, cotangent):
+    """The vector-Jacobian product of ``module.eval`` in every float input, for ``cotangent``."""
+    if framework == "torch":
+        import torch
+
+        inputs = {name: v.detach().requires_grad_() if isinstance(v, torch.Tensor) else v
+                  for name, v in (*material.items(), ("wi", wi), ("wo", wo))}
+        f = module.eval({n: v for n, v in inputs.items() if n not in ("wi", "wo")}, inputs["wi"], inputs["wo"], **opts)
+        leaves = [v for v in inputs.values() if isinstance(v, torch.Tensor)]
+        if not leaves:
+            return []
+        return torch.autograd.grad(f, leaves, torch.tensor(cotangent, dtype=f.dtype), allow_unused=True)
+    import jax
+
+    names = [n for n, v in (*material.items(), ("wi", wi), ("wo", wo)) if isinstance(v, jax.Array)]
+    arguments = {**material, "wi": wi, "wo": wo}
+
+    def call(*differentiated):
+        given = {**arguments, **dict(zip(names, differentiated))}
+        return module.eval({n: v for n, v in given.items() if n not in ("wi", "wo")}, given["wi"], given["wo"], **opts)
+
+    value, vjp = jax.vjp(call, *[arguments[n] for n in names])
+    return jax.block_until_ready(vjp(jax.numpy.asarray(cotangent, value.dtype)))
