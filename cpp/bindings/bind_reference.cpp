@@ -53,7 +53,7 @@ void require_rows(const Float64Array& a, py::ssize_t n, py::ssize_t columns, con
 }
 
 // The sampling functions take each input as N rows or as a single row shared by
-// all N (a uniform material, one view direction): a packed (N, 13) copy of a
+// all N (a uniform material, one view direction): a packed (N, 16) copy of a
 // uniform material would cost more than the samples.
 struct Rows {
     const double* data;
@@ -100,7 +100,7 @@ void each_shading2015(Model model, Function&& f) {
     }
 }
 
-// f or the lobes for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
+// f (N,3) or the lobes (N,7,3) for N packed rows: wi (N,3), wo (N,3), params (N,16) or one shared row.
 py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
                                    int model, bool lobes, bool energy_compensation, int mode) {
     const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
@@ -169,7 +169,8 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
     return out;
 }
 
-// f (N,3) and its Jacobian (N,3,13) for N packed rows: wi (N,3), wo (N,3), params (N,13) or one shared row.
+// f (N,3) and its Jacobian (N,3,P), P = gradient_slots(model) (13, or 16 for the 2015 models), for N packed
+// rows: wi (N,3), wo (N,3), params (N,16) or one shared row.
 py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, const Float64Array& params, int model,
                               int mode) {
     const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
@@ -256,7 +257,7 @@ py::array_t<double> reference_eval_direction_grad(const Float64Array& wi, const 
     return jacobian;
 }
 
-// docs/sampling.md: wo (N,3), u (N,3) = (u0, u1, u2), params (N,13); each may be one shared row.
+// docs/sampling.md: wo (N,3), u (N,3) = (u0, u1, u2), params (N,16); each may be one shared row.
 py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const Float64Array& params, int model,
                            int sampler, bool energy_compensation, int mode) {
     const py::ssize_t n = common_row_count({&wo, &u, &params});
@@ -306,14 +307,15 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
     return py::make_tuple(wi_out, pdf_out, weight_out, lobe_out);
 }
 
-// The mixture pdf (N,) of wi (N,3) given wo (N,3); model is checked but does not change it.
+// The mixture pdf (N,) of wi (N,3) given wo (N,3): the 2012 and 2014 models share one (the
+// compensation's tables aside), each 2015 model has its own over the whole sphere.
 py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
                                   int model, int sampler, bool energy_compensation) {
     const py::ssize_t n = common_row_count({&wi, &wo, &params});
     const Rows in = shared_or_rows(wi, n, 3, "wi");
     const Rows view = shared_or_rows(wo, n, 3, "wo");
     const Rows material_rows = shared_or_rows(params, n, kParamSlots, "params");
-    const Model which_model = model_from(model);  // the pdf depends on it through the compensation's tables only
+    const Model which_model = model_from(model);  // for the BRDFs, only through the compensation's tables
     const SpecularSampler which_sampler = sampler_from(sampler);
 
     py::array_t<double> out(n);
@@ -339,7 +341,7 @@ py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo
     return out;
 }
 
-// (P0, P1, P2) (N,3) at wo (N,3).
+// (P0, P1, P2) (N,3) at wo (N,3); for the 2015 models (N,5), the lobes of kSampledLobeNames.
 py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const Float64Array& params, int model,
                                                  bool energy_compensation) {
     const py::ssize_t n = common_row_count({&wo, &params});

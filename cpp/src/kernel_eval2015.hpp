@@ -1,5 +1,6 @@
 // Part of kernel.hpp, included inside the per-arch namespace: the 2015
-// solid's evaluation loop (model/bsdf2015.hpp): f, its lobes, the sampling
+// models' evaluation loop, the solid's and the thin sheet's
+// (model/bsdf2015.hpp): f, its lobes, the sampling
 // pdf, f with the pdf, the Jacobian in the parameter slots and its product
 // with a cotangent (model/bsdf2015_gradient.hpp), over the whole sphere, in
 // any layout.

@@ -4,7 +4,7 @@
 // when uniform, per batch otherwise).
 #pragma once  // (per translation unit)
 
-// The 13 parameter slots of one batch of elements.
+// The kParamSlots (16) parameter slots of one batch of elements.
 struct RawMaterial {
     Floats slot[kParamSlots];
 };

@@ -3,7 +3,7 @@
 #pragma once  // (per translation unit)
 
 // Every array of a call in one layout lets the loop be compiled for it;
-// kMixedLayouts reads each array's layout at run time.
+// Layouts::kMixed reads each array's layout at run time.
 enum class Layouts { kInterleaved, kRows, kMixed };
 
 template <Layouts layouts = Layouts::kMixed>

@@ -46,7 +46,7 @@ struct ParamSlot {
 
 enum class Output : int {
     kTotal = 0,  // f
-    kLobes = 1,  // diffuse, sheen, specular, clearcoat, multiple_scattering
+    kLobes = 1,  // the kLobeCount lobes of kLobeNames (params.hpp), in its order
     kPdf = 2,    // the sampling pdf of (wi, wo)
     kGradient = 3,  // f and its Jacobian in the parameter slots
     kValuePdf = 4,  // f and the sampling pdf of (wi, wo), in one pass
@@ -126,7 +126,7 @@ struct EvalJob {
     TransportMode mode = TransportMode::kRadiance;  // the 2015 solid's transmission (params.hpp)
     // the multiple-scattering energy compensation (model/energy.hpp); not with Output::kGradient
     bool energy_compensation = false;
-    // out[0] is f; with Output::kLobes, out[0..5] are the lobes of kLobeNames.
+    // out[0] is f; with Output::kLobes, out[0 .. kLobeCount - 1] are the lobes of kLobeNames.
     MutableVec3Array out[kLobeCount];
     // Output::kGradient: out[0] is f, and element i's ∂f_c/∂p for the P =
     // columns.count wanted slots p is at jacobian[3 P i + P c + k] (an (N, 3, P)
@@ -201,7 +201,7 @@ struct NormalEquationsJob {
     double* cost = nullptr;      // (count,)
 };
 
-// sample(material, wo, u): wi, pdf, weight = f cos θl / pdf and lobe per element.
+// sample(material, wo, u): wi, pdf, weight = f |cos θl| / pdf and lobe per element.
 struct SampleJob {
     Vec3Array wo;
     Vec3Array u;  // three uniforms per element, or data == nullptr for the counter-based generator
@@ -214,9 +214,9 @@ struct SampleJob {
     TransportMode mode = TransportMode::kRadiance;  // as in EvalJob
     MutableVec3Array wi, weight;  // outputs, (N, 3) or (3, N)
     float* pdf = nullptr;         // output, N
-    std::int32_t* lobe = nullptr; // output, N: 0 cosine, 1 specular, 2 clearcoat
+    std::int32_t* lobe = nullptr; // output, N: an index into kSampledLobeNames (0 to 4; 3 and 4 the 2015 models')
     // optional outputs, (N, 3) or (3, N) each: every lobe's share of the weight
-    // (the lobe's value cos θl / pdf, in kLobeNames' order); unused when the first is null
+    // (the lobe's value |cos θl| / pdf, in kLobeNames' order); unused when the first is null
     MutableVec3Array lobe_weight[kLobeCount];
     DirectionCheck check;  // of wo, as in EvalJob
     bool per_element_material = false;  // as in EvalJob

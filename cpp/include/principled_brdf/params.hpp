@@ -74,8 +74,9 @@ constexpr double default_of(Param slot) {
     return 0.0;
 }
 
-// Which specular masking term the model uses (docs/model.md, "The model"); the names
-// are the Python ones, in the enum's order.
+// The models (docs/model.md, "The model"; docs/model-2015.md): the 2014 and 2012
+// BRDFs, which differ only in the specular masking term, and the 2015 BSDFs of a
+// solid and of a thin sheet; the names are the Python ones, in the enum's order.
 enum class Model : int {
     kDisney2014 = 0,  // anisotropic Smith GGX with the material's alpha_x, alpha_y
     kDisney2012 = 1,  // isotropic Smith GGX with alpha_g = (0.5 + roughness / 2)^2

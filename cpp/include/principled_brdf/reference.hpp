@@ -1,8 +1,9 @@
 // The float64 reference: the model (docs/model.md) instantiated for double,
 // with exact arithmetic where the kernels approximate (model/scalar_ops.hpp),
 // one pair at a time. It is the yardstick the SIMD kernels are measured
-// against; tests/numpy_model.py, an independent transcription of README
-// "The model", is its own.
+// against; tests/numpy_model.py, an independent transcription of
+// docs/model.md, "The model", and tests/numpy_model_2015.py, of
+// docs/model-2015.md, are its own.
 #pragma once
 
 #include <Eigen/Core>
@@ -119,7 +120,7 @@ using GradientShadingCache = RowCache<GradientShading, &gradient_shading_of>;
 using Shading2015Cache = RowCache<Shading2015<double>, &solid_shading2015_of<double>>;
 using ThinShading2015Cache = RowCache<Shading2015<double>, &thin_shading2015_of<double>>;
 
-// The four lobes, each already weighted as it enters the sum.
+// The lobes of kLobeNames (params.hpp), in its order, each already weighted as it enters the sum.
 struct Lobes {
     Vector3d diffuse = Vector3d::Zero();    // diffuse + subsurface, times (1 - metallic)
     Vector3d sheen = Vector3d::Zero();      // times (1 - metallic)

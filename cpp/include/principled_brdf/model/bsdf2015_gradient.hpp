@@ -1,5 +1,6 @@
-// Part of the model (docs/model-2015.md, "Derivatives"): the 2015 solid's
-// derivatives in its parameter slots, by forward mode: eval_lobes2015
+// Part of the model (docs/gradients.md, "The 2015 BSDF"): the 2015 models'
+// derivatives (the solid's and the thin sheet's) in their parameter slots and
+// in the directions, by forward mode: eval_lobes2015
 // instantiated for dual numbers (model/dual.hpp), so that every path of the
 // model (its sides, η from specular through the exact Fresnel factor and the
 // refraction, the clamps) is differentiated as it is evaluated. Where the

@@ -1,14 +1,16 @@
-// Part of the model (docs/model.md): the partial derivatives of f with respect
-// to the 13 parameter slots (params.hpp order, base color expanded), over a
-// number type F, written by hand beside the parts they differentiate.
+// Part of the model (docs/model.md): the partial derivatives of the 2012 and
+// 2014 models' f with respect to their 13 parameter slots (params.hpp order,
+// base color expanded, kGradientSlots), over a number type F, written by hand
+// beside the parts they differentiate.
 //
 // f is linear in most parameters (docs/model.md, "The model"): per channel c,
-//   f_c = D dc_c + FH sc_c + T f0_c + (S FH + C),   T = S (1 - FH),
+//   f_c = diffuse dc_c + FH sc_c + T f0_c + (S FH + C),   T = S (1 - FH),
 // with the material's colors dc (diffuse), sc (sheen), f0 (Cspec0) and the
-// scalars of the pair: D (diffuse, from roughness and subsurface), FH,
+// scalars of the pair: diffuse = mix(Fd, ss, subsurface) (LobeValues::diffuse,
+// from roughness and subsurface; not the distribution D), FH,
 // S (specular, from roughness and anisotropic) and C (clearcoat, linear in
 // clearcoat, through GTR1 in clearcoat_gloss). So the Jacobian is
-//   ∂f_c/∂p = ∂D/∂p dc_c + D ∂dc_c/∂p + FH ∂sc_c/∂p + ∂S/∂p ((1 - FH) f0_c + FH) + T ∂f0_c/∂p + ∂C/∂p:
+//   ∂f_c/∂p = ∂diffuse/∂p dc_c + diffuse ∂dc_c/∂p + FH ∂sc_c/∂p + ∂S/∂p ((1 - FH) f0_c + FH) + T ∂f0_c/∂p + ∂C/∂p:
 // the colors' partials are per-material constants (MaterialPartials, only
 // the non-zero ones: Cspec0 and Csheen move with base_color through Ctint, the
 // diffuse color only in its own channel), the
@@ -146,7 +148,7 @@ PB_MODEL_INLINE Rgb<F> eval_gradient(const Geometry<F>& g, const Shading<F>& s, 
     LobeValues<F> lobes = eval_lobes<model>(g, s, view);
     F fh = lobes.fh, one_minus_fh = one_minus_schlick_weight(g);
     F zero(0.0);
-    // D, S, C per unit clearcoat, with their partials, where a wanted column reads them
+    // diffuse, S, C per unit clearcoat, with their partials, where a wanted column reads them
     F diffuse_roughness = zero, diffuse_subsurface = zero;
     if (wanted(kRoughness) || wanted(kSubsurface)) {
         DiffusePartials<F> diffuse = diffuse_partials(s.diffuse, g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
@@ -176,7 +178,7 @@ PB_MODEL_INLINE Rgb<F> eval_gradient(const Geometry<F>& g, const Shading<F>& s, 
     F diffuse_value = weigh(lobes.diffuse), fh_weighed = weigh(fh);
     F specular_tinted = weigh(lobes.specular * one_minus_fh);  // T
 
-    // base_color: ∂f_c/∂base_k = δ_ck (D (1 - metallic)/π + T metallic) + (FH sheen_tint_scale + T specular_tint_scale) ∂Ctint_c/∂base_k
+    // base_color: ∂f_c/∂base_k = δ_ck (diffuse (1 - metallic)/π + T metallic) + (FH sheen_tint_scale + T specular_tint_scale) ∂Ctint_c/∂base_k
     F own_channel = mul_add(diffuse_value, d.dielectric_over_pi, specular_tinted * d.metallic);
     F through_tint = mul_add(fh_weighed, d.sheen_tint_scale, specular_tinted * d.specular_tint_scale);
     for (int c = 0; c < 3; ++c) {
