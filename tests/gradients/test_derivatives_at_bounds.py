@@ -88,3 +88,26 @@ def test_uniform_and_per_element_materials_agree_at_the_bounds(isa, model):
     reference = pb.reference.eval_grad(pb.Material(roughness=0.5), wi, wo, model=model).jacobian
     scale = np.maximum(np.abs(reference), 1e-3 * np.abs(reference).max(axis=(-2, -1), keepdims=True) + 1e-12)
     assert np.quantile(np.abs(uniform - reference) / scale, 0.9999) <= 1e-4
+
+
+@pytest.mark.parametrize("model, name, bound, others, pair, into", [c for c in CASES if c[0] != "disney2014"],
+                         ids=[i for i, c in zip(IDS, CASES) if c[0] != "disney2014"])
+def test_torch_and_jax_derivatives_at_the_bound(model, name, bound, others, pair, into):
+    """The frameworks' backward passes run the same kernels: at the bound, the gradient of
+    sum(f) in the parameter is the reference's one-sided derivative (a fit started there moves)."""
+    import jax
+    import jax.numpy as jnp
+    import torch
+
+    from principled_brdf import jax as pbj
+    from principled_brdf import torch as pbt
+
+    wi, wo = (w.astype(np.float32)[None] for w in pair)
+    expected = pb.reference.eval_grad(pb.Material(**others, **{name: bound}), wi[0], wo[0], model=model,
+                                      wrt=name).jacobian[:, 0].sum()
+    value = torch.tensor(bound, dtype=torch.float32, requires_grad=True)
+    pbt.eval({**others, name: value}, torch.from_numpy(wi), torch.from_numpy(wo), model=model).sum().backward()
+    through_jax = jax.grad(lambda v: pbj.eval({**others, name: v}, jnp.asarray(wi), jnp.asarray(wo),
+                                              model=model).sum())(jnp.float32(bound))
+    for actual in (float(value.grad), float(through_jax)):
+        assert actual == pytest.approx(float(expected), rel=1e-4, abs=1e-7)
