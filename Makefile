@@ -4,7 +4,7 @@
 PYTHON ?= python3
 export PYTHON
 
-.PHONY: demo test install deps bench sanitize wheel docs
+.PHONY: demo test install deps bench sanitize wheel docs check-neon
 
 demo: install
 	bash scripts/install-deps.sh demo
@@ -47,3 +47,8 @@ sanitize: deps
 docs: install
 	bash scripts/install-deps.sh docs
 	$(PYTHON) -m sphinx -b html -W --keep-going -q -d build/docs/.doctrees docs/api build/docs
+
+# The NEON kernel against the float64 reference: built for aarch64 into build/neon-check
+# and run under qemu's emulation on x86-64 (scripts/check-neon.sh says how)
+check-neon:
+	bash scripts/check-neon.sh

