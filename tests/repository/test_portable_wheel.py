@@ -178,6 +178,8 @@ print(json.dumps({
     "file": pb.__file__, "numpy": np.__file__, "prefix": sys.prefix, "info": info,
     "eval": {isa: [pb.eval(m, wi, wo, isa=isa).tolist() for m in materials] for isa in info["available"]},
     "reference": [pb.reference.eval(m, wi, wo).tolist() for m in materials],
+    "sample": {isa: [[s.wi.tolist(), s.pdf.tolist(), s.weight.tolist()]
+                     for s in (pb.sample(m, wo, seed=5, isa=isa) for m in materials)] for isa in info["available"]},
 }))
 """
 
@@ -219,6 +221,14 @@ def test_a_fresh_venv_runs_the_wheel(wheel, tmp_path):
     np.testing.assert_allclose(np.array(out["reference"]), np.array(expected), rtol=1e-9)
     for isa, values in out["eval"].items():
         np.testing.assert_allclose(np.array(values), np.array(expected), rtol=1e-4, atol=1e-7, err_msg=isa)
+    for isa, draws in out["sample"].items():  # each draw's pdf and weight as this process's reference has them
+        for m, (drawn, pdf, weight) in zip(materials, draws):
+            drawn, pdf, weight = np.array(drawn), np.array(pdf), np.array(weight)
+            valid = pdf > 0
+            assert valid.mean() > 0.9 and np.isfinite(weight).all(), isa
+            np.testing.assert_allclose(pdf[valid], pb.reference.pdf(m, drawn[valid], wo[valid]), rtol=1e-3, err_msg=isa)
+            f = pb.reference.eval(m, drawn[valid], wo[valid], cosine=True)
+            np.testing.assert_allclose(weight[valid], f / pdf[valid, None], rtol=2e-3, atol=1e-7, err_msg=isa)
 
     info = run([str(python), "-m", "principled_brdf", "info"], cwd=tmp_path, env=env)
     assert f"principled-brdf {pb.__version__}" in info, info
@@ -227,3 +237,7 @@ def test_a_fresh_venv_runs_the_wheel(wheel, tmp_path):
     forced = run([str(python), "-m", "principled_brdf", "info"], cwd=tmp_path,
                  env={**env, "PRINCIPLED_BRDF_ISA": "sse2"})
     assert "instruction set: sse2" in forced, forced
+    # the instruction set forced lower for the whole process (the dispatch override): its default is then SSE2
+    lowered = json.loads(run([str(python), "-c", VENV_SCRIPT], cwd=tmp_path, env={**env, "PRINCIPLED_BRDF_ISA": "sse2"}))
+    assert lowered["info"]["isa"] == "sse2"
+    np.testing.assert_array_equal(np.array(lowered["eval"]["sse2"]), np.array(out["eval"]["sse2"]))
