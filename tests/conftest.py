@@ -361,3 +361,20 @@ SELECTED_TESTS = pytest.StashKey[list]()
 @pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     config.stash[SELECTED_TESTS] = items
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """The command line's jobs themselves fail the test: a refused option never starts one
+    (nor hangs the test)."""
+    import principled_brdf.benchmark
+    import principled_brdf.demo
+
+    def job(*args, **kwargs):
+        raise AssertionError("the job started")
+
+    monkeypatch.setattr(pb.render, "render_sphere", job)
+    monkeypatch.setattr(pb.render, "_sample", job)
+    monkeypatch.setattr(principled_brdf.demo, "run", job)
+    monkeypatch.setattr(principled_brdf.demo, "cpu_info", job)
+    monkeypatch.setattr(principled_brdf.benchmark, "compare_with_numpy", job)

@@ -44,7 +44,7 @@ def test_the_2015_models_take_every_ior_up_to_the_limit(model):
         np.testing.assert_allclose(f, pb.reference.eval(m, wi, wo, model=model), rtol=1e-4)
         assert np.isfinite(pb.eval_grad(m, wi, wo, model=model, isa=isa).jacobian).all()
         s = pb.sample(m, np.tile(wo[:1], (1000, 1)), seed=1, model=model, isa=isa)
-        assert np.isfinite(s.weight).all() and (s.pdf > 0).mean() > 0.5  # (was 0: no sample at all)
+        assert np.isfinite(s.weight).all() and (s.pdf > 0).mean() > 0.5  # most views of the sheet draw a sample
     for specular in (np.nextafter(MAX_BSDF_SPECULAR, 13.0), 12.49999, 12.5):
         with pytest.raises(ValueError, match=rf"specular: model '{model}' needs specular <= 8.36777 \(an index of "
                                              r"refraction up to MAX_IOR = 10\)"):

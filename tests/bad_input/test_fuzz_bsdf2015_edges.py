@@ -121,7 +121,7 @@ def test_fuzz_bsdf2015_at_the_edges(data, seed, model, isa, entry):
 def test_fuzz_bsdf2015_albedo_at_every_ior(seed, ior, side):
     """The albedo of white rough glass from either side is positive (rough glass loses up to
     two thirds at grazing views, without energy compensation) and at most 1 for every
-    accepted η (a large η used to give no sample from outside: albedo 0)."""
+    accepted η: every η the domain takes draws samples from outside."""
     rng = np.random.default_rng(seed)
     roughness = float(rng.choice([0.0, 0.3, 1.0]))
     m = pb.Material(base_color=(1, 1, 1), spec_trans=1, roughness=roughness, ior=ior)

@@ -844,20 +844,6 @@ def test_explorer_after_close_ignores_changes():
 # The command line and pb.render
 
 
-@pytest.fixture
-def no_work(monkeypatch):
-    """The jobs themselves fail the test: a refused option never starts one (nor hangs the test)."""
-    import principled_brdf.benchmark
-    import principled_brdf.demo
-
-    def job(*args, **kwargs):
-        raise AssertionError("the job started")
-
-    monkeypatch.setattr(pb.render, "render_sphere", job)
-    monkeypatch.setattr(pb.render, "_sample", job)
-    monkeypatch.setattr(principled_brdf.demo, "run", job)
-    monkeypatch.setattr(principled_brdf.benchmark, "compare_with_numpy", job)
-
 
 def exit_status(capsys, args):
     from principled_brdf.cli import main
