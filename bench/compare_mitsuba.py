@@ -1,10 +1,18 @@
 """pb.eval and pb.sample beside Mitsuba 3's `principled` BSDF on the same pairs and material.
 
-    pip install mitsuba==3.5.2 drjit==0.4.6      # and Debian's libllvm16
-    DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-16.so.1 python3 bench/compare_mitsuba.py
+    apt-get install libllvm19                     # Debian 12's LLVM 19, for Dr.Jit's LLVM backend
+    pip install mitsuba==3.9.1 drjit==1.5.0
+    DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so python3 bench/compare_mitsuba.py
+
+Dr.Jit 1.5 emits `llvm.maximum` (fmaximum), which LLVM 16 and older cannot
+select for x86: the process aborts inside LLVM, so the script refuses an older
+LLVM. Without DRJIT_LIBLLVM_PATH Dr.Jit picks whichever libLLVM it finds first.
 
 Mitsuba runs its LLVM backend (variant llvm_ad_rgb, no gradients asked for),
-whose JIT folds the uniform material's constants into the kernel. Its `wi`
+which compiles for the host CPU whatever instruction set this library is
+forced to (PRINCIPLED_BRDF_ISA). Mitsuba traces its kernel for the material:
+a lobe whose parameter is zero (sheen, clearcoat, spec_trans, ...) is left out,
+and the uniform parameters enter as scalar kernel inputs. Its `wi`
 is this library's `wo` (towards the viewer) and its `eval` includes the
 cosine, so it is timed against `pb.eval(..., cosine=True)`; its `sample`
 against `pb.sample` with given uniforms. Each figure is the best of
@@ -15,14 +23,18 @@ Dr.Jit runs asynchronously, so its timer stops after `dr.sync_thread()`.
 one thread; "all" uses every core. `--material` takes a preset instead of
 the benchmark material. `--model disney2015` compares the 2015 BSDF (Mitsuba's
 `principled` with `spec_trans`, `--spec-trans`, default 1) on pairs over the
-whole sphere. Prints a Markdown table (M pairs/s and ratios); not a test
-dependency.
+whole sphere. Prints a Markdown table (M pairs/s and ratios) headed by the CPU
+and this library's instruction set, then the agreement of the two evals on
+the timed pairs (reported, never enforced: Mitsuba's BSDF is not the 2014
+model, and its sheen, clearcoat and flatness are not the 2015 model's); not a
+test dependency.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import platform
 import time
 
 import numpy as np
@@ -58,6 +70,20 @@ def best_seconds(run, repeats: int, min_seconds: float = 0.2) -> float:
     return best
 
 
+def cpu_name() -> str:
+    """The CPU's vendor and model as /proc/cpuinfo names them."""
+    fields: dict[str, str] = {}
+    try:
+        with open("/proc/cpuinfo") as lines:
+            for line in lines:
+                key, _, value = line.partition(":")
+                fields.setdefault(key.strip(), value.strip())
+    except OSError:
+        pass
+    vendor = fields.get("vendor_id", fields.get("CPU implementer", "unknown vendor"))
+    return f"{vendor} {fields.get('model name', platform.processor() or 'unknown model')}"
+
+
 def random_pairs(n: int, seed: int = 1, sphere: bool = False):
     """wi, wo over the upper hemisphere (or the whole sphere) and the uniforms."""
     rng = np.random.default_rng(seed)
@@ -72,6 +98,7 @@ def random_pairs(n: int, seed: int = 1, sphere: bool = False):
 
 
 def mitsuba_timers(material: pb.Material, n: int, wi, wo, u, repeats: int):
+    """Best seconds of Mitsuba's eval and sample, and its eval's values as (n, 3)."""
     import drjit as dr
     import mitsuba as mi
 
@@ -92,13 +119,30 @@ def mitsuba_timers(material: pb.Material, n: int, wi, wo, u, repeats: int):
         value = bsdf.eval(ctx, si, light)
         dr.eval(value)
         dr.sync_thread()
+        return value
 
     def sample():
         drawn, weight = bsdf.sample(ctx, si, sample1, sample2)
         dr.eval(drawn.wo, drawn.pdf, weight)
         dr.sync_thread()
 
-    return {"eval": best_seconds(evaluate, repeats), "sample": best_seconds(sample, repeats)}
+    seconds = {"eval": best_seconds(evaluate, repeats), "sample": best_seconds(sample, repeats)}
+    # Dr.Jit hands a Color3f to numpy as (3, n): one row per channel
+    return seconds, evaluate().numpy().T
+
+
+def agreement(theirs: np.ndarray, ours: np.ndarray) -> str:
+    """|Mitsuba - pb| / |pb| over the values finite and nonzero in both: its max
+    and median, and its max over the values at least 1e-3 of the largest (the
+    far tails of transmission are float32 rounding in both)."""
+    theirs, ours = theirs.astype(np.float64), ours.astype(np.float64)
+    both = np.isfinite(theirs) & np.isfinite(ours) & (theirs != 0) & (ours != 0)
+    if not both.any():
+        return "no value finite and nonzero in both"
+    relative = np.abs(theirs[both] - ours[both]) / np.abs(ours[both])
+    large = np.abs(ours[both]) >= 1e-3 * np.abs(ours[both]).max()
+    return (f"max relative difference {relative.max():.2g} (median {np.median(relative):.2g}) over {both.sum():,} "
+            f"of {theirs.size:,} values; {relative[large].max():.2g} over the {large.sum():,} at least 1e-3 of the largest")
 
 
 def library_timers(m: pb.Material, n: int, wi, wo, u, threads, repeats: int, model: str):
@@ -123,6 +167,12 @@ def main() -> None:
     parser.add_argument("--spec-trans", type=float, default=1.0, help="the material's spec_trans with disney2015")
     args = parser.parse_args()
     import drjit as dr
+    import mitsuba as mi
+
+    llvm = dr.detail.llvm_version()
+    if llvm is None or llvm[0] < 17:
+        raise SystemExit(f"Dr.Jit found LLVM {llvm}, which aborts on Dr.Jit 1.5's fmaximum (checked with 19): "
+                         "set DRJIT_LIBLLVM_PATH to libLLVM-19.so")
 
     material = material_named(args.material)
     sphere = args.model == "disney2015"
@@ -130,21 +180,30 @@ def main() -> None:
         material = material.replace(spec_trans=args.spec_trans)
 
     cores = sorted(os.sched_getaffinity(0))
-    print(f"principled-brdf {pb.__version__}, {pb.cpu_info()['isa']}; Mitsuba 3 llvm_ad_rgb; material {args.material}; "
+    print(f"{cpu_name()}; principled-brdf {pb.__version__}, ISA {pb.cpu_info()['isa']}; Mitsuba {mi.__version__} "
+          f"llvm_ad_rgb (Dr.Jit {dr.__version__}, LLVM {'.'.join(map(str, llvm))}); material {args.material}; "
           f"model {args.model}" + (f", spec_trans {args.spec_trans:g}, pairs over the sphere" if sphere else "") + "\n")
     print("| pairs | cores | call | pb M pairs/s | Mitsuba M pairs/s | pb / Mitsuba |\n|---:|---|---|---:|---:|---:|")
+    agreements = {}
     for label, affinity, threads in (("one (pinned)", {cores[0]}, 1), ("all", set(cores), None)):
         os.sched_setaffinity(0, affinity)
+        # Dr.Jit counts the calling thread as one of its threads: 1 means no worker
         dr.set_thread_count(len(affinity))
         for n in args.sizes:
             wi, wo, u = random_pairs(n, sphere=sphere)
-            theirs = mitsuba_timers(material, n, wi, wo, u, args.repeats)
+            theirs, mitsuba_values = mitsuba_timers(material, n, wi, wo, u, args.repeats)
             ours = library_timers(material, n, wi, wo, u, threads, args.repeats, args.model)
+            if n not in agreements:
+                agreements[n] = agreement(mitsuba_values, pb.eval(material, wi, wo, cosine=True, model=args.model))
+            del mitsuba_values
             for call, seconds in ours.items():
                 peer = theirs["sample" if call.startswith("sample") else "eval"]
                 print(f"| {n:,} | {label} | {call} | {n / seconds / 1e6:.0f} | {n / peer / 1e6:.0f} | "
                       f"{peer / seconds:.2f}x |", flush=True)
     os.sched_setaffinity(0, set(cores))
+    print("\nMitsuba's eval against pb.eval(..., cosine=True) on the timed pairs:")
+    for n, text in agreements.items():
+        print(f"- {n:,} pairs: {text}")
 
 
 if __name__ == "__main__":
