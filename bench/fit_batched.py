@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 import principled_brdf as pb
-from principled_brdf import _core, _direction_grad
+from principled_brdf import _core, _derivatives
 from principled_brdf._gradient import GRADIENT_NAMES
 
 
@@ -70,7 +70,7 @@ def eval_subsets(repeats: int, threads: int, pairs: int) -> None:
         label = "eval_vjp " + ("all 13" if wrt is None else ", ".join(wrt))
         print(f"  {label:40s} {base / t:.2f}x  ({n * inner / t / 1e6:.1f} M pairs/s)")
     # the directions' product, as principled_brdf.torch and .jax call it in their backward passes
-    t = best_of(repeats, lambda: [_direction_grad.vjp(m, wi, wo, g, threads=threads) for _ in range(inner)])
+    t = best_of(repeats, lambda: [_derivatives.direction_vjp(m, wi, wo, g, threads=threads) for _ in range(inner)])
     print(f"  {'direction vjp (wi, wo)':40s} {base / t:.2f}x  ({n * inner / t / 1e6:.1f} M pairs/s)")
 
 

@@ -6,9 +6,10 @@ See the README for the model and the API tour.
 from . import (environment, frames, measured, microfacet, piecewise, plot, presets, procedural_environments, reference,
                render, synthetic)
 from .fit import FitResult, fit
-from ._batch import Lobes, Sample, ValuePdf, cpu_info, eval, eval_grad, eval_lobes, eval_vjp, eval_pdf, pdf, random_uniforms, sample
-from ._gradient import GRADIENT_NAMES, Gradient
-from ._direction_grad import DIRECTION_NAMES
+from ._batch import cpu_info, eval, eval_lobes, eval_pdf, pdf, random_uniforms, sample
+from ._derivatives import DIRECTION_NAMES, eval_grad, eval_vjp
+from ._gradient import GRADIENT_NAMES
+from ._results import Gradient, Lobes, Sample, ValuePdf
 from .albedo import Albedo, albedo
 from .material import PARAMETERS, BrightColorWarning, Material, gamma22_to_linear, linear_to_srgb, srgb_to_linear
 

@@ -1,4 +1,7 @@
-"""The batched float32 SIMD path: pb.eval, pb.eval_lobes, pb.cpu_info.
+"""The batched float32 SIMD path: pb.eval, pb.eval_lobes, pb.pdf, pb.eval_pdf,
+pb.sample, pb.random_uniforms, pb.cpu_info, and the kernel passes of the
+derivatives, in the parameters and the directions, that ``_derivatives``
+joins into pb.eval_grad and pb.eval_vjp.
 
 Input handling, once per call:
 
@@ -19,30 +22,28 @@ from typing import TYPE_CHECKING, NamedTuple, overload
 
 import numpy as np
 
-from . import _core
+from . import _core, _gradient, _models
+from ._gradient import GRADIENT_NAMES
+from ._model_checks import model_and_mode
+from ._results import Gradient, Lobes, Sample, ValuePdf
+from ._segments import choose_split, compact, leading_of, part, unexpanded
 from ._validate import (
-    BSDF_MODELS,
     DIRECTION_LENGTH_TOLERANCE,
     as_real_array,
     broadcast_leading,
-    LOBE_NAMES,
     direction_error,
     element_name,
     flag,
     integer,
-    model_and_mode,
-    model_index,
-    require_finite,
+    layout as checked_layout,
+    refuse_energy_compensation_derivative,
     require_float32,
     require_in_domain,
     sampler_index,
     seed_value,
     unit_length,
 )
-from . import _direction_grad, _gradient
-from ._segments import choose_split, compact, leading_of, part, unexpanded
-from ._gradient import GRADIENT_NAMES, Gradient
-from .material import PARAMETERS, Material
+from .material import PARAMETERS, Material, require_material
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -52,61 +53,16 @@ if TYPE_CHECKING:
 
     from ._typing import Float32Array, FloatArray, Layout, Mode, Model, RealArrayLike, SpecularSampler
 
-__all__ = ["eval", "eval_lobes", "eval_grad", "eval_vjp", "eval_pdf", "ValuePdf", "pdf", "sample", "random_uniforms", "Lobes", "Sample", "cpu_info"]
+__all__ = ["eval", "eval_lobes", "eval_pdf", "pdf", "sample", "random_uniforms", "cpu_info", "parameter_grad",
+           "parameter_vjp", "direction_grad", "direction_vjp", "require_out_pair", "out_pair", "FLOAT32_LIMITS"]
 
 _INTERLEAVED, _ROWS, _SINGLE = 0, 1, 2
-
-
-if TYPE_CHECKING:  # the fields of LOBE_NAMES (the C++ table), spelled out for type checkers
-    class _LobeArrays(NamedTuple):
-        diffuse: FloatArray
-        sheen: FloatArray
-        specular: FloatArray
-        clearcoat: FloatArray
-        multiple_scattering: FloatArray
-        transmission: FloatArray
-        diffuse_transmission: FloatArray
-else:
-    _LobeArrays = NamedTuple("LobeArrays", [(name, np.ndarray) for name in LOBE_NAMES])
-
-
-class Lobes(_LobeArrays):
-    """The lobes of f (docs/model.md, "The model"), in the C++ table's order: ``diffuse``
-    (with subsurface, times 1 - metallic), ``sheen`` (times 1 - metallic),
-    ``specular``, ``clearcoat`` (grey) and ``multiple_scattering`` (the energy
-    compensation's, 0 unless it is on), each shaped like :func:`eval`'s
-    result, already weighted as they enter the sum."""
-
-    __slots__ = ()
-
-    def total(self) -> FloatArray:
-        return sum(self[1:], self[0])
-
-
-class Sample(NamedTuple):
-    """What :func:`sample` and ``pb.reference.sample`` return."""
-
-    wi: FloatArray  # (..., 3) drawn direction towards the light
-    pdf: FloatArray  # (...) mixture density in solid angle; 0 where the draw is no sample (docs/sampling.md)
-    weight: FloatArray  # (..., 3) f(wi, wo) |cos θl| / pdf; 0 where pdf is 0
-    # (...) int32, an index into SAMPLED_LOBE_NAMES: 0 cosine, 1 primary specular, 2 clearcoat,
-    # 3 transmission, 4 diffuse_transmission (the last two: the 2015 models)
-    lobe: NDArray[np.int32]
-
-
-_LAYOUTS = ("aos", "soa")
 
 
 def cpu_info() -> dict[str, Any]:
     """The instruction set in use (``PRINCIPLED_BRDF_ISA`` forces one), the
     available ones, SIMD width in floats and hardware threads."""
     return dict(_core.cpu_info())
-
-
-def _layout(layout: Layout) -> Layout:
-    if layout not in _LAYOUTS:
-        raise ValueError(f"layout: expected 'aos' for (..., 3) or 'soa' for (3, ...), got {layout!r}")
-    return layout
 
 
 def _threads(threads: SupportsIndex | None) -> int:
@@ -357,11 +313,6 @@ def _as_array(value: object) -> NDArray[Any] | None:
     return value if isinstance(value, np.ndarray) else None
 
 
-def _require_material(material: object) -> None:
-    if not isinstance(material, Material):
-        raise TypeError(f"material: expected a principled_brdf.Material, got {type(material).__name__}")
-
-
 def _size(leading: tuple[int, ...]) -> int:
     return math.prod(leading)
 
@@ -386,12 +337,11 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     the vector-Jacobian product. ``directions``: the derivatives in the six
     direction components instead of the slots."""
     vjp = cotangent is not None
-    _require_material(material)
+    require_material("material", material)
+    if gradient or vjp or directions:
+        refuse_energy_compensation_derivative(energy_compensation)
     energy_compensation = flag("energy_compensation", energy_compensation)
-    if (gradient or vjp or directions) and energy_compensation:
-        raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
-                                  "multiple-scattering lobe is not implemented); evaluate f with pb.eval")
-    layout = _layout(layout)
+    layout = checked_layout(layout)
     thread_count = _threads(threads)
     isa_name = _isa(isa)
     cosine, check = flag("cosine", cosine), flag("check", check)
@@ -463,7 +413,7 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     else:
         bad = _core.batch_eval(
             wi=wi_flat, wi_layout=wi_code, wo=wo_flat, wo_layout=wo_code, params=params,
-            outputs=[_flat_vec3(o, layout)[0] for o in outputs], lobes=len(outputs) == len(LOBE_NAMES),
+            outputs=[_flat_vec3(o, layout)[0] for o in outputs], lobes=len(outputs) == len(_models.LOBE_NAMES),
             out_layout=out_layout, n=n, options=options, segments=segments)
     if bad >= 0:
         raise _direction_error(bad, leading, wi_dirs, wo_dirs)
@@ -508,19 +458,19 @@ def eval_lobes(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, mode
     diffuse_transmission 0 but for ``disney2015_thin``."""
     model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
     outputs = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa,
-                        lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in LOBE_NAMES],
+                        lambda leading, layout: [np.empty(_vec3_shape(leading, layout), np.float32) for _ in _models.LOBE_NAMES],
                         energy_compensation=energy_compensation, mode_id=mode_id)
     return Lobes(*outputs)
 
 
-def _require_pair(out: object, second: str) -> None:
+def require_out_pair(out: object, second: str) -> None:
     """``out=`` of a call with two results, f and ``second``: None or a tuple of two arrays."""
     if out is not None and not (isinstance(out, tuple) and len(out) == 2):
         raise TypeError(f"out: expected a tuple (value, {second}) of float32 arrays")
 
 
-def _output_pair(out: tuple[object, object] | None, value_shape: tuple[int, ...], second_shape: tuple[int, ...],
-                 second: str) -> tuple[Float32Array, Float32Array]:
+def out_pair(out: tuple[object, object] | None, value_shape: tuple[int, ...], second_shape: tuple[int, ...],
+             second: str) -> tuple[Float32Array, Float32Array]:
     """The two result arrays: fresh, or ``out``'s checked (shapes, dtype, no overlap)."""
     if out is not None:
         for i, array in enumerate(out):
@@ -537,41 +487,21 @@ def _jacobian_shape(leading: tuple[int, ...], layout: str, width: int) -> tuple[
     return leading + (3, width) if layout == "aos" else (3, width) + leading
 
 
-def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
-              wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014", cosine: bool = False,
-              layout: Layout = "aos", threads: SupportsIndex | None = None,
-              out: tuple[Float32Array, Float32Array] | None = None, check: bool = True,
-              isa: str | None = None, energy_compensation: bool = False, mode: Mode = "radiance") -> Gradient:
-    """f and its Jacobian in the material's parameters, by the SIMD kernel in
-    float32 (docs/gradients.md).
-
-    Returns a :class:`Gradient`: ``value`` as :func:`eval` returns it,
-    ``jacobian`` ``(..., 3, P)`` (``(3, P, ...)`` for ``layout="soa"``) with
-    ``jacobian[..., c, k] = ∂f_c/∂names[k]``, and ``names``: the P parameters
-    ``wrt`` selects (default all 13 slots of the parameter table the 2012
-    and 2014 models read, all 16 for ``model="disney2015"``,
-    ``base_color`` as ``base_color_r/g/b``), in the table's order. A uniform
-    parameter still gets a per-element derivative. ``out=(value, jacobian)``
-    writes into preallocated float32 arrays of exactly those shapes. The other
-    arguments are :func:`eval`'s; ``energy_compensation=True`` raises
-    NotImplementedError. ``wrt`` may also name ``"wi"`` and ``"wo"``: three
-    columns each (``wi_x, wi_y, wi_z``, ``wo_x, wo_y, wo_z``) after the
-    parameters', the derivatives of f in the 3-vectors as given
-    (docs/gradients.md, "Derivatives in the directions").
-    """
-    if _direction_grad.asks_for_directions(wrt):
-        return _direction_grad.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
-                                         threads=threads, out=out, check=check, isa=isa,
-                                         energy_compensation=energy_compensation, mode=mode)
+def parameter_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
+                   wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014",
+                   cosine: bool = False, layout: Layout = "aos", threads: SupportsIndex | None = None,
+                   out: tuple[Float32Array, Float32Array] | None = None, check: bool = True,
+                   isa: str | None = None, energy_compensation: bool = False, mode: Mode = "radiance") -> Gradient:
+    """pb.eval_grad in the parameters only (its arguments, checked as it checks them)."""
     model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
     names = _gradient.gradient_names(model)
     wanted = _gradient.columns(wrt, names=names)
-    full = len(wanted) == len(GRADIENT_NAMES) and names is GRADIENT_NAMES  # (the 2015 models name their columns)
-    _require_pair(out, "jacobian")
+    full = len(wanted) == len(GRADIENT_NAMES) and names == GRADIENT_NAMES  # (the 2015 models name their columns)
+    require_out_pair(out, "jacobian")
 
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
-        value, jacobian = _output_pair(out, _vec3_shape(leading, layout), _jacobian_shape(leading, layout, len(wanted)),
-                                       "jacobian")
+        value, jacobian = out_pair(out, _vec3_shape(leading, layout), _jacobian_shape(leading, layout, len(wanted)),
+                                   "jacobian")
         return [value, jacobian]
 
     # the kernel computes and writes the wanted columns only
@@ -581,76 +511,52 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     return Gradient(value, jacobian, tuple(names[k] for k in wanted))
 
 
-def eval_vjp(material: Material, wi: RealArrayLike, wo: RealArrayLike, cotangent: RealArrayLike, *,
-             wrt: str | list[str] | tuple[str, ...] | None = None, model: Model = "disney2014", cosine: bool = False,
-             layout: Layout = "aos", threads: SupportsIndex | None = None, check: bool = True,
-             isa: str | None = None, precision: Literal["float32", "float64"] = "float32",
-             mode: Mode = "radiance") -> dict[str, FloatArray]:
-    """The vector-Jacobian product of f: for a cotangent g shaped like f,
-    ``Σ_c g_c ∂f_c/∂p`` for each parameter slot p that ``wrt`` selects (as
-    :func:`eval_grad`'s; default all), without forming the Jacobian
-    (docs/gradients.md).
-
-    Returns ``{slot name: array}`` in the table's order, each array shaped like
-    that parameter's own value in ``material`` (without ``base_color``'s
-    trailing 3): a per-element parameter gets one product per element (summed
-    over the axes it is broadcast along), a uniform one the sum over every
-    element, a 0-d array. ``cotangent``: real, ``(..., 3)`` (``(3, ...)`` for
-    ``layout="soa"``) broadcasting with the call's shape. ``precision``:
-    ``"float32"`` (the SIMD kernel; sums over elements taken in float64, then
-    rounded) or ``"float64"`` (the reference). The other arguments are
-    :func:`eval_grad`'s.
-    """
-    _require_material(material)
-    model_id, mode_id = model_and_mode(material, model, mode)
-    names = _gradient.gradient_names(model)
-    wanted = _gradient.columns(wrt, names=names)
-    if not isinstance(precision, str) or precision not in ("float32", "float64"):
-        raise ValueError(f"precision: expected 'float32' or 'float64', got {precision!r}")
-    soa = _layout(layout) == "soa"
-    # a float32 cotangent is read as it is, anything else as float64
-    given_float32 = isinstance(cotangent, np.ndarray) and cotangent.dtype == np.float32
-    g = np.asarray(cotangent) if given_float32 else as_real_array("cotangent", cotangent)
-    if g.ndim == 0 or g.shape[0 if soa else -1] != 3:
-        raise ValueError(f"cotangent: expected shape {'(3, ...)' if soa else '(..., 3)'} like f, got {g.shape}")
-    require_finite("cotangent", g)  # the rule of every backward pass (docs/bad-input.md)
-    if precision == "float64":
-        from . import reference  # (imports this module)
-
-        gradient = reference.eval_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout, mode=mode)
-        jacobian = gradient.jacobian if not soa else np.moveaxis(gradient.jacobian, (0, 1), (-2, -1))
-        g_aos = g if not soa else np.moveaxis(g, 0, -1)
-        products = np.einsum("...c,...ck->...k", np.broadcast_to(g_aos, jacobian.shape[:-1]), jacobian)
-        return _sum_to_parameters(material, products, wanted, names, np.float64)
-    g32 = g.astype(np.float32, copy=False)
-    if g32 is not g and np.isinf(g32).any():
-        raise ValueError("cotangent: values beyond float32's range")
+def parameter_vjp(material: Material, wi: object, wo: object, cotangent: Float32Array, *, columns: list[int],
+                  model_id: int, mode_id: int, cosine: bool, layout: Layout, threads: SupportsIndex | None,
+                  check: bool, isa: str | None) -> Float32Array:
+    """``Σ_c g_c ∂f_c/∂p`` per element for the slots ``columns``: ``(..., P)`` at the call's
+    broadcast shape (``(P, ...)`` for ``layout="soa"``), for a float32 ``cotangent`` in f's layout."""
+    soa = layout == "soa"
 
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
-        return [np.empty(leading + (len(wanted),) if not soa else (len(wanted),) + leading, np.float32)]
+        return [np.empty(leading + (len(columns),) if not soa else (len(columns),) + leading, np.float32)]
 
     (product,) = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs,
-                           energy_compensation=False, columns=wanted, cotangent=g32, mode_id=mode_id)
-    return _sum_to_parameters(material, product if not soa else np.moveaxis(product, 0, -1), wanted, names, np.float32)
+                           energy_compensation=False, columns=columns, cotangent=cotangent, mode_id=mode_id)
+    return product
 
 
-def _sum_to_parameters(material: Material, products: NDArray[Any], wanted: list[int], names: tuple[str, ...],
-                       dtype: type[np.floating[Any]]) -> dict[str, FloatArray]:
-    """``products`` ``(..., P)`` summed down to each selected parameter's own shape (float64 sums)."""
-    result: dict[str, FloatArray] = {}
-    for k, slot in enumerate(wanted):
-        info = next(i for i in PARAMETERS.values() if i.first_slot <= slot < i.first_slot + i.slots)
-        value = np.asarray(getattr(material, info.name))
-        own = value.shape[:-1] if info.slots == 3 else value.shape
-        column = products[..., k]
-        extra = column.ndim - len(own)
-        axes = tuple(range(extra)) + tuple(extra + a for a, d in enumerate(own) if d == 1 and column.shape[extra + a] != 1)
-        if not axes:  # one product an element: as it is
-            result[names[slot]] = np.ascontiguousarray(column, dtype=dtype).reshape(own)
-            continue
-        total = column.sum(axis=axes, dtype=np.float64, keepdims=False)
-        result[names[slot]] = np.asarray(total, dtype=np.float64).reshape(own).astype(dtype)
-    return result
+# The six direction components the derivatives in the directions are taken by: wi's, then wo's.
+DIRECTION_COMPONENTS = 6
+
+
+def direction_grad(material: Material, wi: object, wo: object, *, model_id: int, mode_id: int, cosine: bool,
+                   layout: Layout, threads: SupportsIndex | None, check: bool,
+                   isa: str | None) -> tuple[Float32Array, Float32Array]:
+    """f and its derivatives in the six direction components, ``(..., 3)`` and
+    ``(..., 3, 6)`` (``(3, ...)`` and ``(3, 6, ...)`` for ``layout="soa"``), by the model's
+    forward mode over double batches (``model/direction_gradient.hpp``)."""
+
+    def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
+        return [np.empty(_vec3_shape(leading, layout), np.float32),
+                np.empty(_jacobian_shape(leading, layout, DIRECTION_COMPONENTS), np.float32)]
+
+    value, jacobian = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs,
+                                directions=True, mode_id=mode_id)
+    return value, jacobian
+
+
+def direction_vjp(material: Material, wi: object, wo: object, cotangent: Float32Array, *, model_id: int,
+                  mode_id: int, cosine: bool, threads: SupportsIndex | None, isa: str | None) -> Float32Array:
+    """``Σ_c g_c ∂f_c/∂w`` per element in the six direction components, ``(..., 6)``, for
+    ``(..., 3)`` arguments and a float32 ``cotangent`` broadcasting with them."""
+
+    def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
+        return [np.empty(leading + (DIRECTION_COMPONENTS,), np.float32)]
+
+    (product,) = _evaluate(material, wi, wo, model_id, cosine, "aos", threads, True, isa, outputs,
+                           cotangent=cotangent, directions=True, mode_id=mode_id)
+    return product
 
 
 def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
@@ -667,18 +573,11 @@ def pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Mode
     where it lies on the other (docs/sampling.md, "The 2015 solid" and
     "The 2015 thin sheet")."""
     model_id = model_and_mode(material, model, energy_compensation=energy_compensation)[0]
-    by_model = energy_compensation or model in BSDF_MODELS  # else the pdf is the 2014 model's
+    by_model = energy_compensation or _models.is_whole_sphere(model)  # else the pdf is the 2014 model's
     (density,) = _evaluate(material, wi, wo, model_id if by_model else 0, False, layout, threads, check, isa,
                            lambda leading, layout: [np.empty(leading, np.float32)],
                            pdf_sampler=sampler_index(specular_sampler), energy_compensation=energy_compensation)
     return density
-
-
-class ValuePdf(NamedTuple):
-    """What :func:`eval_pdf` returns."""
-
-    value: Float32Array  # f, as eval returns it
-    pdf: Float32Array  # the sampling density of wi given wo, as pdf returns it
 
 
 def eval_pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model = "disney2014",
@@ -689,10 +588,10 @@ def eval_pdf(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model:
     """f and the sampling pdf of (wi, wo) in one kernel pass (what multiple importance
     sampling needs): ``value`` as :func:`eval` returns it, ``pdf`` as :func:`pdf` does.
     ``out=(value, pdf)`` writes into preallocated float32 arrays of those shapes."""
-    _require_pair(out, "pdf")
+    require_out_pair(out, "pdf")
 
     def outputs(leading: tuple[int, ...], layout: str) -> list[Float32Array]:
-        value, density = _output_pair(out, _vec3_shape(leading, layout), leading, "pdf")
+        value, density = out_pair(out, _vec3_shape(leading, layout), leading, "pdf")
         return [density, value]
 
     model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
@@ -771,7 +670,7 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     """
     model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
     sampler = sampler_index(specular_sampler)
-    layout = _layout(layout)
+    layout = checked_layout(layout)
     thread_count = _threads(threads)
     isa_name = _isa(isa)
     seed = _fresh_seed() if seed is None else seed_value(seed)
@@ -797,7 +696,7 @@ def sample(material: Material, wo: RealArrayLike, *, u: RealArrayLike | None = N
     weight_out = np.empty_like(wi_out)
     pdf_out = np.empty(leading, np.float32)
     lobe_out = np.empty(leading, np.int32)
-    shares = [np.empty_like(wi_out) for _ in LOBE_NAMES] if with_lobes else None
+    shares = [np.empty_like(wi_out) for _ in _models.LOBE_NAMES] if with_lobes else None
     call = _segmented(leading, layout, [None, wo_dirs, uniforms], material)
     (wo_flat, wo_code), (u_flat, u_code) = call.vectors[1:]
     options = _core.SampleOptions(model=model_id, sampler=sampler, energy_compensation=energy_compensation, mode=mode_id,

@@ -1,4 +1,4 @@
-"""What ``eval_grad`` returns, and the parameters it differentiates by.
+"""The parameters ``eval_grad`` differentiates by: its columns, by name.
 
 The Jacobian's columns are the 13 parameter slots of the C++ table
 (``params.hpp``), in its order, with ``base_color`` expanded to
@@ -7,49 +7,28 @@ The Jacobian's columns are the 13 parameter slots of the C++ table
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _core
-from ._validate import BSDF_MODELS
+from . import _core, _models
+from ._models import gradient_names
+from ._results import Gradient
 from .material import PARAMETERS
 
 if TYPE_CHECKING:
     from ._typing import FloatArray
 
-__all__ = ["Gradient", "GRADIENT_NAMES", "DIFFERENTIABLE"]
+__all__ = ["GRADIENT_NAMES", "GRADIENT_NAMES_2015", "DIFFERENTIABLE", "gradient_names", "columns", "result"]
 
-
-# The parameters with derivative columns, in the table's order: the 2012 and
-# 2014 models' (the 2015 models' own parameters have none yet), which fitting
-# adjusts.
-DIFFERENTIABLE = {name: info for name, info in PARAMETERS.items() if info.first_slot < _core.GRADIENT_SLOTS}
-
-
-def _slot_names() -> tuple[str, ...]:
-    names: list[str] = []
-    for info in DIFFERENTIABLE.values():
-        names += [f"{info.name}_{c}" for c in "rgb"] if info.slots == 3 else [info.name]
-    return tuple(names)
-
-
-GRADIENT_NAMES = _slot_names()
-# the 2015 models' columns: every slot of the table
-GRADIENT_NAMES_2015 = GRADIENT_NAMES + tuple(name for name in PARAMETERS if name not in DIFFERENTIABLE)
-
-
-def gradient_names(model: object) -> tuple[str, ...]:
-    """The columns of ``model``'s Jacobian in the parameters (``model`` checked by the caller)."""
-    return GRADIENT_NAMES_2015 if model in BSDF_MODELS else GRADIENT_NAMES
-
-
-class Gradient(NamedTuple):
-    """f and its partial derivatives: ``jacobian[..., c, k] = ∂f_c / ∂names[k]``."""
-
-    value: FloatArray  # (..., 3) as eval returns it
-    jacobian: FloatArray  # (..., 3, P)
-    names: tuple[str, ...]  # the P parameters in the table's order, then any direction components
+# The columns of the default model (the 2012 and 2014 models' 13 slots).
+GRADIENT_NAMES = gradient_names(_models.DEFAULT_MODEL)
+# Every slot of the table: the 2015 models' columns, and what fitting packs.
+GRADIENT_NAMES_2015 = _models.slot_names(_core.PARAM_SLOTS)
+# The parameters with derivative columns in the default model, in the table's order,
+# which the plots sweep.
+DIFFERENTIABLE = {name: info for name, info in PARAMETERS.items()
+                  if info.first_slot < _models.RULES[_models.DEFAULT_MODEL].gradient_slots}
 
 
 def columns(wrt: object, argument: str = "wrt", names: tuple[str, ...] = GRADIENT_NAMES) -> list[int]:

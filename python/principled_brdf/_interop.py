@@ -12,8 +12,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _batch, _direction_grad, reference
-from ._validate import as_real_array, broadcast_leading, flag, mode_index, model_and_mode, model_index, require_finite
+from . import _batch, _derivatives, reference
+from ._model_checks import model_and_mode
+from ._validate import as_real_array, broadcast_leading, flag, mode_index, model_index, require_finite
 from .material import PARAMETERS, Material
 
 if TYPE_CHECKING:
@@ -140,8 +141,8 @@ def vjp(material: Material, names: Sequence[str], wi: np.ndarray, wo: np.ndarray
         per_element = np.einsum("...c,...ck->...k", cotangent.astype(np.float64, copy=False), gradient.jacobian)
         columns = dict(zip(gradient.names, np.moveaxis(per_element, -1, 0)))
     else:
-        columns = _batch.eval_vjp(material, np.asarray(wi, np.float32), np.asarray(wo, np.float32), cotangent,
-                                  wrt=asked, **options)
+        columns = _derivatives.eval_vjp(material, np.asarray(wi, np.float32), np.asarray(wo, np.float32), cotangent,
+                                        wrt=asked, **options)
     result: list[np.ndarray | None] = []
     for name, want in zip(names, wanted):
         if not want:
@@ -165,5 +166,5 @@ def direction_vjp(material: Material, wi: np.ndarray, wo: np.ndarray, cotangent:
         gradient = reference.eval_grad(material, wi_call, wo_call, wrt=["wi", "wo"], **options)
         products = np.einsum("...c,...ck->...k", cotangent.astype(np.float64, copy=False), gradient.jacobian)
         return products[..., :3], products[..., 3:]
-    return _direction_grad.vjp(material, np.asarray(wi_call, np.float32), np.asarray(wo_call, np.float32),
-                               np.asarray(cotangent, np.float32), **options)
+    return _derivatives.direction_vjp(material, np.asarray(wi_call, np.float32), np.asarray(wo_call, np.float32),
+                                      np.asarray(cotangent, np.float32), **options)

@@ -14,23 +14,22 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _core
+from . import _core, _models
 
 if TYPE_CHECKING:
     from numpy.typing import NDArray
 
-    from ._typing import Float64Array, FloatArray
-    from .material import Material
+    from ._typing import Float64Array, FloatArray, Layout
 
 DIRECTION_LENGTH_TOLERANCE = 1e-3
 # A direction passes when its float64 squared length, summed as x² + y² + z²,
 # lies within these: the rule the kernels apply (batch.hpp, DirectionCheck).
 DIRECTION_LENGTH2_BOUNDS = tuple(_core.direction_length2_bounds(DIRECTION_LENGTH_TOLERANCE))
 # The C++ side's name tables (params.hpp), each in its enum's order.
-MODELS = {name: index for index, name in enumerate(_core.MODEL_NAMES)}
+MODELS = {name: index for index, name in enumerate(_models.MODEL_NAMES)}
 SAMPLERS = {name: index for index, name in enumerate(_core.SAMPLER_NAMES)}  # of the primary specular lobe
-LOBE_NAMES = tuple(_core.LOBE_NAMES)  # of f, as eval_lobes returns them
-SAMPLED_LOBE_NAMES = tuple(_core.SAMPLED_LOBE_NAMES)  # by the index a sample reports
+MODES = {name: index for index, name in enumerate(_core.MODE_NAMES)}
+LAYOUTS = ("aos", "soa")  # (..., 3) and (3, ...): where a direction's components lie
 FLOAT32_MAX = float(np.finfo(np.float32).max)
 MAX_RESOLUTION = 16384  # pixels (or angles) along a picture's side: 16384² pixels is 3 GB of float32 RGB
 _REAL_KINDS = "biuf"  # bool, signed and unsigned integers, floats
@@ -237,29 +236,32 @@ def model_index(model: object) -> int:
     return MODELS[model]
 
 
-MODES = {name: index for index, name in enumerate(_core.MODE_NAMES)}
-# The models of the whole sphere (the 2015 BSDF of a solid and of a thin sheet, docs/model-2015.md);
-# the others are BRDFs.
-BSDF_MODELS = ("disney2015", "disney2015_thin")
-
-
 def mode_index(mode: object) -> int:
     if not isinstance(mode, str) or mode not in MODES:
         raise ValueError(f"mode: expected one of {sorted(MODES)}, got {mode!r}")
     return MODES[mode]
 
 
-def model_and_mode(material: Material, model: object, mode: object = "radiance",
-                   energy_compensation: object = False) -> tuple[int, int]:
-    """The indices of ``model`` and ``mode``, after the rules a model sets: its
-    unread parameters at their defaults (:meth:`Material.require_read_by`), and
-    for the 2015 models no energy compensation."""
-    model_id, mode_id = model_index(model), mode_index(mode)
-    if hasattr(material, "require_read_by"):  # (else the caller's material check names the argument)
-        material.require_read_by(str(model))
-    if model in BSDF_MODELS and flag("energy_compensation", energy_compensation):
+def require_energy_compensation_offered(model: object, energy_compensation: object) -> None:
+    """A ValueError for ``energy_compensation=True`` with a model that does not offer it
+    (the 2015 models)."""
+    if not _models.offers_energy_compensation(model) and flag("energy_compensation", energy_compensation):
         raise ValueError(f"energy_compensation: not available for model {model!r} (docs/model-2015.md)")
-    return model_id, mode_id
+
+
+def refuse_energy_compensation_derivative(energy_compensation: object) -> None:
+    """The derivatives (eval_grad, eval_vjp, in the parameters or the directions) take f
+    without the multiple-scattering lobe: NotImplementedError for ``energy_compensation=True``."""
+    if flag("energy_compensation", energy_compensation):
+        raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
+                                  "multiple-scattering lobe is not implemented); evaluate f with pb.eval")
+
+
+def layout(value: object) -> Layout:
+    """``"aos"`` (directions ``(..., 3)``) or ``"soa"`` (``(3, ...)``); a ValueError otherwise."""
+    if not isinstance(value, str) or value not in LAYOUTS:
+        raise ValueError(f"layout: expected 'aos' or 'soa' (directions (..., 3) or (3, ...)), got {value!r}")
+    return value  # type: ignore[return-value]  # one of LAYOUTS
 
 
 def sampler_index(specular_sampler: object) -> int:

@@ -6,14 +6,16 @@ into the light from wo's side (reflectance) and through the surface
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._batch import Lobes, random_uniforms, sample
-from ._validate import (BSDF_MODELS, LOBE_NAMES, as_real_array, broadcast_leading, element_name, first_true,
-                        integer_in, require_in_domain, seed_value)
-from .material import PARAMETERS, Material, _require_material
+from . import _models
+from ._batch import random_uniforms, sample
+from ._results import Albedo, Lobes
+from ._validate import (as_real_array, broadcast_leading, element_name, first_true, integer_in, require_in_domain,
+                        seed_value)
+from .material import PARAMETERS, Material, require_material
 
 if TYPE_CHECKING:
     from typing import Any, SupportsIndex
@@ -26,17 +28,6 @@ __all__ = ["Albedo", "albedo"]
 MAX_SAMPLES = 1 << 26
 # Elements per kernel call: bounds the memory of one chunk (about 150 bytes each).
 _CHUNK_ELEMENTS = 1 << 22
-
-
-class Albedo(NamedTuple):
-    """Directional albedo at each cos θo, RGB ``(..., 3)``, with standard errors."""
-
-    total: Float64Array
-    lobes: Lobes  # diffuse, sheen, specular, clearcoat, multiple_scattering, transmission
-    total_error: Float64Array  # standard error of the mean
-    lobe_errors: Lobes
-    reflectance: Float64Array  # the part from wo's side of the surface (the total for a BRDF)
-    transmittance: Float64Array  # the part through the surface (0 for a BRDF)
 
 
 def _with_sample_axis(material: Material, leading: tuple[int, ...]) -> Material:
@@ -67,9 +58,9 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
     in ``pb.sample``; in importance mode the albedo of a clear dielectric
     (``spec_trans=1``, white) is at most 1 from either side.
     """
-    _require_material("material", material)
+    require_material("material", material)
     cos_o = as_real_array("cos_theta_o", cos_theta_o)
-    whole_sphere = model in BSDF_MODELS
+    whole_sphere = _models.is_whole_sphere(model)
     require_in_domain("cos_theta_o", cos_o, -1.0 if whole_sphere else 0.0, 1.0)
     if np.any(cos_o == 0.0):  # wo in the surface
         i = first_true(cos_o == 0.0)
@@ -83,7 +74,7 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
     cos_flat = np.broadcast_to(cos_o, leading).reshape(-1)
     m = cos_flat.size
 
-    sums = np.zeros((3 + len(LOBE_NAMES), m, 3))  # total, the lobes, reflectance, transmittance
+    sums = np.zeros((3 + len(_models.LOBE_NAMES), m, 3))  # total, the lobes, reflectance, transmittance
     squares = np.zeros_like(sums)
     per_chunk = max(1, _CHUNK_ELEMENTS // count)
     flat_material = _flatten(expanded, leading)
@@ -109,7 +100,7 @@ def albedo(material: Material, cos_theta_o: RealArrayLike, *, samples: SupportsI
     variance = np.maximum(squares / count - mean * mean, 0.0) * count / (count - 1)
     error = np.sqrt(variance / count)
     shape = leading + (3,)
-    lobes = range(1, 1 + len(LOBE_NAMES))
+    lobes = range(1, 1 + len(_models.LOBE_NAMES))
     return Albedo(
         total=mean[0].reshape(shape),
         lobes=Lobes(*(mean[k].reshape(shape) for k in lobes)),

@@ -50,13 +50,14 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from . import _color, _validate
+from . import _color, _models, _validate
 from . import presets as _presets
 from . import render as _render
 from ._batch import FLOAT32_LIMITS as _KERNEL_LIMITS
 from ._batch import eval_lobes as _eval_lobes
 from .albedo import albedo as _albedo
-from .material import PARAMETERS, Material, srgb_to_linear, unread_parameters
+from ._models import unread_parameters
+from .material import PARAMETERS, Material, srgb_to_linear
 from .plot import _LOBE_COLORS as _PLOT_LOBE_COLORS
 from .plot import CHANNELS, _rgba, _uniform_material, _upper_half_disc, slice_directions
 
@@ -86,7 +87,7 @@ CUSTOM = "(custom)"
 _LUMINANCE = np.asarray(CHANNELS["luminance"], dtype=np.float64)
 # plot's colors; the multiple-scattering lobe counts in the totals without a line of its own
 _LOBE_COLORS = {name: color for name, color in _PLOT_LOBE_COLORS.items()
-                if name in _validate.LOBE_NAMES + ("total",) and name != "multiple_scattering"}
+                if name in _models.LOBE_NAMES + ("total",) and name != "multiple_scattering"}
 # What each picture shows (keys of Explorer._state): it is redrawn only when one of these changes.
 _DEPENDS = {
     "sphere": ("material", "model", "energy_compensation", "light", "exposure", "sky", "environment"),
@@ -280,7 +281,7 @@ class Explorer:
             self.sliders[name] = slider(name, value, info.lower, upper, 0.01, limit=_KERNEL_LIMITS.get(name, math.inf))
         self.base_color = widgets.ColorPicker(value=_hex(self._base_color), description="base_color", concise=False,
                                               style=style, layout=layout)
-        self.model = widgets.Dropdown(options=list(_validate.MODELS), value=model, description="model", style=style,
+        self.model = widgets.Dropdown(options=list(_models.MODEL_NAMES), value=model, description="model", style=style,
                                       layout=layout)
         self.preset = widgets.Dropdown(options=[CUSTOM] + _presets.names(), value=preset or CUSTOM,
                                        description="preset", style=style, layout=layout)
@@ -369,7 +370,7 @@ class Explorer:
         unread = unread_parameters(self.model.value)
         for name, slider in self.sliders.items():
             slider.disabled = name in unread
-        self.view_theta.max = 180.0 if self.model.value in _validate.BSDF_MODELS else 90.0
+        self.view_theta.max = 180.0 if _models.is_whole_sphere(self.model.value) else 90.0
 
     def _state(self) -> dict[str, Any]:
         return {
@@ -590,14 +591,14 @@ class Explorer:
 
     def _draw_polar(self, material: Material, state: Mapping[str, Any]) -> bytes:
         ax, lines = self._polar["ax"], self._polar["lines"]
-        t = self._polar_span(180.0 if state["model"] in _validate.BSDF_MODELS else 90.0)
+        t = self._polar_span(180.0 if _models.is_whole_sphere(state["model"]) else 90.0)
         theta_v, phi_v = state["view"]
         azimuth = np.array([math.cos(math.radians(phi_v)), math.sin(math.radians(phi_v))])
         wi = np.empty((t.size, 3))
         wi[:, 0], wi[:, 1], wi[:, 2] = np.sin(t) * azimuth[0], np.sin(t) * azimuth[1], np.cos(t)
         wo = _direction(theta_v, phi_v)
         values = _eval_lobes(material, wi, wo, model=state["model"], energy_compensation=state["energy_compensation"])
-        curves = {name: np.asarray(v, dtype=np.float64) @ _LUMINANCE for name, v in zip(_validate.LOBE_NAMES, values)}
+        curves = {name: np.asarray(v, dtype=np.float64) @ _LUMINANCE for name, v in zip(_models.LOBE_NAMES, values)}
         curves["total"] = cast("Float64Array", sum(curves.values()))  # (not 0: there are four lobes)
         peak = float(curves["total"].max())
         log = state["log"]
@@ -707,7 +708,7 @@ class Explorer:
     def _draw_albedo(self, material: Material, state: Mapping[str, Any]) -> bytes:
         a = self._albedo
         ax, lines = a["ax"], a["lines"]
-        sphere = state["model"] in _validate.BSDF_MODELS
+        sphere = _models.is_whole_sphere(state["model"])
         angles = _ALBEDO_ANGLES_SPHERE if sphere else _ALBEDO_ANGLES
         ax.set_xlim(0.0, 180.0 if sphere else 90.0)
         ax.set_xticks([0, 45, 90, 135, 180] if sphere else [0, 30, 60, 90])
@@ -715,7 +716,7 @@ class Explorer:
                          model=state["model"], energy_compensation=state["energy_compensation"])
         curves: dict[str, tuple[FloatArray, FloatArray]] = {"total": (result.total, result.total_error)}
         curves.update({name: (value, error) for name, value, error in
-                       zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)})
+                       zip(_models.LOBE_NAMES, result.lobes, result.lobe_errors)})
         for band in a["bands"].values():
             band.remove()
         a["bands"] = {}

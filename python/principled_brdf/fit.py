@@ -23,13 +23,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _gradient, _inert, _solver, _validate
-from ._loss_scale import log_scale, log_scales
-from ._batch import eval, eval_grad
+from . import _gradient, _inert, _models, _solver, _validate, reference
+from ._batch import eval
+from ._derivatives import eval_grad
 from ._gradient import GRADIENT_NAMES_2015
-from ._validate import BSDF_MODELS
-from .material import MAX_BSDF_SPECULAR, PARAMETERS, Material, unread_parameters
-from . import reference
+from ._loss_scale import log_scale, log_scales
+from .material import PARAMETERS, Material
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator, Mapping
@@ -135,8 +134,9 @@ def _domain(name: str, model: Model) -> tuple[float, float]:
     """A parameter's domain under ``model``: the 2015 models turn specular into an index of
     refraction, which MAX_IOR bounds."""
     info = PARAMETERS[name]
-    if name == "specular" and model in BSDF_MODELS:
-        return info.lower, MAX_BSDF_SPECULAR
+    limit = _models.max_specular(model)
+    if name == "specular" and limit < math.inf:
+        return info.lower, limit
     return info.lower, info.upper
 
 
@@ -171,7 +171,7 @@ def _parameters_in(width: int) -> dict[str, Any]:
 
 def _fitted_slots(fit: object, model: Model, width: int) -> list[int]:
     """The slots ``fit`` names (default: every parameter ``model`` reads), in the table's order."""
-    unread = unread_parameters(model)
+    unread = _models.unread_parameters(model)
     owners = [name for name, info in _parameters_in(len(GRADIENT_NAMES_2015)).items() for _ in range(info.slots)]
     if fit is None:
         return [k for k in range(width) if owners[k] not in unread]
@@ -208,7 +208,7 @@ def _cosine_factors(wi: NDArray[Any], cosine: bool, model: Model) -> Float64Arra
     for the 2015 BSDFs (as eval's cosine=True), or 1 without ``cosine``."""
     if not cosine:
         return np.ones(wi.shape[:-1])
-    return np.abs(wi[..., 2]) if model in BSDF_MODELS else np.maximum(wi[..., 2], 0.0)
+    return np.abs(wi[..., 2]) if _models.is_whole_sphere(model) else np.maximum(wi[..., 2], 0.0)
 
 
 def _residual_and_jacobian(value: Float64Array, jacobian: Float64Array, measured: Float64Array,

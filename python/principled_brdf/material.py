@@ -7,9 +7,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _color, _core
+from . import _color, _core, _models
+from ._models import MAX_BSDF_SPECULAR, MAX_IOR, unread_parameters  # noqa: F401 - principled_brdf.material's names too
 from ._segments import unexpanded
-from ._validate import BSDF_MODELS, as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
+from ._validate import as_real_array, broadcast_leading, element_name, first_true, flag, require_in_domain
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -39,19 +40,6 @@ class _ParamInfo:
 
 # Names, defaults and domains come from the C++ table (params.hpp), defined once.
 PARAMETERS = {row[0]: _ParamInfo(*row) for row in _core.PARAMETER_TABLE}
-
-# The parameters each model leaves unread, which must be at their defaults (docs/model-2015.md).
-# (the slots past the 2012 and 2014 models' derivative columns)
-_READ_BY_2015 = tuple(name for name, info in PARAMETERS.items() if info.first_slot >= _core.GRADIENT_SLOTS)
-_UNREAD_BY = {"disney2014": _READ_BY_2015, "disney2012": _READ_BY_2015, "disney2015": ("subsurface", "diff_trans"),
-              "disney2015_thin": ("subsurface",)}
-
-
-def unread_parameters(model: str) -> tuple[str, ...]:
-    """The parameters ``model`` does not read (which must stay at their defaults), e.g.
-    ``("subsurface", "diff_trans")`` for ``"disney2015"``."""
-    return _UNREAD_BY.get(model, ())
-
 
 
 def _owned_copy(array: Float64Array) -> Float64Array:
@@ -223,9 +211,10 @@ class Material:
             self._require_everywhere(name, lambda array: array == default,
                                      f"model {model!r} does not read it and needs its default {default:g} "
                                      + ("(use flatness)" if name == "subsurface" else ""))
-        if model in BSDF_MODELS:
-            self._require_everywhere("specular", lambda array: array <= MAX_BSDF_SPECULAR,
-                                     f"model {model!r} needs specular <= {MAX_BSDF_SPECULAR:.6g} "
+        limit = _models.max_specular(model)
+        if limit < np.inf:
+            self._require_everywhere("specular", lambda array: array <= limit,
+                                     f"model {model!r} needs specular <= {limit:.6g} "
                                      f"(an index of refraction up to MAX_IOR = {MAX_IOR:g})")
 
     def _require_everywhere(self, name: str, holds: Callable[[Float64Array], NDArray[np.bool_]], rule: str) -> None:
@@ -246,8 +235,8 @@ class Material:
         ``t`` is a number or a per-element mask in [0, 1], broadcast against the
         materials' leading shapes (it applies to all three channels of base_color).
         """
-        _require_material("a", a)
-        _require_material("b", b)
+        require_material("a", a)
+        require_material("b", b)
         weight = as_real_array("t", t)
         require_in_domain("t", weight, 0.0, 1.0)
         broadcast_leading(a=a.shape, b=b.shape, t=weight.shape)  # else numpy's message names no argument
@@ -307,7 +296,7 @@ class Material:
         return "Material(" + ", ".join(parts) + ")"
 
 
-def _require_material(name: str, value: object) -> Material:
+def require_material(name: str, value: object) -> Material:
     """``value``, if it is a Material; a TypeError naming the argument otherwise."""
     if not isinstance(value, Material):
         raise TypeError(f"{name}: expected a principled_brdf.Material, got {type(value).__name__}")
@@ -329,14 +318,6 @@ def specular_of_ior(ior: RealArrayLike) -> Float64Array:
 def _specular_of_eta(eta: Float64Array | float) -> Float64Array:
     return np.asarray(((eta - 1.0) / (eta + 1.0)) ** 2 / 0.08)
 
-
-# The largest index of refraction the 2015 models take (and ``ior=`` accepts): up to it
-# the float32 kernels hold the model's accuracy bounds (docs/model-2015.md). Beyond it
-# ever more of the light from inside meets the interface near the critical angle
-# (cos θc = sqrt(1 - 1/η²)), where float32 cannot decide total internal reflection
-# (from η = 20 single pairs differ by 4 %), and from specular 12.5 on η is infinite.
-MAX_IOR = 10.0
-MAX_BSDF_SPECULAR = float(_specular_of_eta(MAX_IOR))
 
 
 class BrightColorWarning(UserWarning):

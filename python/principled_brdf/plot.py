@@ -37,7 +37,7 @@ import numpy as np
 from . import presets as _presets
 from ._batch import eval as _eval
 from ._batch import eval_lobes as _eval_lobes
-from . import _color, _validate
+from . import _color, _models, _validate
 from .albedo import MAX_SAMPLES as _ALBEDO_MAX_SAMPLES
 from .albedo import albedo as _albedo
 from .material import Material
@@ -269,7 +269,7 @@ def brdf_slice(material: Material | str | _measured.MerlBRDF | Callable[..., Any
     refraction's lobe in the same coordinates.
     """
     _validate.model_index(model)
-    if _validate.flag("transmission", transmission) and model not in _validate.BSDF_MODELS:
+    if _validate.flag("transmission", transmission) and not _models.is_whole_sphere(model):
         raise ValueError(f"transmission: model {model!r} transmits nothing; use a 2015 model")
     brdf = _brdf("material", material, model)
     n = _validate.resolution("resolution", resolution)
@@ -372,7 +372,7 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
     """
     _validate.model_index(model)
     brdf = _brdf("material", material, model, cosine=_validate.flag("cosine", cosine))
-    span = 180.0 if model in _validate.BSDF_MODELS else 90.0  # the circle, or the upper half of it
+    span = 180.0 if _models.is_whole_sphere(model) else 90.0  # the circle, or the upper half of it
     theta = _validate.real_number("theta_o", theta_o, -span, span, open_upper=True, open_lower=True)
     n = _validate.resolution("resolution", resolution, unit=" angles")
     weights = _channel(channel)
@@ -387,7 +387,7 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
     wo = np.array([np.sin(np.radians(theta)), 0.0, np.cos(np.radians(theta))])
     if brdf.material is not None:
         values = _eval_lobes(brdf.material, wi, wo, cosine=cosine, model=model)
-        curves = {name: _project(v, weights) for name, v in zip(_validate.LOBE_NAMES, values)}
+        curves = {name: _project(v, weights) for name, v in zip(_models.LOBE_NAMES, values)}
         total = typing.cast("Float64Array", sum(curves.values()))  # (not 0: there are four lobes)
     else:
         curves = {}
@@ -514,7 +514,7 @@ def albedo_curves(material: Material | str | _measured.MerlBRDF | Callable[..., 
     theta = np.asarray(angles, dtype=np.float64) if not isinstance(angles, str) else None
     if theta is None or theta.ndim != 1 or theta.size < 1 or not np.all(np.isfinite(theta)):
         raise ValueError("angles: expected a 1-d array of finite angles in degrees")
-    sphere = model in _validate.BSDF_MODELS
+    sphere = _models.is_whole_sphere(model)
     last = 180.0 if sphere else 90.0
     if np.any(theta < 0.0) or np.any(theta >= last) or np.any(theta == 90.0):
         raise ValueError(f"angles: expected degrees in [0, {last:g}){' without 90' if sphere else ''}, got values "
@@ -535,7 +535,7 @@ def albedo_curves(material: Material | str | _measured.MerlBRDF | Callable[..., 
                        ("transmittance", result.transmittance, result.total_error)]
         if lobes:
             curves += [(name, value, error)
-                       for name, value, error in zip(_validate.LOBE_NAMES, result.lobes, result.lobe_errors)]
+                       for name, value, error in zip(_models.LOBE_NAMES, result.lobes, result.lobe_errors)]
     for name, value, error in curves:
         mean, band = _project(value, weights), _project(error, weights) * 2.0
         if name != "total" and not np.any(mean > 0.0):

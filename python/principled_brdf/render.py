@@ -33,7 +33,9 @@ from ._batch import random_uniforms as _random_uniforms
 from ._batch import sample as _sample
 from .environment import MAP_FORMATS as _MAP_FORMATS
 from .environment import Environment
-from .material import Material, _require_material
+from ._model_checks import model_and_mode as _model_and_mode
+from .material import Material
+from .material import require_material as _require_material
 from .procedural_environments import BUILT_IN as _BUILT_IN
 from .procedural_environments import built_in as _built_in
 
@@ -279,7 +281,7 @@ def render_environment(material: Material, resolution: int = 256, environment: _
     resolution = _validate.resolution("resolution", resolution)
     samples = _samples(samples, _pixels(material, resolution))
     if lighting is None:  # no environment, no light: a black picture, of the checked arguments' shape
-        _validate.model_and_mode(_require_material("material", material), model, "radiance", energy_compensation)
+        _model_and_mode(_require_material("material", material), model, "radiance", energy_compensation)
         shape = _validate.broadcast_leading(material=material.shape, resolution=(resolution, resolution))
         return np.zeros(shape + (3,))
     inside, to_local = sphere_frames(resolution)

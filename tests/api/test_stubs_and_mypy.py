@@ -206,7 +206,7 @@ def test_the_typing_literals_are_the_cpp_tables():
     assert _typing.Model.__args__ == tuple(_core.MODEL_NAMES)
     assert _typing.SpecularSampler.__args__ == tuple(_core.SAMPLER_NAMES)
     assert _typing.Mode.__args__ == tuple(_core.MODE_NAMES)
-    source = ast.parse((PACKAGE_DIR / "_batch.py").read_text())
+    source = ast.parse((PACKAGE_DIR / "_results.py").read_text())
     (lobe_arrays,) = [n for n in ast.walk(source) if isinstance(n, ast.ClassDef) and n.name == "_LobeArrays"]
     fields = tuple(n.target.id for n in lobe_arrays.body if isinstance(n, ast.AnnAssign)
                    and isinstance(n.target, ast.Name))

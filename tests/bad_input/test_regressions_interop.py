@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import principled_brdf as pb
-from principled_brdf import _batch, _interop
+from principled_brdf import _derivatives, _interop
 
 torch = pytest.importorskip("torch")
 jax = pytest.importorskip("jax")
@@ -229,7 +229,7 @@ def count_calls(monkeypatch, module, name):
 
 def test_jax_backward_computes_only_the_cotangents_asked_for(monkeypatch):
     by_directions = count_calls(monkeypatch, _interop, "direction_vjp")
-    by_parameters = count_calls(monkeypatch, _batch, "eval_vjp")
+    by_parameters = count_calls(monkeypatch, _derivatives, "eval_vjp")
     loss = lambda r, wi: jnp.sum(pbj.eval({"roughness": r, "metallic": 0.5}, wi, WO))  # noqa: E731
     r = jnp.float32([0.4, 0.7])
     by_r = jax.jit(jax.grad(loss))(r, WI)

@@ -254,13 +254,13 @@ def test_simd_direction_derivatives_match_the_reference(float32_direction_case, 
 
 @pytest.mark.parametrize("isa", ISAS)
 def test_the_direction_vector_jacobian_product_is_the_contraction(float32_direction_case, isa):
-    from principled_brdf import _direction_grad
+    from principled_brdf import _derivatives
 
     model, material, wi, wo, _ = float32_direction_case
     g = seeded_rng("bsdf2015-direction-vjp", isa).normal(size=wi.shape).astype(np.float32)
     for cosine in (False, True):
         jacobian = pb.eval_grad(material, wi, wo, wrt=["wi", "wo"], model=model, cosine=cosine, isa=isa).jacobian
-        by_wi, by_wo = _direction_grad.vjp(material, wi, wo, g, model=model, cosine=cosine, isa=isa)
+        by_wi, by_wo = _derivatives.direction_vjp(material, wi, wo, g, model=model, cosine=cosine, isa=isa)
         expected = np.einsum("nc,nck->nk", g.astype(np.float64), jacobian.astype(np.float64))
         bound = 4 * np.finfo(np.float32).eps * np.einsum("nc,nck->nk", np.abs(g), np.abs(jacobian))
         assert np.all(np.abs(np.concatenate([by_wi, by_wo], -1) - expected) <= bound)

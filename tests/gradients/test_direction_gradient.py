@@ -216,7 +216,7 @@ def test_direction_wrt_out_and_bad_input():
 def test_the_directions_vjp_kernel_is_the_jacobians_contraction(isa):
     """batch_eval_direction_vjp (the interop's backward pass): Σ_c g_c ∂f_c/∂w per element,
     within a few float32 roundings of the contraction of eval_grad's direction columns."""
-    from principled_brdf import _direction_grad
+    from principled_brdf import _derivatives
 
     rng = seeded_rng("direction-vjp", isa)
     n = 1003
@@ -224,10 +224,10 @@ def test_the_directions_vjp_kernel_is_the_jacobians_contraction(isa):
     m = pb.Material(**random_material_arrays(rng, n))
     g = rng.normal(size=(n, 3)).astype(np.float32)
     for cosine in (False, True):
-        by_wi, by_wo = _direction_grad.vjp(m, wi, wo, g, cosine=cosine, isa=isa)
+        by_wi, by_wo = _derivatives.direction_vjp(m, wi, wo, g, cosine=cosine, isa=isa)
         jacobian = pb.eval_grad(m, wi, wo, wrt=["wi", "wo"], cosine=cosine, isa=isa).jacobian.astype(np.float64)
         expected = np.einsum("nc,nck->nk", g.astype(np.float64), jacobian)
         bound = 4 * np.finfo(np.float32).eps * np.einsum("nc,nck->nk", np.abs(g), np.abs(jacobian))
         assert np.all(np.abs(np.concatenate([by_wi, by_wo], -1) - expected) <= bound)
-    one_g = _direction_grad.vjp(m, wi, wo, g[0], isa=isa)  # one cotangent for every element
-    np.testing.assert_array_equal(one_g[1], _direction_grad.vjp(m, wi, wo, np.broadcast_to(g[0], g.shape), isa=isa)[1])
+    one_g = _derivatives.direction_vjp(m, wi, wo, g[0], isa=isa)  # one cotangent for every element
+    np.testing.assert_array_equal(one_g[1], _derivatives.direction_vjp(m, wi, wo, np.broadcast_to(g[0], g.shape), isa=isa)[1])
