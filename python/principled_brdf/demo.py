@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _core, _validate, presets, reference
-from .albedo import albedo
+from .directional_albedo import albedo
 from ._batch import cpu_info, eval as _eval, sample as _sample
 from .benchmark import best_seconds, random_pairs
 from .material import Material

@@ -179,7 +179,7 @@ def _fit_tile(measured: np.ndarray, wi: np.ndarray, wo: np.ndarray, *, options: 
     """One tile of texels: pb.fit of its (B, N, 3) problems; the slots, the cost and success
     packed as (th, tw, P + 2) float64 (module level, so that tasks pickle by reference); an
     error names a bad texel by its index in the whole texture."""
-    from .fit import fit as _fit
+    from .fitting import fit as _fit
 
     tile = measured.shape[:-2]
     problems = measured.reshape((-1,) + measured.shape[-2:])

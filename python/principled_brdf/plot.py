@@ -38,8 +38,8 @@ from . import presets as _presets
 from ._batch import eval as _eval
 from ._batch import eval_lobes as _eval_lobes
 from . import _color, _models, _validate
-from .albedo import MAX_SAMPLES as _ALBEDO_MAX_SAMPLES
-from .albedo import albedo as _albedo
+from .directional_albedo import MAX_SAMPLES as _ALBEDO_MAX_SAMPLES
+from .directional_albedo import albedo as _albedo
 from .material import Material
 from ._gradient import DIFFERENTIABLE as _DIFFERENTIABLE
 from . import measured as _measured

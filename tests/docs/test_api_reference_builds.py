@@ -16,8 +16,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 MODULES = ["principled_brdf", "principled_brdf.reference", "principled_brdf.microfacet", "principled_brdf.frames",
            "principled_brdf.measured", "principled_brdf.synthetic", "principled_brdf.presets",
            "principled_brdf.render", "principled_brdf.environment", "principled_brdf.procedural_environments",
-           "principled_brdf.piecewise", "principled_brdf.plot", "principled_brdf.fit", "principled_brdf.albedo",
-           "principled_brdf.explorer", "principled_brdf.torch", "principled_brdf.jax"]
+           "principled_brdf.piecewise", "principled_brdf.plot", "principled_brdf.fitting",
+           "principled_brdf.directional_albedo", "principled_brdf.explorer_app", "principled_brdf.torch", "principled_brdf.jax"]
 
 
 @pytest.fixture(scope="module")

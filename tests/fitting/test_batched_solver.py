@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import principled_brdf as pb
-from principled_brdf import _core
+from principled_brdf import _core, fitting
 from principled_brdf._gradient import GRADIENT_NAMES
-from principled_brdf.fit import LOSSES
+from principled_brdf.fitting import LOSSES
 from conftest import random_direction_pairs, seeded_rng
 
 TRUTH = dict(base_color=(0.7, 0.3, 0.1), metallic=0.2, subsurface=0.3, specular=0.6, specular_tint=0.3, roughness=0.35,
@@ -127,7 +127,7 @@ def test_the_float64_paths_normal_equations_are_numpys():
     columns = [0, 1, 2, 7, 12]
     for loss in ("linear", "log"):
         gain = np.array([1.0, 0.25])
-        equations = _solver.float64_equations(pb.fit.__globals__["_material_of"], wi, wo, target, scale, gain, rows,
+        equations = _solver.float64_equations(fitting._material_of, wi, wo, target, scale, gain, rows,
                                               columns, np.arange(count), LOSS_CODES[loss], True, "disney2014")
         got = equations.evaluate(np.arange(count), rows[:, columns])
         expected = numpy_normal_equations(rows, wi, wo, target, scale, columns, loss, True, gain)
@@ -263,11 +263,9 @@ def test_the_batched_method_leaves_blas_alone(monkeypatch):
 
 def test_a_texture_solved_in_parts_is_the_texture_solved_at_once(monkeypatch):
     """fit takes a large batch a few million samples at a time: the parts give the same bits."""
-    import sys
-
     wi, wo, measured, _ = texels(count=5, n=100, key="parts")
     whole = pb.fit(wi, wo, measured, fit=FITTED)
-    monkeypatch.setattr(sys.modules["principled_brdf.fit"], "_batch_problems", lambda pairs: 2)
+    monkeypatch.setattr(fitting, "_batch_problems", lambda pairs: 2)
     parts = pb.fit(wi, wo, measured, fit=FITTED)
     np.testing.assert_array_equal(parts.slots, whole.slots)
     np.testing.assert_array_equal(parts.cost, whole.cost)

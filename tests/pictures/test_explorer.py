@@ -8,7 +8,6 @@ the call says what to install.
 
 from __future__ import annotations
 
-import importlib
 import io
 import struct
 import sys
@@ -24,8 +23,8 @@ import ipywidgets  # noqa: E402 - a test extra: a missing one fails here, it is 
 import matplotlib.image as mpimg  # noqa: E402
 
 import principled_brdf as pb  # noqa: E402
+from principled_brdf import explorer_app as explorer_module  # noqa: E402 - pb.explorer is the function
 
-explorer_module = importlib.import_module("principled_brdf.explorer")  # pb.explorer is the function
 OUTPUTS = ("sphere", "polar", "slice", "albedo")
 
 

@@ -55,7 +55,7 @@ from . import presets as _presets
 from . import render as _render
 from ._batch import FLOAT32_LIMITS as _KERNEL_LIMITS
 from ._batch import eval_lobes as _eval_lobes
-from .albedo import albedo as _albedo
+from .directional_albedo import albedo as _albedo
 from ._models import unread_parameters
 from .material import PARAMETERS, Material, srgb_to_linear
 from .plot import _LOBE_COLORS as _PLOT_LOBE_COLORS
@@ -780,7 +780,7 @@ class Explorer:
 
 
 def explorer(material: Material | str | None = None, *, model: Model = "disney2014", resolution: int = 192) -> Explorer:
-    """An interactive BRDF explorer for Jupyter (module :mod:`principled_brdf.explorer`).
+    """An interactive BRDF explorer for Jupyter (module :mod:`principled_brdf.explorer_app`).
 
     ``material``: the starting material (a uniform Material or a preset name;
     default ``pb.Material()``, the BRDF Explorer's defaults), ``model``:
