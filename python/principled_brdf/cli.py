@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _core
+from . import _models
 from ._batch import FLOAT32_LIMITS
 from .material import PARAMETERS, Material
 from .environment import MAP_FORMATS
@@ -321,7 +321,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="the tone curve of a PNG (default filmic; EXR and NPY stay linear)")
     render.add_argument("--energy-compensation", action=argparse.BooleanOptionalAction, default=False,
                         help="add the multiple-scattering lobe of rough metals (default off)")
-    render.add_argument("--model", choices=tuple(_core.MODEL_NAMES), default="disney2014",
+    render.add_argument("--model", choices=_models.MODEL_NAMES, default=_models.DEFAULT_MODEL,
                         help="disney2014 (default), disney2012, or the 2015 BSDF: disney2015 (a solid sphere, light "
                              "refracted through it), disney2015_thin (a thin shell)")
     render.add_argument("--output", required=True, type=_image_path(tuple(IMAGE_FORMATS)),
