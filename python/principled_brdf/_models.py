@@ -17,9 +17,9 @@ if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
     from typing import Any
 
-__all__ = ["MODEL_NAMES", "DEFAULT_MODEL", "PARAMETER_NAMES", "LOBE_NAMES", "SAMPLED_LOBE_NAMES", "MAX_IOR", "ModelRules", "RULES",
-           "WHOLE_SPHERE_MODELS", "MAX_BSDF_SPECULAR", "is_whole_sphere", "unread_parameters", "gradient_names",
-           "slot_names", "offers_energy_compensation", "max_specular"]
+__all__ = ["MODEL_NAMES", "DEFAULT_MODEL", "PARAMETER_NAMES", "LOBE_NAMES", "SAMPLED_LOBE_NAMES", "ModelRules",
+           "RULES", "WHOLE_SPHERE_MODELS", "MAX_IOR", "MAX_BSDF_SPECULAR", "is_whole_sphere", "unread_parameters",
+           "offers_energy_compensation", "max_specular", "slot_names", "gradient_names"]
 
 # The C++ side's name tables (params.hpp), each in its enum's order.
 MODEL_NAMES: tuple[str, ...] = tuple(_core.MODEL_NAMES)

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _core
+from . import _core, _float64
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -212,8 +212,6 @@ def float64_equations(material_of: Callable[[Float64Array], Any], wi: NDArray[An
                       chunk_bytes: int = 1 << 26) -> NormalEquations:
     """The normal equations from the float64 reference's Jacobian, reduced by
     numpy a few problems at a time (each problem's sums over its own pairs)."""
-    from . import reference
-
     slots = np.array(full_start, dtype=np.float64)
     fitted_index = np.asarray(fitted, dtype=np.int64)
     pairs = target.shape[1]
@@ -231,8 +229,8 @@ def float64_equations(material_of: Callable[[Float64Array], Any], wi: NDArray[An
         for begin in range(0, len(rows), chunk):
             part = rows[begin:begin + chunk]
             material = material_of(slots[part]).reshape(len(part), 1)
-            g = reference.eval_grad(material, wi[part] if per_problem else wi, wo[part] if per_problem else wo,
-                                    model=model, cosine=cosine)
+            g = _float64.parameter_grad(material, wi[part] if per_problem else wi, wo[part] if per_problem else wo,
+                                        model=model, cosine=cosine)
             f, jacobian = g.value * gain[part][:, None, None], g.jacobian[..., fitted] * gain[part][:, None, None, None]
             t, s = target[part], scale[part]
             if loss == 1:
