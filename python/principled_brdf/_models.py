@@ -92,6 +92,7 @@ def _rules(table: Sequence[Mapping[str, Any]]) -> dict[str, ModelRules]:
     return rules
 
 
+# The extension's model table; the same rules from Python's constants for an extension built without it.
 RULES: dict[str, ModelRules] = _rules(getattr(_core, "MODEL_TABLE", None) or _table_from_python_constants())
 DEFAULT_MODEL = MODEL_NAMES[0]
 # The models of the whole sphere (the 2015 BSDF of a solid and of a thin sheet); the others are BRDFs.
