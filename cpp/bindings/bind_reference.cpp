@@ -22,6 +22,36 @@ namespace principled_brdf::bindings {
 
 using Float64Array = py::array_t<double, py::array::c_style>;
 
+namespace {
+
+// The names of the members of `set` among `names`, in their order.
+template <std::size_t N>
+py::tuple names_in(BitSet set, const std::array<const char*, N>& names) {
+    py::list members;
+    for (std::size_t k = 0; k < N; ++k)
+        if (contains(set, static_cast<int>(k))) members.append(names[k]);
+    return py::tuple(members);
+}
+
+// A row of the model table as Python reads it (python/principled_brdf/_models.py).
+py::dict model_row(const ModelRow& row) {
+    std::array<const char*, kParams.size()> parameter_names{};
+    for (std::size_t k = 0; k < kParams.size(); ++k) parameter_names[k] = kParams[k].name;
+    py::dict d;
+    d["name"] = row.name;
+    d["whole_sphere"] = row.whole_sphere;
+    d["reads"] = names_in(row.reads, parameter_names);
+    d["gradient_slots"] = row.gradient_slots;
+    d["lobes"] = names_in(row.lobes, kLobeNames);
+    d["sampled_lobes"] = names_in(row.sampled_lobes, kSampledLobeNames);
+    d["energy_compensation"] = row.energy_table != kNoEnergyTable;
+    d["max_ior"] = row.max_ior;
+    d["max_specular"] = max_specular(row);
+    return d;
+}
+
+}  // namespace
+
 void bind_params(py::module_& m) {
     py::list table;
     for (const ParamInfo& info : kParams) {
@@ -36,7 +66,13 @@ void bind_params(py::module_& m) {
         for (std::size_t i = 0; i < table.size(); ++i) tuple[i] = table[i];
         return tuple;
     };
-    m.attr("MODEL_NAMES") = names(kModelNames);
+    py::tuple model_names(kModels.size()), model_table(kModels.size());
+    for (std::size_t i = 0; i < kModels.size(); ++i) {
+        model_names[i] = kModels[i].name;
+        model_table[i] = model_row(kModels[i]);
+    }
+    m.attr("MODEL_NAMES") = model_names;
+    m.attr("MODEL_TABLE") = model_table;
     m.attr("LOBE_NAMES") = names(kLobeNames);
     m.attr("SAMPLED_LOBE_NAMES") = names(kSampledLobeNames);
     m.attr("SAMPLER_NAMES") = names(kSpecularSamplerNames);

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "principled_brdf/batch.hpp"
-#include "principled_brdf/params.hpp"
+#include "principled_brdf/model_table.hpp"
 
 namespace principled_brdf::bindings {
 
@@ -21,7 +21,12 @@ Enum enum_from(int index, const std::array<const char*, N>& names, const char* w
     return static_cast<Enum>(index);
 }
 
-inline Model model_from(int index) { return enum_from<Model>(index, kModelNames, "model"); }
+// An index into MODEL_NAMES (the model table's order) as its model.
+inline Model model_from(int index) {
+    if (index < 0 || index >= static_cast<int>(kModels.size()))
+        throw std::invalid_argument("model: expected an index below " + std::to_string(kModels.size()));
+    return kModels[index].model;
+}
 inline TransportMode mode_from(int index) { return enum_from<TransportMode>(index, kTransportModeNames, "mode"); }
 inline SpecularSampler sampler_from(int index) {
     return enum_from<SpecularSampler>(index, kSpecularSamplerNames, "specular_sampler");

@@ -9,10 +9,10 @@ struct CornerTables {
     alignas(64) float values[2][kRoughnesses * kIntervals * kCorners] = {};
 
     CornerTables() {
-        for (int model = 0; model < 2; ++model)
+        for (int table = 0; table < 2; ++table)
             for (int at = 0; at < (kRoughnesses - 1) * kIntervals; ++at)
                 for (int c = 0; c < kCorners; ++c)
-                    values[model][kCorners * at + c] = kMissing[model][2 * at + (c & 1) + (c >> 1) * 2 * kIntervals];
+                    values[table][kCorners * at + c] = kMissing[table][2 * at + (c & 1) + (c >> 1) * 2 * kIntervals];
     }
 };
 

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "principled_brdf/params.hpp"  // Model
+#include "principled_brdf/model_table.hpp"
 
 namespace principled_brdf::energy {
 namespace {
@@ -18,7 +18,7 @@ struct InterceptTable {
     alignas(64) float values[kRoughnesses * kIntervals * 2] = {};
 
     InterceptTable() {
-        const float* missing = kMissing[static_cast<int>(Model::kDisney2014)];
+        const float* missing = kMissing[row_of(Model::kDisney2014).energy_table];
         for (int at = 0; at < kRoughnesses * kIntervals; ++at) {
             const double value = missing[2 * at], slope = missing[2 * at + 1];
             values[2 * at] = static_cast<float>(value - cosine_at(at % kIntervals + 1) * slope);

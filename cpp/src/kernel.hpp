@@ -51,10 +51,8 @@ constexpr std::int64_t kLanes = static_cast<std::int64_t>(Floats::size);
 #include "kernel_sampling.hpp"
 #include "kernel_direction_gradient.hpp"
 #include "kernel_eval.hpp"
-#include "kernel_eval2015.hpp"
 #include "kernel_normal.hpp"
 #include "kernel_sample.hpp"
-#include "kernel_sample2015.hpp"
 
 }  // namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS
 

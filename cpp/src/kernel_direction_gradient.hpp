@@ -1,6 +1,6 @@
 // Part of kernel.hpp, included inside the per-arch namespace: one batch of the
 // derivatives of f in the directions (model/direction_gradient.hpp), for the
-// evaluation loops of kernel_eval.hpp and kernel_eval2015.hpp: the Jacobian's
+// evaluation loop of kernel_eval.hpp: the Jacobian's
 // 18 values an element (Output::kDirectionGradient) or their products with a
 // cotangent (Output::kDirectionVjp).
 //

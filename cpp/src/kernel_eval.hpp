@@ -8,23 +8,23 @@
 struct NoPartials {};
 
 // The outputs that take derivatives in the parameters: the Jacobian and the vector-Jacobian product.
-constexpr bool differentiates(Output output) { return output == Output::kGradient || output == Output::kVjp; }
+constexpr bool in_parameters(Output output) { return output == Output::kGradient || output == Output::kVjp; }
 // The outputs with a Jacobian or a product in `jacobian` (in the parameters or in the directions).
-constexpr bool has_jacobian(Output output) { return differentiates(output) || in_directions(output); }
+constexpr bool has_jacobian(Output output) { return in_parameters(output) || in_directions(output); }
 // The outputs that read a cotangent.
 constexpr bool is_vjp(Output output) { return output == Output::kVjp || output == Output::kDirectionVjp; }
 
 template <Output output>
 struct Prepared {
     Shading<Floats> shading;
-    std::conditional_t<differentiates(output), MaterialPartials<Floats>, NoPartials> partials;
+    std::conditional_t<in_parameters(output), MaterialPartials<Floats>, NoPartials> partials;
     std::conditional_t<in_directions(output), DirectionShading, NoPartials> directions;
 };
 
 template <Output output>
 PB_KERNEL_INLINE Prepared<output> prepare(const RawMaterial& m) {
     // built in place: assigning into a default-constructed one would copy the whole Shading per batch
-    if constexpr (differentiates(output)) {
+    if constexpr (in_parameters(output)) {
         return {shading_of(m), material_partials_of(m.slot), NoPartials{}};
     } else if constexpr (in_directions(output)) {
         return {shading_of(m), NoPartials{}, halves_of(m, [](const Doubles* p) {
@@ -48,12 +48,35 @@ struct CompensatedPrepared : Prepared<output> {
     MultipleScatteringLobe<Floats> ms;
 };
 
-template <Output output, bool compensated>
-using PreparedOf = std::conditional_t<compensated, CompensatedPrepared<output>, Prepared<output>>;
+// The 2015 models' (model/bsdf2015.hpp): their constants, over dual numbers for
+// the derivatives in the parameters (with their tangents) or, for those in
+// the directions, over dual numbers of double without tangents as well.
+struct DirectionShading2015 {
+    Shading2015<Floats> shading;
+    Halves<Shading2015<PassDual<Doubles>>> directions;
+};
+
+template <Output output>
+using Prepared2015 = std::conditional_t<in_parameters(output), GradientShading2015<Floats>,
+                                        std::conditional_t<in_directions(output), DirectionShading2015, Shading2015<Floats>>>;
+
+// What a batch of `model` needs of its material.
+template <Model model, Output output, bool compensated>
+using PreparedOf = std::conditional_t<is_bsdf(model), Prepared2015<output>,
+                                      std::conditional_t<compensated, CompensatedPrepared<output>, Prepared<output>>>;
 
 template <Model model, Output output, bool compensated>
-PB_KERNEL_INLINE PreparedOf<output, compensated> prepare_for(const RawMaterial& m) {
-    if constexpr (compensated) {
+PB_KERNEL_INLINE PreparedOf<model, output, compensated> prepare_for(const RawMaterial& m) {
+    static_assert(!compensated || has_energy_table(model), "the energy compensation needs the model's table");
+    constexpr bool thin = model == Model::kDisney2015Thin;
+    if constexpr (is_bsdf(model) && in_parameters(output)) {
+        return gradient_shading2015_of(m.slot, thin);
+    } else if constexpr (is_bsdf(model) && in_directions(output)) {
+        return DirectionShading2015{shading2015_of(m.slot, thin),
+                                    halves_of(m, [&](const Doubles* p) { return constant_shading2015_of(p, thin); })};
+    } else if constexpr (is_bsdf(model)) {
+        return shading2015_of(m.slot, thin);
+    } else if constexpr (compensated) {
         Shading<Floats> s = shading_of(m);
         return {{s, NoPartials{}, NoPartials{}}, multiple_scattering_of(m.slot, s, model)};
     } else {
@@ -162,13 +185,7 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
     if constexpr (output == Output::kPdf) return;
     LobeValues<Floats> values = eval_lobes<model, lobes>(g, s, view);
     if constexpr (output == Output::kLobes) {
-        store_rgb<layouts>(job.out[0], i, masked(values.diffuse_rgb(s)));
-        store_rgb<layouts>(job.out[1], i, masked(values.sheen_rgb(s)));
-        store_rgb<layouts>(job.out[2], i, masked(values.specular_rgb(s)));
-        store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
-        store_rgb<layouts>(job.out[4], i, masked(ms.rgb(multiple_scattering)));
-        store_rgb<layouts>(job.out[5], i, zero);
-        store_rgb<layouts>(job.out[6], i, zero);
+        store_lobes<layouts>(job.out, i, values.colors(s, ms.rgb(multiple_scattering)), masked);
     } else if constexpr (output != Output::kPdf) {
         store_rgb<layouts, true>(job.out[0], i, masked(ms.added_to(values.template total<lobes>(s), multiple_scattering)));
     }
@@ -176,7 +193,7 @@ PB_KERNEL_INLINE void eval_compensated_batch(const EvalJob& job, std::int64_t i,
 
 template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes = LobeSet::kAll>
 PB_KERNEL_INLINE void eval_values_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
-                                        const PreparedOf<output, compensated>& material) {
+                                        const PreparedOf<model, output, compensated>& material) {
     if constexpr (compensated) {
         eval_compensated_batch<model, output, layouts, lobes>(job, i, wi, wo, material.shading, material.ms);
         return;
@@ -186,7 +203,7 @@ PB_KERNEL_INLINE void eval_values_batch(const EvalJob& job, std::int64_t i, cons
     // select discards whatever the formulas gave below the surface (H may be 0)
     Mask above = above_surface(g);
     View<Floats> view = view_of<model, lobes>(wo, s);
-    if constexpr (differentiates(output)) {
+    if constexpr (in_parameters(output)) {
         // x cos θl or x times 1 (the same bits), then 0 below the surface
         Floats cosine_weight = job.cosine ? wi.z : Floats(1.0f);
         auto masked = [&](Floats x) { return select(above, cosine_weight * x, Floats(0.0f)); };
@@ -209,24 +226,47 @@ PB_KERNEL_INLINE void eval_values_batch(const EvalJob& job, std::int64_t i, cons
         Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
         auto masked = [&](Rgb<Floats> c) { return select(above, job.cosine ? wi.z * c : c, zero); };
         if constexpr (output == Output::kLobes) {
-            store_rgb<layouts>(job.out[0], i, masked(values.diffuse_rgb(s)));
-            store_rgb<layouts>(job.out[1], i, masked(values.sheen_rgb(s)));
-            store_rgb<layouts>(job.out[2], i, masked(values.specular_rgb(s)));
-            store_rgb<layouts>(job.out[3], i, masked(values.clearcoat_rgb()));
-            store_rgb<layouts>(job.out[4], i, zero);
-            store_rgb<layouts>(job.out[5], i, zero);
-            store_rgb<layouts>(job.out[6], i, zero);
+            store_lobes<layouts>(job.out, i, values.colors(s, zero), masked);
         } else {
             store_rgb<layouts, true>(job.out[0], i, masked(values.template total<lobes>(s)));
         }
     }
 }
 
+PB_KERNEL_INLINE Floats absolute(Floats x) { return xsimd::abs(x); }
+
+// A batch of the 2015 models (model/bsdf2015.hpp): every output over the whole
+// sphere, the cosine as |cos θl|.
+template <Output output, Layouts layouts, LobeSet lobes>
+PB_KERNEL_INLINE void eval_bsdf_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
+                                      const Prepared2015<output>& s) {
+    auto weighted = [&](const Rgb<Floats>& c) { return job.cosine ? absolute(wi.z) * c : c; };
+    if constexpr (in_parameters(output)) {
+        derivative_batch<output == Output::kGradient, JacobianStore<layouts>, VjpSink<layouts>, layouts>(
+                job, i, [&](auto& target) { return eval_gradient2015(wi, wo, s, job.mode, job.cosine, target); });
+    } else if constexpr (in_directions(output)) {
+        auto differentiate = [&](int half, const Vec3<Doubles>& w_i, const Vec3<Doubles>& w_o, auto& jacobian) {
+            return eval_direction_gradient2015(w_i, w_o, s.directions[half], job.mode, job.cosine, jacobian);
+        };
+        auto value = [&] { return weighted(eval2015(wi, wo, s.shading, job.mode)); };  // as f alone
+        direction_batch<output, layouts>(job, i, wi, wo, differentiate, value);
+    } else if constexpr (output == Output::kLobes) {
+        store_lobes<layouts>(job.out, i, eval_lobes2015(wi, wo, s, job.mode).colors(), weighted);
+    } else {
+        if constexpr (output == Output::kPdf || output == Output::kValuePdf)
+            pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
+        if constexpr (output != Output::kPdf)
+            store_rgb<layouts, true>(job.out[0], i, weighted(eval2015<lobes>(wi, wo, s, job.mode)));
+    }
+}
+
 // One batch at i of any output.
 template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes = LobeSet::kAll>
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
-                                 const PreparedOf<output, compensated>& material) {
-    if constexpr (in_directions(output)) {
+                                 const PreparedOf<model, output, compensated>& material) {
+    if constexpr (is_bsdf(model)) {
+        eval_bsdf_batch<output, layouts, lobes>(job, i, wi, wo, material);
+    } else if constexpr (in_directions(output)) {
         eval_direction_batch<model, output, layouts>(job, i, wi, wo, material.shading, material.directions);
     } else {
         eval_values_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, material);
@@ -239,21 +279,31 @@ constexpr bool has_lobe_sets(Output output) { return output == Output::kTotal ||
 
 // The lobes a material needs, from its values (LobeSet's conditions): a
 // uniform one's once per call, a batch's when all its lanes agree. The
-// clearcoat first: a batch of random materials is done after one test.
-template <class Value, class Condition>
+// clearcoat first: a batch of random materials is done after one test. In
+// the 2015 models the diffuse, the sheen and the diffuse transmission are 0
+// for a metal and for a material whose light all meets the interface
+// (spec_trans 1), and the subsurface is not read.
+template <Model model, class Value, class Condition>
 PB_KERNEL_INLINE LobeSet lobe_set_where(Value value, Condition holds) {
     if (!holds(value(kClearcoat) == 0.0f)) return LobeSet::kAll;
+    if constexpr (is_bsdf(model)) {
+        if (holds((value(kMetallic) == 1.0f) | (value(kSpecTrans) == 1.0f))) return LobeSet::kSpecular;
+        if (holds(value(kSheen) == 0.0f)) return LobeSet::kPlain;
+        return LobeSet::kAll;
+    }
     if (holds(value(kMetallic) == 1.0f)) return LobeSet::kSpecular;
     if (holds((value(kSheen) == 0.0f) & (value(kSubsurface) == 0.0f))) return LobeSet::kPlain;
     return LobeSet::kAll;
 }
 
-inline LobeSet lobe_set_of(const ParamSlot* params) {
-    return lobe_set_where([&](Param slot) { return params[slot].value; }, [](bool b) { return b; });
+template <Model model>
+LobeSet lobe_set_of(const ParamSlot* params) {
+    return lobe_set_where<model>([&](Param slot) { return params[slot].value; }, [](bool b) { return b; });
 }
 
+template <Model model>
 PB_KERNEL_INLINE LobeSet lobe_set_of(const RawMaterial& m) {
-    return lobe_set_where([&](Param slot) { return m.slot[slot]; }, [](const Mask& b) { return all(b); });
+    return lobe_set_where<model>([&](Param slot) { return m.slot[slot]; }, [](const Mask& b) { return all(b); });
 }
 
 // true unless the direction check is on and its fast test does not accept every lane
@@ -264,7 +314,7 @@ PB_KERNEL_INLINE bool accepted(const EvalJob& job, const Vec3<Floats>& wi, const
 // One batch at i; false, with nothing stored, when the fast direction test
 // does not accept it.
 template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes>
-PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const PreparedOf<output, compensated>& uniform) {
+PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const PreparedOf<model, output, compensated>& uniform) {
     Vec3<Floats> wi = load_vec3<layouts>(job.wi, i);
     Vec3<Floats> wo = load_vec3<layouts>(job.wo, i);
     if (!accepted(job, wi, wo)) return false;
@@ -274,7 +324,7 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
         Shading<Floats> s = shading_of(m);
         MultipleScatteringLobe<Floats> ms = multiple_scattering_of(m.slot, s, model);
         if constexpr (has_lobe_sets(output)) {  // the batch's LobeSet, as below
-            switch (lobe_set_of(m)) {
+            switch (lobe_set_of<model>(m)) {
                 case LobeSet::kSpecular:
                     eval_compensated_batch<model, output, layouts, LobeSet::kSpecular>(job, i, wi, wo, s, ms);
                     return true;
@@ -289,18 +339,18 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
     } else if constexpr (per_element && has_lobe_sets(output)) {
         // the batch's LobeSet, when all its lanes agree (a texture's metal or plastic regions)
         RawMaterial m = load_material(job.params, i);
-        switch (lobe_set_of(m)) {
+        switch (lobe_set_of<model>(m)) {
             case LobeSet::kSpecular:
-                eval_batch<model, output, layouts, false, LobeSet::kSpecular>(job, i, wi, wo, prepare<output>(m));
+                eval_batch<model, output, layouts, false, LobeSet::kSpecular>(job, i, wi, wo, prepare_for<model, output, false>(m));
                 break;
             case LobeSet::kPlain:
-                eval_batch<model, output, layouts, false, LobeSet::kPlain>(job, i, wi, wo, prepare<output>(m));
+                eval_batch<model, output, layouts, false, LobeSet::kPlain>(job, i, wi, wo, prepare_for<model, output, false>(m));
                 break;
             default:
-                eval_batch<model, output, layouts, false>(job, i, wi, wo, prepare<output>(m));
+                eval_batch<model, output, layouts, false>(job, i, wi, wo, prepare_for<model, output, false>(m));
         }
     } else if constexpr (per_element) {
-        eval_batch<model, output, layouts, compensated>(job, i, wi, wo, prepare<output>(load_material(job.params, i)));
+        eval_batch<model, output, layouts, compensated>(job, i, wi, wo, prepare_for<model, output, false>(load_material(job.params, i)));
     } else {
         eval_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, uniform);
     }
@@ -314,7 +364,7 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
 // roots and divisions among them) is longer than the out-of-order window
 // can cover with the next batch's work when the batches come one per step.
 template <Model model, Output output, Layouts layouts, bool compensated, LobeSet lobes>
-PB_KERNEL_INLINE std::int64_t eval_two_batches(const EvalJob& job, std::int64_t i, const PreparedOf<output, compensated>& uniform) {
+PB_KERNEL_INLINE std::int64_t eval_two_batches(const EvalJob& job, std::int64_t i, const PreparedOf<model, output, compensated>& uniform) {
     Vec3<Floats> wi = load_vec3<layouts>(job.wi, i), wo = load_vec3<layouts>(job.wo, i);
     Vec3<Floats> next_wi = load_vec3<layouts>(job.wi, i + kLanes), next_wo = load_vec3<layouts>(job.wo, i + kLanes);
     if (!accepted(job, wi, wo)) return i;
@@ -363,7 +413,7 @@ bool eval_tail(const EvalJob& job, const Padding& pad, const OneBatch& one_batch
 // batch the fast direction test did not accept (see run_checked).
 template <Model model, Output output, bool per_element, Layouts layouts, bool compensated, LobeSet lobes>
 std::int64_t eval_batches(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    PreparedOf<output, compensated> uniform{};
+    PreparedOf<model, output, compensated> uniform{};
     BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
         uniform = prepare_for<model, output, compensated>(load_material(job.params, 0));
@@ -442,7 +492,9 @@ std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t
                        ? eval_checked<model, output, per_element, Layouts::kInterleaved, true, lobes>(job, begin, end)
                        : eval_checked<model, output, per_element, Layouts::kMixed, true, lobes>(job, begin, end);
     }
-    if constexpr (in_directions(output)) {  // one loop for every layout: the loads are a small part of a batch
+    // one loop for every layout where the loads are a small part of a batch: the derivatives in the
+    // directions, and the 2015 models' outputs but f alone (the fewer loops, the shorter the build)
+    if constexpr (in_directions(output) || (is_bsdf(model) && output != Output::kTotal)) {
         return eval_checked<model, output, per_element, Layouts::kMixed, false, lobes>(job, begin, end);
     }
     switch (layouts_of(job)) {
@@ -461,7 +513,7 @@ template <Model model, Output output, bool compensated = false>
 std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     if (!job.uniform_material()) return eval_range_for<model, output, true, compensated>(job, begin, end);
     if constexpr (has_lobe_sets(output)) {
-        switch (lobe_set_of(job.params)) {
+        switch (lobe_set_of<model>(job.params)) {
             case LobeSet::kSpecular: return eval_range_for<model, output, false, compensated, LobeSet::kSpecular>(job, begin, end);
             case LobeSet::kPlain: return eval_range_for<model, output, false, compensated, LobeSet::kPlain>(job, begin, end);
             default: break;
@@ -470,49 +522,24 @@ std::int64_t eval_range_for(const EvalJob& job, std::int64_t begin, std::int64_t
     return eval_range_for<model, output, false, compensated>(job, begin, end);
 }
 
-// The energy compensation's loops: every output but the derivatives (the bindings refuse them).
-template <Output output>
-std::int64_t eval_compensated_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, output, true>(job, begin, end)
-                                           : eval_range_for<Model::kDisney2014, output, true>(job, begin, end);
+// One model's loops for one output: with the energy compensation where the
+// model has its table and the output is not a derivative (the bindings refuse
+// those), else the plain ones. The BRDFs' sampling pdf does not depend on
+// their masking term: one loop serves both.
+template <Model model, Output output>
+std::int64_t eval_model_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+    if constexpr (has_energy_table(model) && !has_jacobian(output)) {
+        if (job.energy_compensation) return eval_range_for<model, output, true>(job, begin, end);
+    }
+    if constexpr (output == Output::kPdf && !is_bsdf(model)) {
+        return eval_range_for<Model::kDisney2014, output>(job, begin, end);
+    } else {
+        return eval_range_for<model, output>(job, begin, end);
+    }
 }
 
-// The 2015 solid's loops (kernel_eval2015.hpp).
-inline std::int64_t eval2015_range(const EvalJob& job, std::int64_t begin, std::int64_t end);
-
 inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
-    if (is_bsdf(job.model)) return eval2015_range(job, begin, end);
-    if (job.energy_compensation && !has_jacobian(job.output)) {
-        switch (job.output) {
-            case Output::kPdf: return eval_compensated_range<Output::kPdf>(job, begin, end);
-            case Output::kValuePdf: return eval_compensated_range<Output::kValuePdf>(job, begin, end);
-            case Output::kLobes: return eval_compensated_range<Output::kLobes>(job, begin, end);
-            default: return eval_compensated_range<Output::kTotal>(job, begin, end);
-        }
-    }
-    switch (job.output) {
-        case Output::kPdf:  // the pdf does not depend on the model
-            return eval_range_for<Model::kDisney2014, Output::kPdf>(job, begin, end);
-        case Output::kValuePdf:
-            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kValuePdf>(job, begin, end)
-                                                   : eval_range_for<Model::kDisney2014, Output::kValuePdf>(job, begin, end);
-        case Output::kGradient:
-            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kGradient>(job, begin, end)
-                                                   : eval_range_for<Model::kDisney2014, Output::kGradient>(job, begin, end);
-        case Output::kVjp:
-            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kVjp>(job, begin, end)
-                                                   : eval_range_for<Model::kDisney2014, Output::kVjp>(job, begin, end);
-        case Output::kDirectionGradient:
-            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kDirectionGradient>(job, begin, end)
-                                                   : eval_range_for<Model::kDisney2014, Output::kDirectionGradient>(job, begin, end);
-        case Output::kDirectionVjp:
-            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kDirectionVjp>(job, begin, end)
-                                                   : eval_range_for<Model::kDisney2014, Output::kDirectionVjp>(job, begin, end);
-        case Output::kLobes:
-            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kLobes>(job, begin, end)
-                                                   : eval_range_for<Model::kDisney2014, Output::kLobes>(job, begin, end);
-        default:
-            return job.model == Model::kDisney2012 ? eval_range_for<Model::kDisney2012, Output::kTotal>(job, begin, end)
-                                                   : eval_range_for<Model::kDisney2014, Output::kTotal>(job, begin, end);
-    }
+    return with_model(job.model, [&](auto model) {
+        return with_output(job.output, [&](auto output) { return eval_model_range<model(), output()>(job, begin, end); });
+    });
 }

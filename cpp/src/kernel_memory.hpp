@@ -46,6 +46,13 @@ PB_KERNEL_INLINE void store_rgb(const MutableVec3Array& a, std::int64_t i, const
     }
 }
 
+// f's lobes (or their shares of a sample's weight) in kLobeNames' order, each through `weighted`.
+template <Layouts layouts, class Weighted>
+PB_KERNEL_INLINE void store_lobes(const MutableVec3Array* out, std::int64_t i, const LobeColors<Floats>& lobes,
+                                  const Weighted& weighted) {
+    for (int k = 0; k < kLobeCount; ++k) store_rgb<layouts>(out[k], i, weighted(lobes[k]));
+}
+
 // One batch at i of a derivative output: with `jacobian`, the Jacobian (a Store)
 // written beside f; else the cotangent's products (a Sink) alone.
 // `differentiate(target)` runs the forward pass into either and returns f.

@@ -18,10 +18,34 @@ struct Chosen {
     Floats fv;
 };
 
+// The 2015 models' first stage (model/bsdf2015.hpp's choose2015).
+struct Chosen2015Batch {
+    Vec3<Floats> wo;
+    Uniforms<Floats> u;
+    Chosen2015<Floats> chosen;
+};
+
+// What passes between the stages of a batch of `model`, and the material's constants.
+template <Model model>
+using ChosenOf = std::conditional_t<is_bsdf(model), Chosen2015Batch, Chosen>;
+template <Model model>
+using DrawnOf = std::conditional_t<is_bsdf(model), Drawn2015<Floats>, Direction<Floats>>;
+template <Model model>
+using SamplingShading = std::conditional_t<is_bsdf(model), Shading2015<Floats>, Shading<Floats>>;
+
+template <Model model>
+PB_KERNEL_INLINE SamplingShading<model> sampling_shading_of(const RawMaterial& m) {
+    if constexpr (is_bsdf(model)) {
+        return shading2015_of(m.slot, model == Model::kDisney2015Thin);
+    } else {
+        return shading_of(m);
+    }
+}
+
 // wo and the uniforms (given or counter-based); false, with nothing loaded,
 // when the fast direction test does not accept wo
-template <Layouts layouts>
-PB_KERNEL_INLINE bool load_inputs(const SampleJob& job, std::int64_t i, const CounterSeed& seed, Chosen& c) {
+template <Layouts layouts, class Batch>
+PB_KERNEL_INLINE bool load_inputs(const SampleJob& job, std::int64_t i, const CounterSeed& seed, Batch& c) {
     c.wo = load_vec3<layouts>(job.wo, i);
     if (job.check.enabled && !all(surely_unit_length(c.wo, job.check))) return false;
     if (job.u.data != nullptr) {
@@ -41,14 +65,24 @@ PB_KERNEL_INLINE void choose_lobe_for(Chosen& c, const Shading<Floats>& s) {
 
 // false, with nothing computed, when the fast direction test does not accept wo
 template <Model model, Layouts layouts>
-PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed, Chosen& c) {
+PB_KERNEL_INLINE bool choose(const SampleJob& job, std::int64_t i, const SamplingShading<model>& s, const CounterSeed& seed,
+                             ChosenOf<model>& c) {
     if (!load_inputs<layouts>(job, i, seed, c)) return false;
-    choose_lobe_for(c, s);
+    if constexpr (is_bsdf(model)) {
+        c.chosen = choose2015(c.wo, c.u.u0, s);
+    } else {
+        choose_lobe_for(c, s);
+    }
     return true;
 }
 
-PB_KERNEL_INLINE Direction<Floats> draw(const SampleJob& job, const Chosen& c, const Shading<Floats>& s) {
-    return sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
+template <Model model>
+PB_KERNEL_INLINE DrawnOf<model> draw(const SampleJob& job, const ChosenOf<model>& c, const SamplingShading<model>& s) {
+    if constexpr (is_bsdf(model)) {
+        return draw2015(c.wo, c.u, c.chosen, s, job.sampler);
+    } else {
+        return sample_direction(c.wo, c.u, c.lobe, s, job.sampler);
+    }
 }
 
 // Stores a batch's sample; with_lobes also each lobe's share of the weight,
@@ -61,13 +95,10 @@ PB_KERNEL_INLINE void store_sample(const SampleJob& job, std::int64_t i, const L
     w.pdf.store_unaligned(job.pdf + i);
     store_rgb<layouts>(job.weight, i, w.weight);
     if constexpr (with_lobes) {
-        store_rgb<layouts>(job.lobe_weight[0], i, w.share(w.lobes.diffuse_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[1], i, w.share(w.lobes.sheen_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[2], i, w.share(w.lobes.specular_rgb(s)));
-        store_rgb<layouts>(job.lobe_weight[3], i, w.share(w.lobes.clearcoat_rgb()));
-        store_rgb<layouts>(job.lobe_weight[4], i, multiple_scattering_share);
-        store_rgb<layouts>(job.lobe_weight[5], i, Rgb<Floats>{Floats(0.0f), Floats(0.0f), Floats(0.0f)});
-        store_rgb<layouts>(job.lobe_weight[6], i, Rgb<Floats>{Floats(0.0f), Floats(0.0f), Floats(0.0f)});
+        LobeColors<Floats> shares = w.lobes.colors(s, Rgb<Floats>{Floats(0.0f), Floats(0.0f), Floats(0.0f)});
+        for (Rgb<Floats>& share : shares) share = w.share(share);
+        lobe_of(shares, Lobe::kMultipleScattering) = multiple_scattering_share;
+        store_lobes<layouts>(job.lobe_weight, i, shares, [](const Rgb<Floats>& share) { return share; });
     }
     // the indices' int32 bit patterns selected as floats: no conversion
     auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
@@ -75,12 +106,36 @@ PB_KERNEL_INLINE void store_sample(const SampleJob& job, std::int64_t i, const L
     xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
 }
 
+// The 2015 models' sample, stored as store_sample's.
+template <Layouts layouts, bool with_lobes>
+PB_KERNEL_INLINE void store_sample2015(const SampleJob& job, std::int64_t i, const Sample2015<Floats>& drawn,
+                                       const Shading2015<Floats>& s) {
+    store_rgb<layouts>(job.wi, i, Rgb<Floats>{drawn.wi.x, drawn.wi.y, drawn.wi.z});
+    drawn.pdf.store_unaligned(job.pdf + i);
+    store_rgb<layouts>(job.weight, i, drawn.weight);
+    if constexpr (with_lobes) {
+        auto share = [&](const Rgb<Floats>& lobe) { return drawn.scale * lobe; };  // (scale is 0 where no sample)
+        store_lobes<layouts>(job.lobe_weight, i, drawn.lobes.rgb(s).colors(), share);
+    }
+    // the indices' int32 bit patterns selected as floats: no conversion
+    auto index_bits = [](std::int32_t index) { return xsimd::bitwise_cast<Floats>(Ints(index)); };
+    const LobeChoice<Floats>& reflected = drawn.choice.reflected;
+    Floats reflected_index = select(reflected.cosine, index_bits(0), select(reflected.specular, index_bits(1), index_bits(2)));
+    Floats lobe_index = select(drawn.choice.transmission, index_bits(3),
+                               select(drawn.choice.diffuse_transmission, index_bits(4), reflected_index));
+    xsimd::bitwise_cast<Ints>(lobe_index).store_unaligned(job.lobe + i);
+}
+
 template <Model model, Layouts layouts, bool with_lobes, LobeSet lobes = LobeSet::kAll>
-PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const Chosen& c, const Direction<Floats>& d,
-                            const Shading<Floats>& s) {
+PB_KERNEL_INLINE void weigh(const SampleJob& job, std::int64_t i, const ChosenOf<model>& c, const DrawnOf<model>& d,
+                            const SamplingShading<model>& s) {
     static_assert(!with_lobes || lobes == LobeSet::kAll, "each lobe's share needs every lobe's value");
-    Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
-    store_sample<layouts, with_lobes>(job, i, c.lobe, weigh<model, lobes>(c.wo, c.fv, c.weights, d, s, job.sampler), s, zero);
+    if constexpr (is_bsdf(model)) {
+        store_sample2015<layouts, with_lobes>(job, i, weigh2015<lobes>(c.wo, c.chosen, d, s, job.sampler, job.mode), s);
+    } else {
+        Rgb<Floats> zero{Floats(0.0f), Floats(0.0f), Floats(0.0f)};
+        store_sample<layouts, with_lobes>(job, i, c.lobe, weigh<model, lobes>(c.wo, c.fv, c.weights, d, s, job.sampler), s, zero);
+    }
 }
 
 // The energy compensation's batch (model/energy.hpp): the multiple-scattering
@@ -104,28 +159,30 @@ PB_KERNEL_INLINE bool sample_compensated_batch(const SampleJob& job, std::int64_
     Shading<Floats> s = with_multiple_scattering_weight(material, ms.weight(missing_wo));
     choose_lobe_for(c, s);
     CompensatedWeighed<Floats> cw =
-            weigh_compensated<model>(c.wo, c.fv, c.weights, draw(job, c, s), s, ms, missing_wo, job.sampler);
+            weigh_compensated<model>(c.wo, c.fv, c.weights, draw<model>(job, c, s), s, ms, missing_wo, job.sampler);
     store_sample<layouts, with_lobes>(job, i, c.lobe, cw.weighed, s, cw.weighed.share(cw.multiple_scattering));
     return true;
 }
 
 template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool compensated = false,
           LobeSet lobes = LobeSet::kAll>
-PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const Shading<Floats>& uniform,
+PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, const SamplingShading<model>& uniform,
                                        const MultipleScatteringLobe<Floats>& uniform_ms, const CounterSeed& seed) {
-    if constexpr (compensated) return sample_compensated_batch<model, per_element, layouts, with_lobes>(job, i, uniform, uniform_ms, seed);
+    if constexpr (compensated) {
+        return sample_compensated_batch<model, per_element, layouts, with_lobes>(job, i, uniform, uniform_ms, seed);
+    }
     RawMaterial m;  // (per element only)
-    Shading<Floats> per_batch;
+    SamplingShading<model> per_batch;
     if constexpr (per_element) {
         m = load_material(job.params, i);
-        per_batch = shading_of(m);
+        per_batch = sampling_shading_of<model>(m);
     }
-    const Shading<Floats>& s = per_element ? per_batch : uniform;
-    Chosen chosen;
+    const SamplingShading<model>& s = per_element ? per_batch : uniform;
+    ChosenOf<model> chosen;
     if (!choose<model, layouts>(job, i, s, seed, chosen)) return false;
-    Direction<Floats> drawn = draw(job, chosen, s);
+    DrawnOf<model> drawn = draw<model>(job, chosen, s);
     if constexpr (per_element && !with_lobes) {  // the batch's LobeSet, when all its lanes agree (as eval's)
-        switch (lobe_set_of(m)) {
+        switch (lobe_set_of<model>(m)) {
             case LobeSet::kSpecular: weigh<model, layouts, false, LobeSet::kSpecular>(job, i, chosen, drawn, s); return true;
             case LobeSet::kPlain: weigh<model, layouts, false, LobeSet::kPlain>(job, i, chosen, drawn, s); return true;
             default: break;
@@ -166,19 +223,21 @@ bool sample_tail(const SampleJob& job, const Padding& pad, const OneBatch& one_b
 }
 
 // One batch between its stages: chosen, then drawn.
+template <Model model>
 struct InFlight {
-    Chosen chosen;
-    Direction<Floats> drawn;
+    ChosenOf<model> chosen;
+    DrawnOf<model> drawn;
 };
 
 // One step of the pipeline: weigh the batch at i, draw the next one, choose
 // the one after it at i + 2 kLanes (false when the fast direction test does
 // not accept that one's wo).
 template <Model model, Layouts layouts, LobeSet lobes>
-PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const Shading<Floats>& s, const CounterSeed& seed,
-                                    InFlight& weighed, InFlight& drawn, InFlight& chosen) {
+PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const SamplingShading<model>& s,
+                                    const CounterSeed& seed, InFlight<model>& weighed, InFlight<model>& drawn,
+                                    InFlight<model>& chosen) {
     weigh<model, layouts, false, lobes>(job, i, weighed.chosen, weighed.drawn, s);
-    drawn.drawn = draw(job, drawn.chosen, s);
+    drawn.drawn = draw<model>(job, drawn.chosen, s);
     return choose<model, layouts>(job, i + 2 * kLanes, s, seed, chosen.chosen);
 }
 
@@ -201,12 +260,12 @@ PB_KERNEL_INLINE bool pipeline_step(const SampleJob& job, std::int64_t i, const 
 // run_checked).
 template <Model model, bool per_element, Layouts layouts, bool with_lobes, bool compensated, LobeSet lobes>
 std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t end) {
-    Shading<Floats> uniform{};
+    SamplingShading<model> uniform{};
     MultipleScatteringLobe<Floats> uniform_ms{};
     BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
         RawMaterial m = load_material(job.params, 0);
-        uniform = shading_of(m);
+        uniform = sampling_shading_of<model>(m);
         if constexpr (compensated) {
             uniform_ms = multiple_scattering_of(m.slot, uniform, model);
             row.template use_for<model>(uniform_ms);
@@ -218,15 +277,15 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
     std::int64_t b = 0;
     if constexpr (!per_element && !with_lobes && !compensated) {
         if (batches >= 5) {
-            InFlight slot0, slot1, slot2;
+            InFlight<model> slot0, slot1, slot2;
             // a stop at a batch first weighs the one drawn before it, so that
             // every element before the returned batch is written
             if (!choose<model, layouts>(job, at(0), uniform, seed, slot0.chosen)) return at(0);
             if (!choose<model, layouts>(job, at(1), uniform, seed, slot1.chosen)) {
-                weigh<model, layouts, false, lobes>(job, at(0), slot0.chosen, draw(job, slot0.chosen, uniform), uniform);
+                weigh<model, layouts, false, lobes>(job, at(0), slot0.chosen, draw<model>(job, slot0.chosen, uniform), uniform);
                 return at(1);
             }
-            slot0.drawn = draw(job, slot0.chosen, uniform);
+            slot0.drawn = draw<model>(job, slot0.chosen, uniform);
             // here and after each step: slot0 holds batch b, drawn, and slot1 batch b + 1, chosen
             for (; b + 4 < batches; b += 3) {
                 if (!pipeline_step<model, layouts, lobes>(job, at(b), uniform, seed, slot0, slot1, slot2))
@@ -237,7 +296,7 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
                     { weigh<model, layouts, false, lobes>(job, at(b + 3), slot0.chosen, slot0.drawn, uniform); return at(b + 4); }
             }
             weigh<model, layouts, false, lobes>(job, at(b), slot0.chosen, slot0.drawn, uniform);
-            weigh<model, layouts, false, lobes>(job, at(b + 1), slot1.chosen, draw(job, slot1.chosen, uniform), uniform);
+            weigh<model, layouts, false, lobes>(job, at(b + 1), slot1.chosen, draw<model>(job, slot1.chosen, uniform), uniform);
             b += 2;
         }
     }
@@ -265,7 +324,7 @@ std::int64_t sample_checked(const SampleJob& job, std::int64_t begin, std::int64
 template <Model model, bool per_element, Layouts layouts>
 std::int64_t sample_checked_for_lobes(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     if constexpr (!per_element) {
-        switch (lobe_set_of(job.params)) {
+        switch (lobe_set_of<model>(job.params)) {
             case LobeSet::kSpecular: return sample_checked<model, false, layouts, false, false, LobeSet::kSpecular>(job, begin, end);
             case LobeSet::kPlain: return sample_checked<model, false, layouts, false, false, LobeSet::kPlain>(job, begin, end);
             default: break;
@@ -278,10 +337,12 @@ std::int64_t sample_checked_for_lobes(const SampleJob& job, std::int64_t begin, 
 template <Model model, bool per_element>
 std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     // the energy compensation: batch after batch, any layout (model/energy.hpp)
-    if (job.energy_compensation)
-        return job.lobe_weight[0].data != nullptr
-                       ? sample_checked<model, per_element, Layouts::kMixed, true, true>(job, begin, end)
-                       : sample_checked<model, per_element, Layouts::kMixed, false, true>(job, begin, end);
+    if constexpr (has_energy_table(model)) {
+        if (job.energy_compensation)
+            return job.lobe_weight[0].data != nullptr
+                           ? sample_checked<model, per_element, Layouts::kMixed, true, true>(job, begin, end)
+                           : sample_checked<model, per_element, Layouts::kMixed, false, true>(job, begin, end);
+    }
     // each lobe's share as well (the albedo's split): batch after batch, any layout
     if (job.lobe_weight[0].data != nullptr) return sample_checked<model, per_element, Layouts::kMixed, true>(job, begin, end);
     Vec3Layout layout = job.wo.layout;
@@ -290,22 +351,14 @@ std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int
                                 (job.u.data == nullptr || job.u.layout == layout);
     if (uniform_layout && layout == Vec3Layout::kInterleaved)
         return sample_checked_for_lobes<model, per_element, Layouts::kInterleaved>(job, begin, end);
-    if (uniform_layout && layout == Vec3Layout::kRows)
+    if (uniform_layout && layout == Vec3Layout::kRows && !is_bsdf(model))  // (the 2015 models' (3, N): the mixed loop)
         return sample_checked_for_lobes<model, per_element, Layouts::kRows>(job, begin, end);
     return sample_checked<model, per_element, Layouts::kMixed>(job, begin, end);
 }
 
-// The 2015 solid's loop (kernel_sample2015.hpp).
-template <bool per_element>
-std::int64_t sample2015_checked(const SampleJob& job, std::int64_t begin, std::int64_t end);
-
 inline std::int64_t sample_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     const bool per_element = !job.uniform_material();
-    if (is_bsdf(job.model))
-        return per_element ? sample2015_checked<true>(job, begin, end) : sample2015_checked<false>(job, begin, end);
-    if (job.model == Model::kDisney2012)
-        return per_element ? sample_range_for<Model::kDisney2012, true>(job, begin, end)
-                           : sample_range_for<Model::kDisney2012, false>(job, begin, end);
-    return per_element ? sample_range_for<Model::kDisney2014, true>(job, begin, end)
-                       : sample_range_for<Model::kDisney2014, false>(job, begin, end);
+    return with_model(job.model, [&](auto model) {
+        return per_element ? sample_range_for<model(), true>(job, begin, end) : sample_range_for<model(), false>(job, begin, end);
+    });
 }

@@ -14,7 +14,7 @@ tests/api/test_stubs_and_mypy.py keeps these in step with the module's own signa
 
 from collections.abc import Sequence
 from types import ModuleType
-from typing import Annotated, Final, SupportsFloat, SupportsIndex, SupportsInt, TypedDict, type_check_only
+from typing import Annotated, Any, Final, SupportsFloat, SupportsIndex, SupportsInt, TypedDict, type_check_only
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,6 +37,7 @@ _Segments: TypeAlias = tuple[int, int, Sequence[NDArray[np.int64] | None], Seque
 PARAMETER_TABLE: Final[list[tuple[str, int, int, tuple[float, ...], float, float]]]
 PARAM_SLOTS: Final[int]
 MODEL_NAMES: Final[tuple[str, ...]]
+MODEL_TABLE: Final[tuple[dict[str, Any], ...]]  # one row per model: docs/model.md, "Adding a model"
 LOBE_NAMES: Final[tuple[str, ...]]
 SAMPLED_LOBE_NAMES: Final[tuple[str, ...]]
 SAMPLER_NAMES: Final[tuple[str, ...]]

@@ -43,40 +43,6 @@ class ModelRules(NamedTuple):
     max_specular: float  # the largest specular it takes, that index's (inf: unbounded)
 
 
-def _specular_of_ior(eta: float) -> float:
-    """``specular`` for an index of refraction: ``((η - 1)/(η + 1))² / 0.08``."""
-    return ((eta - 1.0) / (eta + 1.0)) ** 2 / 0.08
-
-
-def _table_from_python_constants() -> tuple[dict[str, Any], ...]:
-    """The model table, one dict per model in MODEL_NAMES order, with the keys of
-    ``_core.MODEL_TABLE``. The C++ table replaces this one where the extension
-    exports it."""
-    # The 2015 models take an index of refraction up to 10: up to it the float32
-    # kernels hold the model's accuracy bounds (docs/model-2015.md). Beyond it ever
-    # more of the light from inside meets the interface near the critical angle
-    # (cos θc = sqrt(1 - 1/η²)), where float32 cannot decide total internal
-    # reflection (from η = 20 single pairs differ by 4 %), and from specular 12.5 on
-    # η is infinite.
-    max_ior = 10.0
-    brdf_reads = tuple(name for name, first_slot, *_ in _core.PARAMETER_TABLE if first_slot < _core.GRADIENT_SLOTS)
-    brdf: dict[str, Any] = dict(
-        whole_sphere=False, reads=brdf_reads, gradient_slots=_core.GRADIENT_SLOTS,
-        lobes=("diffuse", "sheen", "specular", "clearcoat", "multiple_scattering"),
-        sampled_lobes=("cosine", "specular", "clearcoat"), energy_compensation=True, max_ior=math.inf,
-        max_specular=math.inf)
-    solid_lobes = ("diffuse", "sheen", "specular", "clearcoat", "transmission")
-    solid_sampled = ("cosine", "specular", "clearcoat", "transmission")
-    solid: dict[str, Any] = dict(
-        whole_sphere=True, reads=tuple(n for n in PARAMETER_NAMES if n not in ("subsurface", "diff_trans")),
-        gradient_slots=_core.PARAM_SLOTS, lobes=solid_lobes, sampled_lobes=solid_sampled, energy_compensation=False,
-        max_ior=max_ior, max_specular=_specular_of_ior(max_ior))
-    thin = dict(solid, reads=tuple(n for n in PARAMETER_NAMES if n != "subsurface"),
-                lobes=solid_lobes + ("diffuse_transmission",), sampled_lobes=solid_sampled + ("diffuse_transmission",))
-    rows = {"disney2014": brdf, "disney2012": brdf, "disney2015": solid, "disney2015_thin": thin}
-    return tuple(dict(name=name, **rows[name]) for name in MODEL_NAMES)
-
-
 def _rules(table: Sequence[Mapping[str, Any]]) -> dict[str, ModelRules]:
     rules = {}
     for row in table:
@@ -92,8 +58,8 @@ def _rules(table: Sequence[Mapping[str, Any]]) -> dict[str, ModelRules]:
     return rules
 
 
-# The extension's model table; the same rules from Python's constants for an extension built without it.
-RULES: dict[str, ModelRules] = _rules(getattr(_core, "MODEL_TABLE", None) or _table_from_python_constants())
+# The extension's model table (model_table.hpp), one row per model.
+RULES: dict[str, ModelRules] = _rules(_core.MODEL_TABLE)
 DEFAULT_MODEL = MODEL_NAMES[0]
 # The models of the whole sphere (the 2015 BSDF of a solid and of a thin sheet); the others are BRDFs.
 WHOLE_SPHERE_MODELS: tuple[str, ...] = tuple(name for name, rules in RULES.items() if rules.whole_sphere)

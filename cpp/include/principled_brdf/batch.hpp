@@ -5,10 +5,11 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 #include <string>
 #include <vector>
 
-#include "params.hpp"
+#include "model_table.hpp"
 
 namespace principled_brdf {
 
@@ -56,6 +57,22 @@ enum class Output : int {
     kDirectionGradient = 6,
     kDirectionVjp = 7,  // Σ_c g_c ∂f_c/∂w per element for the six components (no f, no Jacobian)
 };
+
+// body(output) with the output as a compile-time constant (std::integral_constant).
+template <class Body>
+auto with_output(Output output, Body&& body) {
+    auto as = [&](auto constant) { return body(constant); };
+    switch (output) {
+        case Output::kLobes: return as(std::integral_constant<Output, Output::kLobes>{});
+        case Output::kPdf: return as(std::integral_constant<Output, Output::kPdf>{});
+        case Output::kGradient: return as(std::integral_constant<Output, Output::kGradient>{});
+        case Output::kValuePdf: return as(std::integral_constant<Output, Output::kValuePdf>{});
+        case Output::kVjp: return as(std::integral_constant<Output, Output::kVjp>{});
+        case Output::kDirectionGradient: return as(std::integral_constant<Output, Output::kDirectionGradient>{});
+        case Output::kDirectionVjp: return as(std::integral_constant<Output, Output::kDirectionVjp>{});
+        default: return as(std::integral_constant<Output, Output::kTotal>{});
+    }
+}
 
 // The direction components the derivatives in the directions are taken by:
 // wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.

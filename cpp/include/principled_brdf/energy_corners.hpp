@@ -1,7 +1,7 @@
 // The tables of energy_tables.hpp rearranged for lookups whose row differs
 // from lane to lane (a per-element roughness): an interval's value and slope
 // in two adjacent rows,
-//   kMissingCorners[model][4 (j kIntervals + b) + c] = kMissing[model][2 (j kIntervals + b) + (c & 1) + (c >> 1) 2 kIntervals],
+//   kMissingCorners[table][4 (j kIntervals + b) + c] = kMissing[table][2 (j kIntervals + b) + (c & 1) + (c >> 1) 2 kIntervals],
 // (row j's value and slope, then row j + 1's), for j < kRoughnesses - 1 (0
 // beyond): one 16-byte load a lane instead of two pairs from two rows
 // (model/energy.hpp).

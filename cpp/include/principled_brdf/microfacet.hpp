@@ -235,7 +235,7 @@ inline double ggx_g2_separable(const Vec3& wi, const Vec3& wo, double alpha_x, d
 
 // Height-correlated Smith G2 = 1 / (1 + Λ(wi) + Λ(wo)) (Heitz 2014 eq. 99).
 inline double ggx_g2_height_correlated(const Vec3& wi, const Vec3& wo, double alpha_x, double alpha_y) {
-    return ggx_of(alpha_x, alpha_y).g2_height_correlated(upper(wi), upper(wo));
+    return f64::g2_height_correlated(ggx_of(alpha_x, alpha_y), upper(wi), upper(wo));
 }
 
 // A wo below the horizon is mirrored (wo -> -wo), so the visible-normal sampler is two-sided.

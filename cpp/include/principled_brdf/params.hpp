@@ -76,19 +76,14 @@ constexpr double default_of(Param slot) {
 
 // The models (docs/model.md, "The model"; docs/model-2015.md): the 2014 and 2012
 // BRDFs, which differ only in the specular masking term, and the 2015 BSDFs of a
-// solid and of a thin sheet; the names are the Python ones, in the enum's order.
+// solid and of a thin sheet. What is known of each, its name among it, is its
+// row of the model table (model_table.hpp).
 enum class Model : int {
     kDisney2014 = 0,  // anisotropic Smith GGX with the material's alpha_x, alpha_y
     kDisney2012 = 1,  // isotropic Smith GGX with alpha_g = (0.5 + roughness / 2)^2
     kDisney2015 = 2,  // the 2015 BSDF of a solid: a rough dielectric interface over the whole sphere (docs/model-2015.md)
     kDisney2015Thin = 3,  // the 2015 BSDF of a thin sheet: light passes through without bending (docs/model-2015.md)
 };
-inline constexpr std::array<const char*, 4> kModelNames{"disney2014", "disney2012", "disney2015", "disney2015_thin"};
-
-// The models whose directions lie on the whole sphere (the others are BRDFs: f = 0 off the upper hemisphere).
-constexpr bool is_bsdf(Model model) { return model == Model::kDisney2015 || model == Model::kDisney2015Thin; }
-// The slots a model's derivatives are taken by: the first gradient_slots(model) of the table.
-constexpr int gradient_slots(Model model) { return is_bsdf(model) ? kParamSlots : kGradientSlots; }
 
 // The lobes of f, in the order eval_lobes returns them; multiple_scattering is
 // the energy compensation's (0 unless it is on), transmission the 2015 models'

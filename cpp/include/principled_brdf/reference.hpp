@@ -14,7 +14,7 @@
 #include <utility>
 
 #include "model/f64.hpp"
-#include "params.hpp"
+#include "model_table.hpp"
 
 namespace principled_brdf::reference {
 
@@ -339,7 +339,7 @@ inline Lobes eval_lobes(const Shading2015<double>& s, const Vector3d& wi, const 
 
 inline Vector3d eval(const Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
                      TransportMode mode = TransportMode::kRadiance) {
-    return vector3d(eval_lobes2015(vec3(wi), vec3(wo), s, mode).total());
+    return vector3d(eval2015(vec3(wi), vec3(wo), s, mode));
 }
 
 // P_k at wo of the sampled lobes (kSampledLobeNames); a solid's interface counted as its split at h = n.

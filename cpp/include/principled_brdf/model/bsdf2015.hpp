@@ -54,15 +54,6 @@ struct Shading2015 {
     PB_MODEL_INLINE bool opaque() const { return !nonzero_anywhere(transmission_weight); }
 };
 
-// Both GGX alphas of a roughness, with the 2014 anisotropy (principled.hpp's shading_of).
-template <class F>
-PB_MODEL_INLINE Ggx<F> ggx_of_roughness(F roughness, F anisotropic) {
-    F aspect2 = neg_mul_add(F(0.9), anisotropic, F(1.0));
-    F inv_aspect = reciprocal_sqrt(aspect2);
-    F alpha = roughness * roughness;
-    return Ggx<F>::from_alphas(max(F(0.001), alpha * inv_aspect), max(F(0.001), alpha * (aspect2 * inv_aspect)));
-}
-
 template <class F>
 PB_MODEL_INLINE Shading2015<F> shading2015_of(const F* p, bool thin = false) {
     F one(1.0);
@@ -144,112 +135,172 @@ template <class F>
 struct Lobes2015 {
     Rgb<F> diffuse, sheen, specular, clearcoat, transmission, diffuse_transmission;
 
-    Rgb<F> total() const { return diffuse + sheen + specular + clearcoat + transmission + diffuse_transmission; }
-};
-
-// The reflection, both directions on the viewer's side (wi.z, wo.z > 0 after
-// the Side's mirror): outside, the 2014 lobes with F_s; inside, only the
-// interface, w_T F_D(cos θd; 1/η) Ds Gs.
-template <class F>
-PB_MODEL_INLINE Lobes2015<F> reflection2015(const Side<F>& side, const Geometry<F>& g, const Shading2015<F>& s) {
-    const Shading<F>& b = s.brdf;
-    F zero(0.0);
-    Rgb<F> none{zero, zero, zero};
-    F fh = schlick_weight_of_complement(g.one_minus_cos_theta_d);
-    Fresnel<F> schlick{schlick_weight(side.wi.z), schlick_weight(side.wo.z), fh};
-    MaskOf<F> outside = !side.inside;
-
-    // Fd + flatness (ss - f_L), f_L = (1 - FL/2)(1 - FV/2): (1 - flatness) f_L + flatness ss + f_R with f_L + f_R = Fd
-    F diffuse = b.diffuse.template value<false>(g, schlick);
-    if (nonzero_anywhere(s.flatness)) {
-        F lambert = neg_mul_add(F(0.5), schlick.fl, F(1.0)) * neg_mul_add(F(0.5), schlick.fv, F(1.0));
-        diffuse = mul_add(s.flatness, b.diffuse.subsurface_shape(g, schlick) - lambert, diffuse);
+    LobeColors<F> colors() const {
+        LobeColors<F> lobes = no_lobes<F>();
+        lobe_of(lobes, Lobe::kDiffuse) = diffuse;
+        lobe_of(lobes, Lobe::kSheen) = sheen;
+        lobe_of(lobes, Lobe::kSpecular) = specular;
+        lobe_of(lobes, Lobe::kClearcoat) = clearcoat;
+        lobe_of(lobes, Lobe::kTransmission) = transmission;
+        lobe_of(lobes, Lobe::kDiffuseTransmission) = diffuse_transmission;
+        return lobes;
     }
-    Lobes2015<F> out;
-    out.diffuse = select(outside, diffuse * b.diffuse.color, none);
-    out.sheen = select(outside, fh * b.sheen.color, none);
+};
 
-    F ds_gs = b.specular.template value<Model::kDisney2014>(g, b.specular.ggx.smith_denominator(side.wo));
-    F exact = fresnel_dielectric(g.cos_theta_d, side.eta_t);
-    F one_minus_fh = F(1.0) - fh;
-    F grey = mul_add(s.dielectric, exact, s.schlick_grazing * fh);
-    Rgb<F> outside_fresnel{mul_add(s.schlick_f0.r, one_minus_fh, grey), mul_add(s.schlick_f0.g, one_minus_fh, grey),
-                           mul_add(s.schlick_f0.b, one_minus_fh, grey)};
-    F inside_fresnel = s.transmission_weight * exact;
-    out.specular = ds_gs * select(side.inside, Rgb<F>{inside_fresnel, inside_fresnel, inside_fresnel}, outside_fresnel);
-
-    F clearcoat = select(outside, b.clearcoat.value(g, fh, b.clearcoat.smith_wo(side.wo)), zero);
-    out.clearcoat = {clearcoat, clearcoat, clearcoat};
-    out.transmission = none;
-    out.diffuse_transmission = none;
-    return out;
-}
-
-// The generalised half vector of a transmitted pair and what both the value
-// and the density read of it: H = wo + η_t wi turned to H.z >= 0 (Walter et
-// al. 2007 eq. 16), valid where each direction sees the microfacet from its
-// own side (wo·H > 0 > wi·H). H is formed as (wo + wi) + (η_t - 1) wi: where
-// η_t nears 1 the light passes nearly straight through, wi nears -wo, and
-// wo + wi is exact where wo + η_t wi would lose the digits of its rounded
-// product.
+// The lobes as scalar factors of the material's colors (as the 2014 model's
+// LobeValues), 0 where the pair does not scatter into the lobe:
+//   diffuse       of brdf.diffuse.color       Fd + flatness (ss - f_L), outside, reflected
+//   sheen         of brdf.sheen.color         FH, outside, reflected
+//   specular_f0   of schlick_f0               Ds Gs (1 - FH), outside, reflected
+//   specular_grey (grey)                      Ds Gs (dielectric F_D + schlick_grazing FH) outside,
+//                                             Ds Gs w_T F_D(cos θd; 1/η) inside, reflected
+//   clearcoat     (grey)                      outside, reflected
+//   transmission  of transmission_color       through the interface or the sheet
+//   diffuse_transmission of diffuse_transmission  1 through the sheet, else 0
+// F_s per channel is schlick_f0 (1 - FH) + the grey part, so the specular is
+// specular_f0 schlick_f0 + specular_grey.
 template <class F>
-struct Refraction {
+struct LobeValues2015 {
+    F diffuse, sheen, specular_f0, specular_grey, clearcoat, transmission, diffuse_transmission;
+
+    Lobes2015<F> rgb(const Shading2015<F>& s) const {
+        auto grey = [](F x) { return Rgb<F>{x, x, x}; };
+        auto specular = [&](F f0) { return mul_add(specular_f0, f0, specular_grey); };
+        return {diffuse * s.brdf.diffuse.color,
+                sheen * s.brdf.sheen.color,
+                {specular(s.schlick_f0.r), specular(s.schlick_f0.g), specular(s.schlick_f0.b)},
+                grey(clearcoat),
+                transmission * s.transmission_color,
+                diffuse_transmission * s.diffuse_transmission};
+    }
+
+    // f per channel, each lobe's product fused into one sum (a LobeSet's
+    // left-out lobes are 0 for the materials it is chosen for, and so are the
+    // transmissions of an opaque solid: their terms are skipped)
+    template <LobeSet lobes = LobeSet::kAll>
+    Rgb<F> total(const Shading2015<F>& s) const {
+        F grey = lobes == LobeSet::kAll ? specular_grey + clearcoat : specular_grey;
+        const bool transmits = !s.opaque();
+        auto channel = [&](F diffuse_color, F sheen_color, F f0, F transmission_color, F diffuse_transmission_color) {
+            F sum = mul_add(specular_f0, f0, grey);
+            if (transmits) sum = mul_add(transmission, transmission_color, sum);
+            if (s.thin) sum = mul_add(diffuse_transmission, diffuse_transmission_color, sum);
+            if constexpr (lobes == LobeSet::kAll) sum = mul_add(sheen, sheen_color, sum);
+            if constexpr (lobes != LobeSet::kSpecular) sum = mul_add(diffuse, diffuse_color, sum);
+            return sum;
+        };
+        const Shading<F>& b = s.brdf;
+        return {channel(b.diffuse.color.r, b.sheen.color.r, s.schlick_f0.r, s.transmission_color.r, s.diffuse_transmission.r),
+                channel(b.diffuse.color.g, b.sheen.color.g, s.schlick_f0.g, s.transmission_color.g, s.diffuse_transmission.g),
+                channel(b.diffuse.color.b, b.sheen.color.b, s.schlick_f0.b, s.transmission_color.b, s.diffuse_transmission.b)};
+    }
+};
+
+// The microfacet of a pair, one a lane whichever way the light goes (Walter
+// et al. 2007 eq. 16): H = wi + wo where the light is reflected, wo + η_t wi
+// where the solid's interface transmits it (the light below the viewer's
+// side), turned to H.z >= 0 (generalized_half_vector); a transmission is
+// valid where each direction sees the microfacet from its own side
+// (wo·H > 0 > wi·H). Kept unnormalised: with
+// Q = Hx²/ax² + Hy²/ay² + Hz², D(h) = norm |H|⁴ / Q², and G1(w) / (2 |cos θ|)
+// = 1 / S(w), S the Smith denominator of w turned above the surface, so that
+//   reflection:   Ds Gs = D G1 G1 / (4 |cos θl| |cos θv|) = norm |H|⁴ / (Q² S(wo) S(wi)),
+//   transmission: D G1 G1 |wo·h| |wi·h| / (|cos θv| |cos θl| (wo·h + η_t wi·h)²)
+//                 = 4 norm (wo·H) |wi·H| / (Q² S(wo) S(wi))   (wo·H + η_t wi·H = |H|²),
+// one quotient for either, with no normalisation and no cancellation in the
+// denominator, and the exact Fresnel factors once, at wo·h.
+template <class F>
+struct Microfacet {
     HalfVector<F> h;
-    F wo_h, wi_h;      // wo·H, wi·H (unnormalised)
-    F stretched_h2;    // Q = Hx²/ax² + Hy²/ay² + Hz²
-    MaskOf<F> valid;
+    F wo_h, wi_h;         // wo·H, wi·H
+    F cos_h;              // wo·h (cos θd where the light is reflected)
+    F one_minus_cos_h;    // 1 - cos θd where the light is reflected, as geometry_of forms it
+    F smith_wo, smith_wi;  // S(wo), S(wi)
+    F over;               // norm / (Q² S(wo) S(wi))
+    MaskOf<F> transmits;  // a valid transmitted pair
 };
 
 template <class F>
-PB_MODEL_INLINE Refraction<F> refraction_of(const Side<F>& side, const Ggx<F>& ggx) {
+PB_MODEL_INLINE Microfacet<F> microfacet_of(const Side<F>& side, const Ggx<F>& ggx, bool refracts) {
+    F zero(0.0);
     const Vec3<F>& wi = side.wi;
-    F k = side.eta_t_minus_one;
-    Vec3<F> sum{mul_add(k, wi.x, side.wo.x + wi.x), mul_add(k, wi.y, side.wo.y + wi.y), mul_add(k, wi.z, side.wo.z + wi.z)};
-    Vec3<F> h = select(sum.z < F(0.0), Vec3<F>{-sum.x, -sum.y, -sum.z}, sum);
-    Refraction<F> r;
-    r.h.hx2 = h.x * h.x;
-    r.h.hy2 = h.y * h.y;
-    r.h.hz = h.z;
-    r.h.hz2 = h.z * h.z;
-    r.h.h_len2 = r.h.hx2 + r.h.hy2 + r.h.hz2;
-    r.wo_h = dot(side.wo, h);
-    r.wi_h = dot(side.wi, h);
-    r.stretched_h2 = mul_add(r.h.hx2, ggx.inv_alpha_x2, mul_add(r.h.hy2, ggx.inv_alpha_y2, r.h.hz2));
-    r.valid = (side.wi.z < F(0.0)) & (r.wo_h > F(0.0)) & (r.wi_h < F(0.0)) & (r.h.h_len2 > F(0.0));
-    return r;
+    const Vec3<F>& wo = side.wo;
+    MaskOf<F> below = wi.z < zero;
+    Vec3<F> h = generalized_half_vector(wi, wo, refracts ? select(below, side.eta_t_minus_one, zero) : zero);
+    Microfacet<F> m;
+    m.h.hx2 = h.x * h.x;
+    m.h.hy2 = h.y * h.y;
+    m.h.hz = h.z;
+    m.h.hz2 = h.z * h.z;
+    m.h.h_len2 = m.h.hx2 + m.h.hy2 + m.h.hz2;
+    m.wo_h = dot(wo, h);
+    m.wi_h = dot(wi, h);
+    // a reflection's wo·H is |H|² / 2 for unit vectors, which does not cancel where wi nears -wo
+    m.cos_h = select(below, m.wo_h, F(0.5) * m.h.h_len2) * reciprocal_sqrt(m.h.h_len2);
+    F dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
+    m.one_minus_cos_h = mul_add(dx, dx, mul_add(dy, dy, dz * dz)) / mul_add(F(4.0), m.cos_h, F(4.0));
+    F q = mul_add(m.h.hx2, ggx.inv_alpha_x2, mul_add(m.h.hy2, ggx.inv_alpha_y2, m.h.hz2));
+    m.smith_wo = ggx.smith_denominator(wo);
+    m.smith_wi = ggx.smith_denominator(Vec3<F>{wi.x, wi.y, max(wi.z, -wi.z)});
+    m.over = ggx.norm / (q * q * (m.smith_wo * m.smith_wi));
+    m.transmits = below & (m.wo_h > zero) & (m.wi_h < zero) & (m.h.h_len2 > zero);
+    return m;
 }
 
-// The transmission (Walter et al. 2007 eq. 21), viewer above, light below:
-//   w_T sqrt(c) (1 - F_D(wo·h; η_t)) D(h) G1(wo) G1(wi) |wo·h| |wi·h| / (|cos θv| |cos θl| (wo·h + η_t wi·h)²),
-// times η_t² in importance mode. With H unnormalised, wo·H + η_t wi·H = |H|²,
-// D(h) = norm |H|⁴ / Q² and G1(w) / |cos θ| = 2 / smith_denominator(|w|), so
-//   D G1 G1 |wo·h| |wi·h| / (...) = 4 norm |wo·H| |wi·H| / (Q² S(wo) S(wi)):
-// no normalisation, and no cancellation in the denominator.
+// Every lobe at (wi, wo) is 0 where the pair is not one the model scatters:
+// a direction in the tangent plane, or not finite (geometry_of's test).
 template <class F>
-PB_MODEL_INLINE F transmission_value(const Side<F>& side, const Refraction<F>& r, const Shading2015<F>& s,
-                                     TransportMode mode) {
-    const Ggx<F>& ggx = s.brdf.specular.ggx;
-    F cos_h = r.wo_h * reciprocal_sqrt(r.h.h_len2);
-    F transmitted = fresnel_dielectric_transmittance(cos_h, side.eta_t);
-    F smith = ggx.smith_denominator(side.wo) * ggx.smith_denominator(mirrored(side.wi));
-    F value = F(4.0) * s.transmission_weight * transmitted * ggx.norm * (r.wo_h * -r.wi_h) /
-              (r.stretched_h2 * r.stretched_h2 * smith);
-    if (mode == TransportMode::kImportance) value = value * (side.eta_t * side.eta_t);
-    return select(r.valid, value, F(0.0));
+PB_MODEL_INLINE MaskOf<F> scattered2015(const Side<F>& side) {
+    F length2 = squared_length(side.wi) + squared_length(side.wo);
+    return (side.wo.z > F(0.0)) & (side.wi.z != F(0.0)) & (length2 <= F(kLargestDirectionsLength2));
+}
+
+// What f and the density read of a pair: its side, microfacet and the
+// exact Fresnel factors there (F_D(wo·h; η_t)).
+template <class F>
+struct Pair2015 {
+    Side<F> side;
+    Microfacet<F> microfacet;
+    FresnelDielectric<F> fresnel;
+    MaskOf<F> scattered;
+};
+
+template <class F>
+PB_MODEL_INLINE Pair2015<F> pair2015_of(const Side<F>& side, const Shading2015<F>& s) {
+    Pair2015<F> p;
+    p.side = side;
+    p.microfacet = microfacet_of(side, s.brdf.specular.ggx, !s.thin && !s.opaque());
+    p.fresnel = fresnel_dielectric_both(p.microfacet.cos_h, side.eta_t);
+    p.scattered = scattered2015(side);
+    return p;
+}
+
+// The reflection's Geometry (lobes.hpp) read from its microfacet, H = wi + wo,
+// for the lobes outside (the diffuse, the clearcoat).
+template <class F>
+PB_MODEL_INLINE Geometry<F> reflection_geometry(const Pair2015<F>& p) {
+    Geometry<F> g;
+    static_cast<HalfVector<F>&>(g) = p.microfacet.h;
+    g.wi = p.side.wi;
+    g.wo = p.side.wo;
+    g.cos_theta_d = p.microfacet.cos_h;
+    g.one_minus_cos_theta_d = p.microfacet.one_minus_cos_h;
+    g.in_range = p.scattered;
+    return g;
 }
 
 // The thin sheet's microfacet transmission, viewer above, light below
 // (Burley 2015): the light's direction mirrored, wi' = mirror(wi), h' the half
 // vector of (wi', wo),
 //   w_T c (1 - F_D(wo·h'; η)) D_t(h') G1_t(wo) G1_t(wi') / (4 |cos θl| |cos θv|),
-// formed as the specular's Ds Gs (SpecularLobe::value) with the sheet's GGX; c applied by the caller.
+// formed as the specular's Ds Gs (SpecularLobe::ds_gs) with the sheet's GGX; c applied by the caller.
 template <class F>
 PB_MODEL_INLINE F thin_transmission_value(const Side<F>& side, const Shading2015<F>& s) {
     Vec3<F> through = mirrored(side.wi);
     Geometry<F> g = geometry_of(through, side.wo);
     F ds_gs = s.thin_ggx.d(g) / (s.thin_ggx.smith_denominator(through) * s.thin_ggx.smith_denominator(side.wo));
     F value = s.transmission_weight * fresnel_dielectric_transmittance(g.cos_theta_d, s.eta) * ds_gs;
-    return select((side.wi.z < F(0.0)) & g.finite, value, F(0.0));
+    return select((side.wi.z < F(0.0)) & g.in_range, value, F(0.0));
 }
 
 // The thin sheet's density of transmitted wi: the mirrored direction's, drawn
@@ -261,38 +312,56 @@ PB_MODEL_INLINE F thin_transmission_pdf(const Side<F>& side, const Ggx<F>& ggx, 
     F d_h = ggx.d(g);
     F pdf = sampler == SpecularSampler::kDistribution ? ggx.distribution_pdf(d_h, g)
                                                      : ggx.visible_pdf(d_h, ggx.smith_denominator(side.wo));
-    return select((side.wi.z < F(0.0)) & g.finite, pdf, F(0.0));
+    return select((side.wi.z < F(0.0)) & g.in_range, pdf, F(0.0));
 }
 
-// Every lobe at (wi, wo), 0 where the pair is not one the model scatters
-// (a direction in the tangent plane, or not finite: see geometry_of).
-template <class F>
-PB_MODEL_INLINE MaskOf<F> scattered2015(const Side<F>& side, const Geometry<F>& g) {
-    return (side.wo.z > F(0.0)) & (side.wi.z != F(0.0)) & g.finite;
-}
-
-template <class F>
-PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Side<F>& side, const Geometry<F>& g, const Shading2015<F>& s,
-                                             TransportMode mode) {
-    F zero(0.0);
-    Rgb<F> none{zero, zero, zero};
-    MaskOf<F> scattered = scattered2015(side, g);
-    Lobes2015<F> out = reflection2015(side, g, s);
-    MaskOf<F> reflected = scattered & (side.wi.z > zero);
-    out.diffuse = select(reflected, out.diffuse, none);
-    out.sheen = select(reflected, out.sheen, none);
-    out.specular = select(reflected, out.specular, none);
-    out.clearcoat = select(reflected, out.clearcoat, none);
-    out.diffuse_transmission = none;
+// The lobes' factors (LobeValues2015; a LobeSet's left-out lobes 0). The
+// reflection, both directions on the viewer's side: outside, the 2014 lobes
+// with F_s; inside, only the interface. The transmission, the light below
+// (Walter et al. 2007 eq. 21, times η_t² in importance mode).
+template <LobeSet lobes = LobeSet::kAll, class F>
+PB_MODEL_INLINE LobeValues2015<F> lobe_values2015(const Pair2015<F>& p, const Shading2015<F>& s, TransportMode mode) {
+    const Shading<F>& b = s.brdf;
+    const Side<F>& side = p.side;
+    const Microfacet<F>& m = p.microfacet;
+    F zero(0.0), one(1.0);
+    MaskOf<F> reflected = p.scattered & (side.wi.z > zero);
+    MaskOf<F> reflected_outside = reflected & !side.inside;
+    F fh = schlick_weight_of_complement(m.one_minus_cos_h);
+    LobeValues2015<F> out;
+    out.diffuse = zero;
+    out.sheen = zero;
+    out.clearcoat = zero;
+    if constexpr (lobes != LobeSet::kSpecular) {
+        Geometry<F> g = reflection_geometry(p);
+        Fresnel<F> schlick{schlick_weight(side.wi.z), schlick_weight(side.wo.z), fh};
+        // Fd + flatness (ss - f_L), f_L = (1 - FL/2)(1 - FV/2): (1 - flatness) f_L + flatness ss + f_R with f_L + f_R = Fd
+        F diffuse = b.diffuse.template factor<false>(g, schlick);
+        if (nonzero_anywhere(s.flatness)) {
+            F lambert = neg_mul_add(F(0.5), schlick.fl, one) * neg_mul_add(F(0.5), schlick.fv, one);
+            diffuse = mul_add(s.flatness, b.diffuse.subsurface_shape(g, schlick) - lambert, diffuse);
+        }
+        out.diffuse = select(reflected_outside, diffuse, zero);
+        if constexpr (lobes == LobeSet::kAll) {
+            out.sheen = select(reflected_outside, fh, zero);
+            out.clearcoat = select(reflected_outside, b.clearcoat.grey_value(g, fh, b.clearcoat.smith_wo(side.wo)), zero);
+        }
+    }
+    F ds_gs = m.h.h_len2 * m.h.h_len2 * m.over;
+    F exact = p.fresnel.reflectance;
+    F grey = select(side.inside, s.transmission_weight * exact, mul_add(s.dielectric, exact, s.schlick_grazing * fh));
+    out.specular_f0 = select(reflected_outside, ds_gs * (one - fh), zero);
+    out.specular_grey = select(reflected, ds_gs * grey, zero);
+    out.transmission = zero;
+    out.diffuse_transmission = zero;
     if (s.thin) {
         // no η² in importance mode: the sheet does not bend the light, and it is reciprocal as it stands
-        MaskOf<F> through = scattered & (side.wi.z < zero);
-        F t = s.opaque() ? zero : select(scattered, thin_transmission_value(side, s), zero);
-        out.transmission = t * s.transmission_color;
-        out.diffuse_transmission = select(through, s.diffuse_transmission, none);
+        if (!s.opaque()) out.transmission = select(p.scattered, thin_transmission_value(side, s), zero);
+        out.diffuse_transmission = select(p.scattered & (side.wi.z < zero), one, zero);
     } else if (!s.opaque()) {
-        F t = select(scattered, transmission_value(side, refraction_of(side, s.brdf.specular.ggx), s, mode), zero);
-        out.transmission = t * s.transmission_color;
+        F t = F(4.0) * s.transmission_weight * p.fresnel.transmittance * (m.wo_h * -m.wi_h) * m.over;
+        if (mode == TransportMode::kImportance) t = t * (side.eta_t * side.eta_t);
+        out.transmission = select(p.scattered & m.transmits, t, zero);
     }
     return out;
 }
@@ -300,8 +369,13 @@ PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Side<F>& side, const Geometry<
 template <class F>
 PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s,
                                              TransportMode mode) {
-    Side<F> side = side_of(wi, wo, s);
-    return eval_lobes2015(side, geometry_of(side.wi, side.wo), s, mode);
+    return lobe_values2015(pair2015_of(side_of(wi, wo, s), s), s, mode).rgb(s);
+}
+
+// f, the lobes summed (LobeValues2015::total)
+template <LobeSet lobes = LobeSet::kAll, class F>
+PB_MODEL_INLINE Rgb<F> eval2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s, TransportMode mode) {
+    return lobe_values2015<lobes>(pair2015_of(side_of(wi, wo, s), s), s, mode).template total<lobes>(s);
 }
 
 // ---------------------------------------------------------------- the sampling mixture (docs/sampling.md)
@@ -377,50 +451,46 @@ PB_MODEL_INLINE InterfaceSplit<F> interface_split(const FresnelDielectric<F>& fr
     return {fresnel.reflectance * inv_total, through * inv_total};
 }
 
-// The transmission lobe's density in wi: the half vector's (visible normals,
-// G1(wo) (wo·h) D(h) / cos θv, or the distribution, D(h) cos θh) times
-// |dωh/dωi| = η_t² |wi·h| / (wo·h + η_t wi·h)² (Walter et al. 2007 eq. 17),
-// from H unnormalised as in transmission_value:
-//   visible: 2 norm η_t² (wo·H) |wi·H| / (Q² S(wo)),  distribution: norm η_t² Hz |wi·H| / Q².
+// Σ P_k pdf_k(wi) given wo: 0 where a direction lies in the tangent plane or
+// is not finite. The specular's density of a reflected wi, from the
+// microfacet's quotient (D = norm |H|⁴ / Q²):
+//   visible normals D / (2 S(wo)),  the distribution D Hz / (2 |H|²);
+// the transmission's, the half vector's density times |dωh/dωi| = η_t² |wi·h|
+// / (wo·h + η_t wi·h)² (Walter et al. 2007 eq. 17):
+//   visible normals 2 norm η_t² (wo·H) |wi·H| / (Q² S(wo)),  the distribution norm η_t² Hz |wi·H| / Q².
+// The interface is split at the pair's own microfacet (interface_split).
 template <class F>
-PB_MODEL_INLINE F transmission_pdf(const Side<F>& side, const Refraction<F>& r, const Ggx<F>& ggx, SpecularSampler sampler) {
-    F common = ggx.norm * side.eta_t * side.eta_t * -r.wi_h / (r.stretched_h2 * r.stretched_h2);
-    F pdf = sampler == SpecularSampler::kDistribution ? common * r.h.hz
-                                                     : F(2.0) * common * r.wo_h / ggx.smith_denominator(side.wo);
-    return select(r.valid, pdf, F(0.0));
-}
-
-// Σ P_k pdf_k(wi) given wo: 0 where a direction lies in the tangent plane or is not finite.
-template <class F>
-PB_MODEL_INLINE F pdf2015(const Side<F>& side, const Geometry<F>& g, const LobeWeights2015<F>& w,
-                          const Shading2015<F>& s, SpecularSampler sampler) {
-    F zero(0.0);
-    MaskOf<F> scattered = scattered2015(side, g);
+PB_MODEL_INLINE F pdf2015(const Pair2015<F>& p, const LobeWeights2015<F>& w, const Shading2015<F>& s,
+                          SpecularSampler sampler) {
+    F zero(0.0), half(0.5);
+    const Side<F>& side = p.side;
+    const Microfacet<F>& m = p.microfacet;
     const Shading<F>& b = s.brdf;
-    F specular = b.specular.pdf(g, b.specular.ggx.smith_denominator(side.wo), sampler);
-    F clearcoat = b.clearcoat.absent() ? zero : w.clearcoat * b.clearcoat.gtr1.pdf(g);
+    const bool distribution = sampler == SpecularSampler::kDistribution;
+    F d_over_smith_wo = m.over * m.smith_wi * m.h.h_len2;  // D / (S(wo) |H|²)
+    F specular = distribution ? half * d_over_smith_wo * m.smith_wo * m.h.hz : half * d_over_smith_wo * m.h.h_len2;
+    F clearcoat = b.clearcoat.absent() ? zero : w.clearcoat * b.clearcoat.gtr1.pdf(m.h);
     F reflected = mul_add(w.cosine * F(kInvPi), side.wi.z, mul_add(w.specular, specular, clearcoat));
-    F pdf = select(side.wi.z > zero, reflected, zero);
+    MaskOf<F> below = side.wi.z < zero;
+    F pdf = select(below, zero, reflected);
     if (s.thin) {
         F through = mul_add(w.diffuse_transmission * F(kInvPi), -side.wi.z,
                             w.transmission * thin_transmission_pdf(side, s.thin_ggx, sampler));
-        pdf = select(side.wi.z < zero, through, pdf);
-    } else if (!s.opaque()) {  // the interface, split at the microfacet: h_r of the reflection, h_t of the refraction
-        Refraction<F> r = refraction_of(side, b.specular.ggx);
-        MaskOf<F> below = side.wi.z < zero;
-        F cos_h = select(below, r.wo_h * reciprocal_sqrt(r.h.h_len2), g.cos_theta_d);
-        InterfaceSplit<F> split = interface_split(fresnel_dielectric_both(cos_h, side.eta_t), w.transmitted_luminance);
-        F interface = select(below, split.refracts * transmission_pdf(side, r, b.specular.ggx, sampler),
-                             split.reflects * specular);
+        pdf = select(below, through, pdf);
+    } else if (!s.opaque()) {
+        InterfaceSplit<F> split = interface_split(p.fresnel, w.transmitted_luminance);
+        F through_h = (side.eta_t * side.eta_t) * -m.wi_h * m.over * m.smith_wi;  // norm η_t² |wi·H| / (Q² S(wo))
+        F through = distribution ? through_h * m.smith_wo * m.h.hz : F(2.0) * through_h * m.wo_h;
+        F interface = select(below, select(m.transmits, split.refracts * through, zero), split.reflects * specular);
         pdf = mul_add(w.transmission, interface, pdf);
     }
-    return select(scattered, w.inv_total * pdf, zero);
+    return select(p.scattered, w.inv_total * pdf, zero);
 }
 
 template <class F>
 PB_MODEL_INLINE F pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s, SpecularSampler sampler) {
     Side<F> side = side_of(wi, wo, s);
-    return pdf2015(side, geometry_of(side.wi, side.wo), lobe_weights2015(side, s), s, sampler);
+    return pdf2015(pair2015_of(side, s), lobe_weights2015(side, s), s, sampler);
 }
 
 // The lobe a sample draws from: 0 cosine, 1 specular, 2 clearcoat, 3 transmission,
@@ -448,25 +518,6 @@ PB_MODEL_INLINE LobeChoice2015<F> choose_lobe2015(F u0, const LobeWeights2015<F>
     return {{cosine, specular}, transmission, diffuse_transmission, within};
 }
 
-// wi refracted from wo about the microfacet normal h = d / |d| with η_t (Snell's
-// law at the microfacet): with c = wo·h and cos²θt = (c² + (η_t - 1)(η_t + 1)) / η_t²,
-//   wi = -wo / η_t + (c / η_t - cos θt) h;
-// 0 under total internal reflection (cos²θt <= 0) or for d = 0.
-template <class F>
-PB_MODEL_INLINE Vec3<F> refract_about(const Vec3<F>& wo, const Vec3<F>& d, F eta_t) {
-    F zero(0.0);
-    F d_len2 = squared_length(d);
-    F inv_len = reciprocal_sqrt(d_len2);
-    Vec3<F> h{d.x * inv_len, d.y * inv_len, d.z * inv_len};
-    F c = dot(wo, h);
-    F cos2_t = cos2_theta_transmitted(c, eta_t);
-    F inv_eta = F(1.0) / eta_t;
-    F along_h = mul_sub(c, inv_eta, square_root_nonnegative(cos2_t));
-    Vec3<F> wi{mul_sub(along_h, h.x, wo.x * inv_eta), mul_sub(along_h, h.y, wo.y * inv_eta), mul_sub(along_h, h.z, wo.z * inv_eta)};
-    Vec3<F> none{zero, zero, zero};
-    return select((cos2_t > zero) & (d_len2 > zero) & (c > zero), wi, none);
-}
-
 // One drawn sample: wi (in the caller's frame), its mixture pdf, weight
 // f |cos θl| / pdf (0 with the pdf where wi is no sample), the lobe drawn from.
 template <class F>
@@ -474,18 +525,40 @@ struct Sample2015 {
     Vec3<F> wi;
     F pdf;
     Rgb<F> weight;
-    Lobes2015<F> lobes;  // f's lobes at (wi, wo)
-    F scale;             // |cos θl| / pdf where valid, else 0
+    LobeValues2015<F> lobes;  // f's lobes at (wi, wo)
+    F scale;                  // |cos θl| / pdf where valid, else 0
+    LobeChoice2015<F> choice;
+};
+
+// A draw in three stages, as the kernels' sampling loop runs them: the
+// choice at wo alone (the weights and the lobe), the direction, its weight.
+template <class F>
+struct Chosen2015 {
+    LobeWeights2015<F> weights;
     LobeChoice2015<F> choice;
 };
 
 template <class F>
-PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u, const Shading2015<F>& s,
-                                        SpecularSampler sampler, TransportMode mode) {
-    F zero(0.0);
+PB_MODEL_INLINE Chosen2015<F> choose2015(const Vec3<F>& wo, F u0, const Shading2015<F>& s) {
+    Chosen2015<F> c;
+    c.weights = lobe_weights2015(side_of(wo, wo, s), s);
+    c.choice = choose_lobe2015(u0, c.weights);
+    return c;
+}
+
+// wi as the viewer sees it, and the lobe it came from once the interface has
+// chosen between reflection and refraction.
+template <class F>
+struct Drawn2015 {
+    Vec3<F> wi;
+    LobeChoice2015<F> choice;
+};
+
+template <class F>
+PB_MODEL_INLINE Drawn2015<F> draw2015(const Vec3<F>& wo, const Uniforms<F>& u, const Chosen2015<F>& c,
+                                      const Shading2015<F>& s, SpecularSampler sampler) {
     Side<F> view = side_of(wo, wo, s);
-    LobeWeights2015<F> w = lobe_weights2015(view, s);
-    LobeChoice2015<F> choice = choose_lobe2015(u.u0, w);
+    LobeChoice2015<F> choice = c.choice;
     Vec3<F> wi = sample_direction(view.wo, u, choice.reflected, s.brdf, sampler).wi;
     wi = select(choice.diffuse_transmission, mirrored(wi), wi);
     if (s.thin && any(choice.transmission)) {
@@ -501,35 +574,55 @@ PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u
         const auto [sin_phi, cos_phi] = sincos_turns(u.u1);
         Vec3<F> d = sampler == SpecularSampler::kDistribution ? ggx.sample_distribution(sin_phi, cos_phi, u.u2)
                                                                : ggx.sample_visible(view.wo, sin_phi, cos_phi, u.u2);
-        F wo_d = dot(view.wo, d), d_len2 = squared_length(d);
-        InterfaceSplit<F> split =
-            interface_split(fresnel_dielectric_both(wo_d * reciprocal_sqrt(d_len2), view.eta_t), w.transmitted_luminance);
+        F d_len2 = squared_length(d);
+        F inv_len = reciprocal_sqrt(d_len2);
+        Vec3<F> h{d.x * inv_len, d.y * inv_len, d.z * inv_len};
+        F wo_h = dot(view.wo, h);
+        InterfaceSplit<F> split = interface_split(fresnel_dielectric_both(wo_h, view.eta_t), c.weights.transmitted_luminance);
         MaskOf<F> reflects = choice.transmission & (choice.within_transmission < split.reflects);
-        F scale = F(2.0) * wo_d / d_len2;
-        Vec3<F> reflected{mul_sub(scale, d.x, view.wo.x), mul_sub(scale, d.y, view.wo.y), mul_sub(scale, d.z, view.wo.z)};
-        wi = select(reflects, reflected, select(choice.transmission, refract_about(view.wo, d, view.eta_t), wi));
+        F scale = F(2.0) * wo_h;
+        Vec3<F> reflected{mul_sub(scale, h.x, view.wo.x), mul_sub(scale, h.y, view.wo.y), mul_sub(scale, h.z, view.wo.z)};
+        Vec3<F> none{F(0.0), F(0.0), F(0.0)};
+        Vec3<F> refracted = select((d_len2 > F(0.0)) & (wo_h > F(0.0)), refract(view.wo, h, view.eta_t), none);
+        wi = select(reflects, reflected, select(choice.transmission, refracted, wi));
         choice.transmission = choice.transmission & !reflects;
         choice.reflected.specular = choice.reflected.specular | reflects;
     }
+    return {wi, choice};
+}
+
+// (LobeSet as for lobe_values2015)
+template <LobeSet lobes = LobeSet::kAll, class F>
+PB_MODEL_INLINE Sample2015<F> weigh2015(const Vec3<F>& wo, const Chosen2015<F>& c, const Drawn2015<F>& drawn,
+                                       const Shading2015<F>& s, SpecularSampler sampler, TransportMode mode) {
+    F zero(0.0);
+    Side<F> side = side_of(wo, wo, s);
+    Vec3<F> wi = drawn.wi;
     // a draw counts only on its lobe's side: the reflected lobes' above, the transmission's below
-    MaskOf<F> below = choice.transmission | choice.diffuse_transmission;
+    MaskOf<F> below = drawn.choice.transmission | drawn.choice.diffuse_transmission;
     MaskOf<F> on_its_side = (below & (wi.z < zero)) | (!below & (wi.z > zero));
     // the pair as the viewer sees it is the view with the drawn wi (side_of reads only wo)
-    Side<F> pair = view;
-    pair.wi = wi;
-    Geometry<F> g = geometry_of(pair.wi, pair.wo);
+    side.wi = wi;
+    Pair2015<F> pair = pair2015_of(side, s);
     Sample2015<F> out;
-    out.pdf = pdf2015(pair, g, w, s, sampler);
-    out.lobes = eval_lobes2015(pair, g, s, mode);
-    wi = select(view.flipped, mirrored(wi), wi);  // back to the caller's frame
-    MaskOf<F> valid = (out.pdf > zero) & (view.wo.z > zero) & on_its_side;
+    out.pdf = pdf2015(pair, c.weights, s, sampler);
+    out.lobes = lobe_values2015<lobes>(pair, s, mode);
+    wi = select(side.flipped, mirrored(wi), wi);  // back to the caller's frame
+    MaskOf<F> valid = (out.pdf > zero) & (side.wo.z > zero) & on_its_side;
     out.scale = select(valid, max(wi.z, -wi.z) / out.pdf, zero);
-    Rgb<F> f = out.lobes.total();
+    Rgb<F> f = out.lobes.template total<lobes>(s);
     out.weight = {select(valid, out.scale * f.r, zero), select(valid, out.scale * f.g, zero), select(valid, out.scale * f.b, zero)};
     out.pdf = select(valid, out.pdf, zero);
     MaskOf<F> finite = squared_length(wo) <= F(kLargestDirectionsLength2);
     Vec3<F> none{zero, zero, zero};
     out.wi = select(finite, wi, none);
-    out.choice = choice;
+    out.choice = drawn.choice;
     return out;
+}
+
+template <LobeSet lobes = LobeSet::kAll, class F>
+PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u, const Shading2015<F>& s,
+                                        SpecularSampler sampler, TransportMode mode) {
+    Chosen2015<F> c = choose2015(wo, u.u0, s);
+    return weigh2015<lobes>(wo, c, draw2015(wo, u, c, s, sampler), s, sampler, mode);
 }

@@ -1,6 +1,6 @@
 // Part of the model (docs/gradients.md, "The 2015 BSDF"): the 2015 models'
 // derivatives (the solid's and the thin sheet's) in their parameter slots and
-// in the directions, by forward mode: eval_lobes2015
+// in the directions, by forward mode: eval2015
 // instantiated for dual numbers (model/dual.hpp), so that every path of the
 // model (its sides, η from specular through the exact Fresnel factor and the
 // refraction, the clamps) is differentiated as it is evaluated. Where the
@@ -60,7 +60,7 @@ PB_MODEL_INLINE Rgb<F> eval_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, c
         bool wanted = q == 0;  // (the first pass gives the value)
         for (int t = 0; t < kSlotsAPass; ++t) wanted = wanted || jacobian.wants(q * kSlotsAPass + t);
         if (!wanted) continue;
-        Rgb<D> f = cosine_factor * eval_lobes2015(dwi, dwo, s.pass[q], mode).total();
+        Rgb<D> f = cosine_factor * eval2015(dwi, dwo, s.pass[q], mode);
         auto put = [&](int c, const D& channel) {
             for (int t = 0; t < kSlotsAPass; ++t)
                 if (jacobian.wants(q * kSlotsAPass + t)) jacobian(c, q * kSlotsAPass + t, channel.d[t]);
@@ -107,7 +107,7 @@ PB_MODEL_INLINE Rgb<F> eval_direction_gradient2015(const Vec3<F>& wi, const Vec3
             w[k] = tangent >= 0 && tangent < kSlotsAPass ? D::variable(components[k], tangent) : D(components[k]);
         }
         Vec3<D> dwi{w[0], w[1], w[2]}, dwo{w[3], w[4], w[5]};
-        Rgb<D> f = eval_lobes2015(dwi, dwo, s, mode).total();
+        Rgb<D> f = eval2015(dwi, dwo, s, mode);
         if (cosine) f = max(dwi.z, -dwi.z) * f;
         auto put = [&](int c, const D& channel) {
             for (int t = 0; t < kSlotsAPass && q * kSlotsAPass + t < kDirectionSlots; ++t)

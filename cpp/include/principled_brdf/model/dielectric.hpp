@@ -64,44 +64,42 @@ PB_MODEL_INLINE F fresnel_dielectric_transmittance(F cos_theta_i, F eta) {
     return fresnel_dielectric_both(cos_theta_i, eta).transmittance;
 }
 
-// The direction refracted from w through the interface (Snell's law), on the
-// far side: with c = |cos θ| and cos θt = sqrt(1 - (1 - c²)/η²),
-//   wt = -w / η + (c / η - cos θt) sign(w·n) n.
-// Zero under total internal reflection (no refracted direction).
+// The direction refracted from w through a surface of unit normal m (Snell's
+// law), on the far side: with c = |w·m| and cos θt = sqrt(1 - (1 - c²)/η²),
+//   wt = -w / η + (c / η - cos θt) sign(w·m) m;
+// zero under total internal reflection (no refracted direction). m is n for
+// the interface itself, a microfacet's normal for a rough one.
 template <class F>
-PB_MODEL_INLINE Vec3<F> refract(const Vec3<F>& w, F eta) {
+PB_MODEL_INLINE Vec3<F> refract(const Vec3<F>& w, const Vec3<F>& m, F eta) {
     F one(1.0), zero(0.0);
-    F c = min(max(w.z, -w.z), one);
+    F signed_c = dot(w, m);
+    F c = min(max(signed_c, -signed_c), one);
     F inv_eta = one / eta;
     F cos2_t = cos2_theta_transmitted(c, eta);
-    MaskOf<F> transmits = cos2_t > zero;
-    F cos_t = square_root(cos2_t);
-    F normal_part = mul_sub(c, inv_eta, cos_t);
-    F z = select(w.z < zero, -normal_part, normal_part) - w.z * inv_eta;
-    Vec3<F> wt{-w.x * inv_eta, -w.y * inv_eta, z};
+    F normal_part = mul_sub(c, inv_eta, square_root_nonnegative(cos2_t));
+    F along = select(signed_c < zero, -normal_part, normal_part);
+    Vec3<F> wt{mul_sub(along, m.x, w.x * inv_eta), mul_sub(along, m.y, w.y * inv_eta), mul_sub(along, m.z, w.z * inv_eta)};
     Vec3<F> none{zero, zero, zero};
-    return select(transmits, wt, none);
+    return select(cos2_t > zero, wt, none);
+}
+
+template <class F>
+PB_MODEL_INLINE Vec3<F> refract(const Vec3<F>& w, F eta) {
+    return refract(w, Vec3<F>{F(0.0), F(0.0), F(1.0)}, eta);
 }
 
 // The generalised half vector of a pair (Walter et al. 2007 eq. 16), each
 // direction weighted by the index of its own side: H = wo + η wi with η the
 // index on wi's side over that on wo's (1 for reflection, where H = wi + wo),
-// unnormalised and turned to the side of n (H·n >= 0).
+// unnormalised and turned to the side of n (H·n >= 0). Given η - 1 and formed
+// as (wo + wi) + (η - 1) wi: where η nears 1 the light passes nearly straight
+// through, wi nears -wo, and wo + wi is exact where wo + η wi would lose the
+// digits of its rounded product.
 template <class F>
-PB_MODEL_INLINE Vec3<F> generalized_half_vector(const Vec3<F>& wi, const Vec3<F>& wo, F eta) {
-    Vec3<F> h{mul_add(eta, wi.x, wo.x), mul_add(eta, wi.y, wo.y), mul_add(eta, wi.z, wo.z)};
+PB_MODEL_INLINE Vec3<F> generalized_half_vector(const Vec3<F>& wi, const Vec3<F>& wo, F eta_minus_one) {
+    F k = eta_minus_one;
+    Vec3<F> h{mul_add(k, wi.x, wo.x + wi.x), mul_add(k, wi.y, wo.y + wi.y), mul_add(k, wi.z, wo.z + wi.z)};
     MaskOf<F> below = h.z < F(0.0);
     Vec3<F> flipped{-h.x, -h.y, -h.z};
     return select(below, flipped, h);
-}
-
-// dωh/dωi of refraction (Walter et al. 2007 eq. 17), h the unit generalised
-// half vector and η as for generalized_half_vector:
-//   η² |wi·h| / (wo·h + η wi·h)²,
-// +inf where the denominator vanishes (wi and wo on one side along h).
-template <class F>
-PB_MODEL_INLINE F refraction_jacobian(const Vec3<F>& wi, const Vec3<F>& wo, const Vec3<F>& h, F eta) {
-    F wi_h = dot(wi, h);
-    F denominator = mul_add(eta, wi_h, dot(wo, h));
-    return eta * eta * max(wi_h, -wi_h) / (denominator * denominator);
 }

@@ -100,13 +100,14 @@ template <class F>
 PB_MODEL_INLINE MultipleScatteringLobe<F> multiple_scattering_of(const F* p, const Shading<F>& s, Model model) {
     F one(1.0);
     MultipleScatteringLobe<F> ms;
-    ms.missing = energy::kMissing[static_cast<int>(model)];
-    ms.corners = energy::kMissingCorners[static_cast<int>(model)];
+    const int table = row_of(model).energy_table;
+    ms.missing = energy::kMissing[table];
+    ms.corners = energy::kMissingCorners[table];
     // r_eff clamped to the tables' [0, 1]
     F y = min(max(p[kRoughness], F(0.0)), one) * F(energy::kRoughnesses - 1);
     IndexOf<F> j = min(truncate_to_index(y), IndexOf<F>(energy::kRoughnesses - 2));
     ms.row = {truncate_to_index(index_to_real(j) * F(energy::kIntervals)), y - index_to_real(j)};
-    const float* average = energy::kMissingAverage[static_cast<int>(model)];
+    const float* average = energy::kMissingAverage[table];
     const auto [average_j, average_next] = gather_pair_in_row<energy::kRoughnesses - 1>(average, j);
     F missing_average = mix(average_j, average_next, ms.row.fraction);
     F e_average = one - missing_average;

@@ -13,13 +13,14 @@
 #include <utility>
 
 #include "principled_brdf/energy_corners.hpp"
-#include "principled_brdf/params.hpp"
+#include "principled_brdf/model_table.hpp"
 
 namespace principled_brdf::f64 {
 
 #include "scalar_ops.hpp"
 #define PB_MODEL_INLINE inline
 #include "model.hpp"
+#include "toolkit.hpp"
 #undef PB_MODEL_INLINE
 
 }  // namespace principled_brdf::f64

@@ -82,12 +82,10 @@ PB_MODEL_INLINE MaterialPartials<F> material_partials_of(const F* p) {
     // ax = max(0.001, r² / aspect), ay = max(0.001, r² aspect), aspect = sqrt(1 - 0.9 anisotropic):
     // ∂ln ax/∂r = ∂ln ay/∂r = 2 / r, ∂ln ax/∂anisotropic = -∂ln ay/∂anisotropic = 0.45 / aspect²
     F roughness = p[kRoughness];
-    F aspect2 = neg_mul_add(F(0.9), p[kAnisotropic], one);
-    F inv_aspect = reciprocal_sqrt(aspect2);
-    F alpha = roughness * roughness;
-    MaskOf<F> x_active = alpha * inv_aspect > F(0.001), y_active = alpha * (aspect2 * inv_aspect) > F(0.001);
+    Alphas<F> alphas = alphas_of(roughness, p[kAnisotropic]);
+    MaskOf<F> x_active = alphas.x > F(0.001), y_active = alphas.y > F(0.001);
     F log_roughness = F(2.0) * reciprocal(select(x_active | y_active, roughness, one));
-    F log_aspect = F(0.45) * (inv_aspect * inv_aspect);
+    F log_aspect = F(0.45) * (alphas.inv_aspect * alphas.inv_aspect);
     F x_roughness = select(x_active, log_roughness, zero), y_roughness = select(y_active, log_roughness, zero);
     F x_anisotropic = select(x_active, log_aspect, zero), y_anisotropic = select(y_active, -log_aspect, zero);
     F half(0.5);

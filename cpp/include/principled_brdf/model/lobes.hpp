@@ -5,6 +5,21 @@
 // wo) and its density.
 #pragma once  // once per translation unit: included only by model.hpp, which allows one namespace
 
+// f's lobes, a color each, in kLobeNames' order (Lobe indexes them); the
+// lobes a model does not have are 0.
+template <class F>
+using LobeColors = std::array<Rgb<F>, kLobeCount>;
+
+template <class F>
+PB_MODEL_INLINE LobeColors<F> no_lobes() {
+    LobeColors<F> lobes;
+    for (Rgb<F>& lobe : lobes) lobe = {F(0.0), F(0.0), F(0.0)};
+    return lobes;
+}
+
+template <class F>
+PB_MODEL_INLINE Rgb<F>& lobe_of(LobeColors<F>& lobes, Lobe lobe) { return lobes[static_cast<int>(lobe)]; }
+
 // What the lobes read of a pair (wi, wo): the half vector H = wi + wo kept
 // unnormalised (docs/model.md, "The model", numerics).
 template <class F>
@@ -12,7 +27,7 @@ struct Geometry : HalfVector<F> {
     Vec3<F> wi, wo;
     F cos_theta_d;            // |H| / 2 (= wi·h = wo·h for unit vectors)
     F one_minus_cos_theta_d;  // |wi - wo|² / (4 (1 + cos θd)): no cancellation as wi -> wo
-    MaskOf<F> finite;         // |wi|² + |wo|² <= kLargestDirectionsLength2: false for NaN, infinities and long vectors
+    MaskOf<F> in_range;       // |wi|² + |wo|² <= kLargestDirectionsLength2: false for NaN, infinities and long vectors
 };
 
 // With the direction check off, a pair is evaluated as given while
@@ -37,7 +52,7 @@ PB_MODEL_INLINE Geometry<F> geometry_of(const Vec3<F>& wi, const Vec3<F>& wo) {
     F dx = wi.x - wo.x, dy = wi.y - wo.y, dz = wi.z - wo.z;
     F d_len2 = mul_add(dx, dx, mul_add(dy, dy, dz * dz));
     // |H|² + |wi - wo|² = 2 (|wi|² + |wo|²) (the parallelogram law)
-    g.finite = g.h_len2 + d_len2 <= F(2.0 * kLargestDirectionsLength2);
+    g.in_range = g.h_len2 + d_len2 <= F(2.0 * kLargestDirectionsLength2);
     g.one_minus_cos_theta_d = d_len2 / mul_add(F(4.0), g.cos_theta_d, F(4.0));
     return g;
 }
@@ -61,7 +76,7 @@ struct DiffuseLobe {
 
     // the scalar factor of color (with_subsurface false: for a subsurface of 0, known)
     template <bool with_subsurface = true>
-    PB_MODEL_INLINE F value(const Geometry<F>& g, const Fresnel<F>& fresnel) const {
+    PB_MODEL_INLINE F factor(const Geometry<F>& g, const Fresnel<F>& fresnel) const {
         F one(1.0);
         F cos2_theta_d = F(0.25) * g.h_len2;
         // mix(1, F90, FL) as 1 + (F90 - 1) FL, one rounding
@@ -90,7 +105,7 @@ struct DiffusePartials {
     F value, roughness, subsurface;
 };
 
-// DiffuseLobe::value with its partials: fd and Fss are products of two lines
+// DiffuseLobe::factor with its partials: fd and Fss are products of two lines
 // in roughness, (1 + (F90 - 1) FL)(1 + (F90 - 1) FV), and D = mix(fd, ss, subsurface)
 template <class F>
 PB_MODEL_INLINE DiffusePartials<F> diffuse_partials(const DiffuseLobe<F>& lobe, const Geometry<F>& g, const Fresnel<F>& fresnel) {
@@ -115,12 +130,35 @@ struct SheenLobe {
     Rgb<F> color;  // sheen Csheen (1 - metallic); the lobe is FH times it
 };
 
+// The GGX alphas of a roughness and an anisotropy (Burley 2012 with the 2014
+// addenda): aspect = sqrt(1 - 0.9 anisotropic), r² / aspect and r² aspect,
+// before the lobes' floor of 0.001.
+template <class F>
+struct Alphas {
+    F x, y;
+    F inv_aspect;  // 1 / aspect
+};
+
+template <class F>
+PB_MODEL_INLINE Alphas<F> alphas_of(F roughness, F anisotropic) {
+    F aspect2 = neg_mul_add(F(0.9), anisotropic, F(1.0));  // in [0.1, 1]
+    F inv_aspect = reciprocal_sqrt(aspect2);
+    F alpha = roughness * roughness;
+    return {alpha * inv_aspect, alpha * (aspect2 * inv_aspect), inv_aspect};
+}
+
+template <class F>
+PB_MODEL_INLINE Ggx<F> ggx_of_roughness(F roughness, F anisotropic) {
+    Alphas<F> a = alphas_of(roughness, anisotropic);
+    return Ggx<F>::from_alphas(max(F(0.001), a.x), max(F(0.001), a.y));
+}
+
 // The primary specular, the microfacet BRDF D F G / (4 cos θl cos θv) with
 //   D = Ds, anisotropic GGX,
 //   F = Fs = mix(Cspec0, 1, FH), per channel (applied by LobeValues),
 //   G = G1(wi) G1(wo), separable Smith: anisotropic in the 2014 model,
 //       isotropic with alpha_g = (0.5 + roughness / 2)² in the 2012 one.
-// value() is its scalar factor D G / (4 cos θl cos θv) = Ds Gs (docs/model.md's
+// ds_gs() is its scalar factor D G / (4 cos θl cos θv) = Ds Gs (docs/model.md's
 // Gs = S(wi) S(wo), S(w) = G1(w) / (2 n·w)).
 template <class F>
 struct SpecularLobe {
@@ -135,7 +173,7 @@ struct SpecularLobe {
     // 1/(4 cos θl cos θv) divides out, so neither G1 nor the cosines' product is
     // formed (no 0/0 at grazing angles), and D over the product is one rounded quotient.
     template <Model model>
-    PB_MODEL_INLINE F value(const Geometry<F>& g, F smith_wo) const {
+    PB_MODEL_INLINE F ds_gs(const Geometry<F>& g, F smith_wo) const {
         F four_cos_cos_over_g;  // 4 cos θl cos θv / G
         if constexpr (model == Model::kDisney2012) {
             four_cos_cos_over_g = smith_denominator_iso(g.wi, alpha_g2) * smith_wo;
@@ -196,7 +234,7 @@ struct ClearcoatLobe {
     // 0.25 clearcoat D F G / (4 cos θl cos θv), grey (0 in every lane without a clearcoat):
     // with D = norm |H|² / gtr1.denominator (Gtr1::d), one quotient
     // (0.25 clearcoat norm) F |H|² / (gtr1.denominator (4 cos θl cos θv / G))
-    PB_MODEL_INLINE F value(const Geometry<F>& g, F fh, F smith_wo) const {
+    PB_MODEL_INLINE F grey_value(const Geometry<F>& g, F fh, F smith_wo) const {
         if (absent()) return F(0.0);
         F f = mul_add(F(0.96), fh, F(0.04));  // F = mix(0.04, 1, FH)
         F four_cos_cos_over_g = smith_denominator_iso_small(g.wi.z, F(kSmithAlpha2)) * smith_wo;  // 4 cos θl cos θv / G

@@ -35,12 +35,7 @@ PB_MODEL_INLINE Shading<F> shading_of(const F* p) {
 
     s.specular.f0 = mix((p[kSpecular] * F(0.08)) * mix(white, tint, p[kSpecularTint]), base, metallic);
     s.specular.f0_luminance = luminance_of(s.specular.f0);
-    // 2014 addenda: aspect = sqrt(1 - 0.9 anisotropic), alpha = roughness²
-    F aspect2 = neg_mul_add(F(0.9), p[kAnisotropic], one);  // in [0.1, 1]
-    F inv_aspect = reciprocal_sqrt(aspect2);
-    F aspect = aspect2 * inv_aspect;
-    F alpha = p[kRoughness] * p[kRoughness];
-    s.specular.ggx = Ggx<F>::from_alphas(max(F(0.001), alpha * inv_aspect), max(F(0.001), alpha * aspect));
+    s.specular.ggx = ggx_of_roughness(p[kRoughness], p[kAnisotropic]);
     F alpha_g = mul_add(F(0.5), p[kRoughness], F(0.5));
     s.specular.alpha_g2 = (alpha_g * alpha_g) * (alpha_g * alpha_g);
 
@@ -55,10 +50,13 @@ PB_MODEL_INLINE Shading<F> shading_of(const F* p) {
 // once per call from a uniform material): each set leaves out only terms that
 // are exactly 0 for the materials it is chosen for, so that f has the same
 // bits as with kAll (a multiply-add with a zero product returns its addend).
+// The 2015 models keep their transmissions in every set (skipped when the
+// material is opaque in every lane).
 enum class LobeSet : int {
     kAll,       // every lobe (subsurface and clearcoat still skipped when 0 in every lane)
     kPlain,     // diffuse and primary specular: subsurface, sheen and clearcoat 0
-    kSpecular,  // the primary specular alone: metallic 1 (no diffuse, subsurface or sheen), clearcoat 0
+    kSpecular,  // the primary specular alone: no diffuse, subsurface or sheen (metallic 1, or in the 2015
+                // models spec_trans 1), clearcoat 0
 };
 
 // What f and the pdf need of wo alone.
@@ -108,6 +106,17 @@ struct LobeValues {
     Rgb<F> specular_rgb(const Shading<F>& s) const { return specular * mix(s.specular.f0, Rgb<F>{F(1.0), F(1.0), F(1.0)}, fh); }  // Ds Gs Fs
     Rgb<F> clearcoat_rgb() const { return {clearcoat, clearcoat, clearcoat}; }
 
+    // every lobe, the multiple-scattering one given (the transmissions are 0)
+    LobeColors<F> colors(const Shading<F>& s, const Rgb<F>& multiple_scattering) const {
+        LobeColors<F> lobes = no_lobes<F>();
+        lobe_of(lobes, Lobe::kDiffuse) = diffuse_rgb(s);
+        lobe_of(lobes, Lobe::kSheen) = sheen_rgb(s);
+        lobe_of(lobes, Lobe::kSpecular) = specular_rgb(s);
+        lobe_of(lobes, Lobe::kClearcoat) = clearcoat_rgb();
+        lobe_of(lobes, Lobe::kMultipleScattering) = multiple_scattering;
+        return lobes;
+    }
+
     // f = diffuse + sheen + specular + clearcoat per channel, summed from the
     // clearcoat up with each lobe's product fused into the sum: three FMAs a
     // channel (fewer for a LobeSet without the diffuse or the sheen: their
@@ -140,7 +149,7 @@ struct LobeValues {
 // off, H is finite): the values are selected away there, whatever they are.
 template <class F>
 PB_MODEL_INLINE MaskOf<F> above_surface(const Geometry<F>& g) {
-    return (g.wi.z > F(0.0)) & (g.wo.z > F(0.0)) & g.finite;
+    return (g.wi.z > F(0.0)) & (g.wo.z > F(0.0)) & g.in_range;
 }
 
 // (the lobes a LobeSet leaves out are 0)
@@ -151,12 +160,12 @@ PB_MODEL_INLINE LobeValues<F> eval_lobes(const Geometry<F>& g, const Shading<F>&
     if constexpr (lobes == LobeSet::kSpecular) {
         out.diffuse = F(0.0);
     } else {
-        out.diffuse = s.diffuse.template value<lobes == LobeSet::kAll>(g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
+        out.diffuse = s.diffuse.template factor<lobes == LobeSet::kAll>(g, Fresnel<F>{schlick_weight(g.wi.z), view.fv, fh});
     }
     out.fh = fh;
-    out.specular = s.specular.template value<model>(g, view.smith_specular);
+    out.specular = s.specular.template ds_gs<model>(g, view.smith_specular);
     if constexpr (lobes == LobeSet::kAll) {
-        out.clearcoat = s.clearcoat.value(g, fh, view.smith_clearcoat);
+        out.clearcoat = s.clearcoat.grey_value(g, fh, view.smith_clearcoat);
     } else {
         out.clearcoat = F(0.0);
     }
@@ -314,13 +323,13 @@ PB_MODEL_INLINE Weighed<F> weigh(const Vec3<F>& wo, F fv, const LobeWeights<F>& 
     View<F> view = view_of<model, set>(wo, s, drawn.smith_visible, fv);
     Geometry<F> g = geometry_of(wi, wo);
     F pdf = mixture_pdf<set>(g, s, view, weights, sampler);
-    MaskOf<F> valid = (min(wi.z, wo.z) > F(0.0)) & g.finite & (pdf > F(0.0));
+    MaskOf<F> valid = (min(wi.z, wo.z) > F(0.0)) & g.in_range & (pdf > F(0.0));
     LobeValues<F> lobes = eval_lobes<model, set>(g, s, view);
     Rgb<F> f = lobes.template total<set>(s);
     F scale = wi.z / pdf;  // cos θl / pdf
     // select after multiplying: below the horizon f may be infinite or NaN
     auto weight = [&](F value) { return select(valid, scale * value, F(0.0)); };
-    auto finite = [&](F value) { return select(g.finite, value, F(0.0)); };
+    auto finite = [&](F value) { return select(g.in_range, value, F(0.0)); };
     Weighed<F> w;
     w.wi = {finite(wi.x), finite(wi.y), finite(wi.z)};
     w.pdf = select(valid, pdf, F(0.0));
