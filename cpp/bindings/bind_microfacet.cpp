@@ -151,7 +151,7 @@ py::array_t<double> generalized_half_vector(const Float64Array& wi, const Float6
     Column a(wi, 3, "wi"), b(wo, 3, "wo"), e(eta, 1, "eta");
     const py::ssize_t n = common_rows({&a, &b, &e});
     return vector_rows(n, [&](py::ssize_t i) {
-        return mf::generalized_half_vector(a.unit_vector(i), b.unit_vector(i), e.scalar(i) - 1.0);
+        return mf::generalized_half_vector(a.unit_vector(i), b.unit_vector(i), e.scalar(i));
     });
 }
 

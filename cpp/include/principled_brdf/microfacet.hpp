@@ -323,7 +323,7 @@ inline Vec3 refract(const Vec3& w, double eta) { return from_model(f64::refract(
 // h = normalize(wo + η wi) turned to the side of n: η the index on wi's side
 // over that on wo's (1: the usual half vector). (0, 0, 0) where wo + η wi = 0.
 inline Vec3 generalized_half_vector(const Vec3& wi, const Vec3& wo, double eta) {
-    const Vec3 h = from_model(f64::generalized_half_vector(to_model(wi), to_model(wo), eta));
+    const Vec3 h = from_model(f64::generalized_half_vector(to_model(wi), to_model(wo), eta - 1.0));
     const double length2 = dot(h, h);
     return length2 > 0.0 ? scale(h, 1.0 / std::sqrt(length2)) : Vec3{0.0, 0.0, 0.0};
 }
