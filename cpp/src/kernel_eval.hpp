@@ -75,7 +75,7 @@ PB_KERNEL_INLINE PreparedOf<model, output, compensated> prepare_for(const RawMat
         return DirectionShading2015{shading2015_of(m.slot, thin),
                                     halves_of(m, [&](const Doubles* p) { return constant_shading2015_of(p, thin); })};
     } else if constexpr (is_bsdf(model)) {
-        return shading2015_of(m.slot, thin);
+        return model_shading_of<model>(m);
     } else if constexpr (compensated) {
         Shading<Floats> s = shading_of(m);
         return {{s, NoPartials{}, NoPartials{}}, multiple_scattering_of(m.slot, s, model)};
@@ -252,11 +252,14 @@ PB_KERNEL_INLINE void eval_bsdf_batch(const EvalJob& job, std::int64_t i, const 
         direction_batch<output, layouts>(job, i, wi, wo, differentiate, value);
     } else if constexpr (output == Output::kLobes) {
         store_lobes<layouts>(job.out, i, eval_lobes2015(wi, wo, s, job.mode).colors(), weighted);
+    } else if constexpr (output == Output::kPdf) {
+        pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
+    } else if constexpr (output == Output::kValuePdf) {
+        ValuePdf2015<Floats> both = eval_pdf2015<lobes>(wi, wo, s, job.mode, job.sampler);
+        both.pdf.store_unaligned(job.pdf + i);
+        store_rgb<layouts, true>(job.out[0], i, weighted(both.f));
     } else {
-        if constexpr (output == Output::kPdf || output == Output::kValuePdf)
-            pdf2015(wi, wo, s, job.sampler).store_unaligned(job.pdf + i);
-        if constexpr (output != Output::kPdf)
-            store_rgb<layouts, true>(job.out[0], i, weighted(eval2015<lobes>(wi, wo, s, job.mode)));
+        store_rgb<layouts, true>(job.out[0], i, weighted(eval2015<lobes>(wi, wo, s, job.mode)));
     }
 }
 

@@ -29,6 +29,16 @@ PB_KERNEL_INLINE RawMaterial load_material(const ParamSlot* params, std::int64_t
 
 PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shading_of(m.slot); }
 
+// A model's constants for f, the pdf and the draw: the BRDFs' Shading, the 2015 models' Shading2015.
+template <Model model>
+PB_KERNEL_INLINE auto model_shading_of(const RawMaterial& m) {
+    if constexpr (is_bsdf(model)) {
+        return shading2015_of(m.slot, model == Model::kDisney2015Thin);
+    } else {
+        return shading_of(m);
+    }
+}
+
 // For a uniform material, once per call (model/energy.hpp): the energy
 // table's two rows about its r_eff blended into one (values and slopes, so
 // linear in r like the lookup of two rows), so that a lookup reads one

@@ -31,16 +31,7 @@ using ChosenOf = std::conditional_t<is_bsdf(model), Chosen2015Batch, Chosen>;
 template <Model model>
 using DrawnOf = std::conditional_t<is_bsdf(model), Drawn2015<Floats>, Direction<Floats>>;
 template <Model model>
-using SamplingShading = std::conditional_t<is_bsdf(model), Shading2015<Floats>, Shading<Floats>>;
-
-template <Model model>
-PB_KERNEL_INLINE SamplingShading<model> sampling_shading_of(const RawMaterial& m) {
-    if constexpr (is_bsdf(model)) {
-        return shading2015_of(m.slot, model == Model::kDisney2015Thin);
-    } else {
-        return shading_of(m);
-    }
-}
+using SamplingShading = decltype(model_shading_of<model>(std::declval<const RawMaterial&>()));
 
 // wo and the uniforms (given or counter-based); false, with nothing loaded,
 // when the fast direction test does not accept wo
@@ -175,7 +166,7 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
     SamplingShading<model> per_batch;
     if constexpr (per_element) {
         m = load_material(job.params, i);
-        per_batch = sampling_shading_of<model>(m);
+        per_batch = model_shading_of<model>(m);
     }
     const SamplingShading<model>& s = per_element ? per_batch : uniform;
     ChosenOf<model> chosen;
@@ -265,7 +256,7 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
     BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
         RawMaterial m = load_material(job.params, 0);
-        uniform = sampling_shading_of<model>(m);
+        uniform = model_shading_of<model>(m);
         if constexpr (compensated) {
             uniform_ms = multiple_scattering_of(m.slot, uniform, model);
             row.template use_for<model>(uniform_ms);

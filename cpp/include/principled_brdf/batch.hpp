@@ -170,7 +170,6 @@ struct EvalJob {
     bool per_element_material = false;
 
     bool uniform_material() const { return !per_element_material && principled_brdf::uniform_material(params); }
-    bool thin() const { return model == Model::kDisney2015Thin; }
     // The floats an element of this job's output writes to `jacobian`.
     int jacobian_width() const {
         switch (output) {
@@ -239,7 +238,6 @@ struct SampleJob {
     bool per_element_material = false;  // as in EvalJob
 
     bool uniform_material() const { return !per_element_material && principled_brdf::uniform_material(params); }
-    bool thin() const { return model == Model::kDisney2015Thin; }
 };
 
 // A call as `count` segments of `length` elements, element j of segment s

@@ -493,6 +493,22 @@ PB_MODEL_INLINE F pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading201
     return pdf2015(pair2015_of(side, s), lobe_weights2015(side, s), s, sampler);
 }
 
+// f and the pdf of a pair from its one microfacet (eval_pdf)
+template <class F>
+struct ValuePdf2015 {
+    Rgb<F> f;
+    F pdf;
+};
+
+template <LobeSet lobes = LobeSet::kAll, class F>
+PB_MODEL_INLINE ValuePdf2015<F> eval_pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s,
+                                             TransportMode mode, SpecularSampler sampler) {
+    Side<F> side = side_of(wi, wo, s);
+    Pair2015<F> pair = pair2015_of(side, s);
+    return {lobe_values2015<lobes>(pair, s, mode).template total<lobes>(s),
+            pdf2015(pair, lobe_weights2015(side, s), s, sampler)};
+}
+
 // The lobe a sample draws from: 0 cosine, 1 specular, 2 clearcoat, 3 transmission,
 // 4 diffuse transmission (kSampledLobeNames), by u0 Σ w against the weights'
 // running sums. The diffuse transmission draws the cosine lobe's direction
