@@ -31,9 +31,12 @@ def module_files() -> dict[str, pathlib.Path]:
 
 
 def extension_modules() -> set[str]:
-    """The compiled submodules (``_core``): imported by name, importing nothing of the package."""
-    return {".".join((PACKAGE,) + path.relative_to(PACKAGE_DIR).parts[:-1] + (path.name.split(".")[0],))
-            for suffix in ("*.so", "*.pyd") for path in PACKAGE_DIR.rglob(suffix)}
+    """The compiled submodules (``_core``): imported by name, importing nothing of the package.
+    Found where the package was imported from (an installed wheel keeps them there, not in
+    the source tree)."""
+    installed = pathlib.Path(pb.__file__).resolve().parent
+    return {".".join((PACKAGE,) + path.relative_to(installed).parts[:-1] + (path.name.split(".")[0],))
+            for suffix in ("*.so", "*.pyd") for path in installed.rglob(suffix)}
 
 
 def _is_type_checking(test: ast.expr) -> bool:
