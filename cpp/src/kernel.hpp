@@ -54,8 +54,15 @@ constexpr std::int64_t kLanes = static_cast<std::int64_t>(Floats::size);
 #include "kernel_normal.hpp"
 #include "kernel_sample.hpp"
 
+// The kernel's entry points, each in one part: CMake compiles kernel_<isa>.cpp
+// once per part (PRINCIPLED_BRDF_KERNEL_PART, kernel_parts.hpp), so that the
+// parts of every instruction set compile side by side; without it one file
+// holds them all.
+#include "kernel_parts.hpp"
+
 }  // namespace principled_brdf::kernel::PRINCIPLED_BRDF_ARCH_NS
 
+#if PB_KERNEL_BUILDS(PB_KERNEL_PART_TABLE)
 // The table dispatch.cpp reads: <ns>_kernels() of kernel_api.hpp.
 #define PRINCIPLED_BRDF_JOIN2(a, b) a##b
 #define PRINCIPLED_BRDF_JOIN(a, b) PRINCIPLED_BRDF_JOIN2(a, b)
@@ -72,3 +79,4 @@ const KernelTable& PRINCIPLED_BRDF_JOIN(PRINCIPLED_BRDF_ARCH_NS, _kernels)() {
 }
 
 }  // namespace principled_brdf::kernel
+#endif

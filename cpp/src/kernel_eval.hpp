@@ -541,8 +541,10 @@ std::int64_t eval_model_range(const EvalJob& job, std::int64_t begin, std::int64
     }
 }
 
-inline std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
+// The job's model's loops for its output, one of the list's (the kernel's parts, kernel_parts.hpp).
+template <class Outputs>
+std::int64_t eval_job_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
     return with_model(job.model, [&](auto model) {
-        return with_output(job.output, [&](auto output) { return eval_model_range<model(), output()>(job, begin, end); });
+        return Outputs::with(job.output, [&](auto output) { return eval_model_range<model(), output()>(job, begin, end); });
     });
 }

@@ -347,7 +347,8 @@ std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int
     return sample_checked<model, per_element, Layouts::kMixed>(job, begin, end);
 }
 
-inline std::int64_t sample_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+// The job's model's sampling loops.
+inline std::int64_t sample_job_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
     const bool per_element = !job.uniform_material();
     return with_model(job.model, [&](auto model) {
         return per_element ? sample_range_for<model(), true>(job, begin, end) : sample_range_for<model(), false>(job, begin, end);

@@ -4,6 +4,7 @@
 // hot path.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <type_traits>
 #include <string>
@@ -58,21 +59,23 @@ enum class Output : int {
     kDirectionVjp = 7,  // Σ_c g_c ∂f_c/∂w per element for the six components (no f, no Jacobian)
 };
 
-// body(output) with the output as a compile-time constant (std::integral_constant).
-template <class Body>
-auto with_output(Output output, Body&& body) {
-    auto as = [&](auto constant) { return body(constant); };
-    switch (output) {
-        case Output::kLobes: return as(std::integral_constant<Output, Output::kLobes>{});
-        case Output::kPdf: return as(std::integral_constant<Output, Output::kPdf>{});
-        case Output::kGradient: return as(std::integral_constant<Output, Output::kGradient>{});
-        case Output::kValuePdf: return as(std::integral_constant<Output, Output::kValuePdf>{});
-        case Output::kVjp: return as(std::integral_constant<Output, Output::kVjp>{});
-        case Output::kDirectionGradient: return as(std::integral_constant<Output, Output::kDirectionGradient>{});
-        case Output::kDirectionVjp: return as(std::integral_constant<Output, Output::kDirectionVjp>{});
-        default: return as(std::integral_constant<Output, Output::kTotal>{});
+// A list of outputs (the kernels' parts compile one list each): holds(output),
+// and with(output, body), body(output) with the output as a compile-time
+// constant (std::integral_constant) for an output of the list.
+template <Output... outputs>
+struct OutputList {
+    static constexpr Output kFirst = std::array<Output, sizeof...(outputs)>{outputs...}[0];
+
+    static constexpr bool holds(Output output) { return ((output == outputs) || ...); }
+
+    template <class Body>
+    static auto with(Output output, Body&& body) {
+        using Result = decltype(body(std::integral_constant<Output, kFirst>{}));
+        Result result{};
+        ((output == outputs && (result = body(std::integral_constant<Output, outputs>{}), true)) || ...);
+        return result;
     }
-}
+};
 
 // The direction components the derivatives in the directions are taken by:
 // wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.
