@@ -124,17 +124,6 @@ void each_compensated(Model model, Function&& f) {
     }
 }
 
-// f(cache) with a shading cache of the 2015 model, the solid's or the thin sheet's.
-template <class Function>
-void each_shading2015(Model model, Function&& f) {
-    if (model == Model::kDisney2015Thin) {
-        reference::ThinShading2015Cache cache;
-        f(cache);
-    } else {
-        reference::Shading2015Cache cache;
-        f(cache);
-    }
-}
 
 // f (N,3) or the lobes (N,7,3) for N packed rows: wi (N,3), wo (N,3), params (N,16) or one shared row.
 py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& wo, const Float64Array& params,
@@ -166,7 +155,7 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
         };
         if (is_bsdf(which_model)) {
             const TransportMode transport = mode_from(mode);
-            each_shading2015(which_model, [&](auto& shading) {
+            reference::with_cache2015<reference::Shading2015Cache>(which_model, [&](auto& shading) {
                 for (py::ssize_t i = 0; i < n; ++i) {
                     const auto& material = shading.of(material_rows.row(i));
                     const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
@@ -234,13 +223,7 @@ py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, co
                     store(i, reference::eval_grad(prepared.of(material_rows.row(i)), in, view, transport));
                 }
             };
-            if (which_model == Model::kDisney2015Thin) {
-                reference::ThinGradientShading2015Cache prepared;
-                run(prepared);
-            } else {
-                reference::GradientShading2015Cache prepared;
-                run(prepared);
-            }
+            reference::with_cache2015<reference::GradientShading2015Cache>(which_model, run);
         } else {
             reference::GradientShadingCache prepared;
             for (py::ssize_t i = 0; i < n; ++i) {
@@ -277,12 +260,9 @@ py::array_t<double> reference_eval_direction_grad(const Float64Array& wi, const 
     };
     {
         py::gil_scoped_release release;
-        if (which_model == Model::kDisney2015Thin) {
-            reference::ThinDirectionShading2015Cache prepared;
-            run(prepared, bsdf);
-        } else if (which_model == Model::kDisney2015) {
-            reference::DirectionShading2015Cache prepared;
-            run(prepared, bsdf);
+        if (is_bsdf(which_model)) {
+            reference::with_cache2015<reference::DirectionShading2015Cache>(which_model,
+                                                                             [&](auto& prepared) { run(prepared, bsdf); });
         } else {
             reference::DirectionShadingCache prepared;
             run(prepared, [&](const auto& s, const Eigen::Vector3d& in, const Eigen::Vector3d& view) {
@@ -326,7 +306,7 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
         };
         if (is_bsdf(which_model)) {
             const TransportMode transport = mode_from(mode);
-            each_shading2015(which_model, [&](auto& shading) {
+            reference::with_cache2015<reference::Shading2015Cache>(which_model, [&](auto& shading) {
                 for (py::ssize_t i = 0; i < n; ++i) {
                     const double* ui = uniforms.row(i);
                     store(i, reference::sample(shading.of(material_rows.row(i)), Eigen::Vector3d(view.row(i)), ui[0], ui[1],
@@ -366,7 +346,7 @@ py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo
             }
         };
         if (is_bsdf(which_model)) {
-            each_shading2015(which_model, run);
+            reference::with_cache2015<reference::Shading2015Cache>(which_model, run);
         } else if (energy_compensation) {
             each_compensated(which_model, run);
         } else {
@@ -396,7 +376,7 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
             }
         };
         if (is_bsdf(model_from(model))) {
-            each_shading2015(model_from(model), run);
+            reference::with_cache2015<reference::Shading2015Cache>(model_from(model), run);
         } else if (energy_compensation) {
             each_compensated(model_from(model), run);
         } else {

@@ -441,7 +441,8 @@ ref::Lobes lobes_of(const ref::Shading<double>& s, const Vector3d& wi, const Vec
 ref::Lobes lobes_of(const ref::Compensated& c, const Vector3d& wi, const Vector3d& wo, const Variant& v) {
     return ref::eval_lobes(c, wi, wo, v.model);
 }
-ref::Lobes lobes_of(const ref::Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo, const Variant& v) {
+template <class S, ref::If2015<S> = 0>
+ref::Lobes lobes_of(const S& s, const Vector3d& wi, const Vector3d& wo, const Variant& v) {
     return ref::eval_lobes(s, wi, wo, v.mode);
 }
 Vector3d f_of(const ref::Shading<double>& s, const Vector3d& wi, const Vector3d& wo, const Variant& v) {
@@ -450,7 +451,8 @@ Vector3d f_of(const ref::Shading<double>& s, const Vector3d& wi, const Vector3d&
 Vector3d f_of(const ref::Compensated& c, const Vector3d& wi, const Vector3d& wo, const Variant& v) {
     return ref::eval(c, wi, wo, v.model);
 }
-Vector3d f_of(const ref::Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo, const Variant& v) {
+template <class S, ref::If2015<S> = 0>
+Vector3d f_of(const S& s, const Vector3d& wi, const Vector3d& wo, const Variant& v) {
     return ref::eval(s, wi, wo, v.mode);
 }
 ref::Sample sample_of(const ref::Shading<double>& s, const Vector3d& wo, const Vector3d& u, const Variant& v, SpecularSampler sampler) {
@@ -459,7 +461,8 @@ ref::Sample sample_of(const ref::Shading<double>& s, const Vector3d& wo, const V
 ref::Sample sample_of(const ref::Compensated& c, const Vector3d& wo, const Vector3d& u, const Variant& v, SpecularSampler sampler) {
     return ref::sample(c, wo, u[0], u[1], u[2], v.model, sampler);
 }
-ref::Sample sample_of(const ref::Shading2015<double>& s, const Vector3d& wo, const Vector3d& u, const Variant& v, SpecularSampler sampler) {
+template <class S, ref::If2015<S> = 0>
+ref::Sample sample_of(const S& s, const Vector3d& wo, const Vector3d& u, const Variant& v, SpecularSampler sampler) {
     return ref::sample(s, wo, u[0], u[1], u[2], sampler, v.mode);
 }
 
@@ -470,12 +473,8 @@ void each_prepared(const Batch& b, const Variant& v, Function&& f) {
     auto loop = [&](auto& cache) {
         for (int i = 0; i < b.n; ++i) f(i, cache.of(b.reference_row(i)));
     };
-    if (v.model == Model::kDisney2015Thin) {
-        ref::ThinShading2015Cache cache;
-        loop(cache);
-    } else if (v.solid()) {
-        ref::Shading2015Cache cache;
-        loop(cache);
+    if (v.bsdf()) {
+        ref::with_cache2015<ref::Shading2015Cache>(v.model, loop);
     } else if (v.compensated && v.model == Model::kDisney2012) {
         ref::CompensatedCache<Model::kDisney2012> cache;
         loop(cache);
@@ -496,12 +495,8 @@ std::vector<double> reference_jacobian(const Batch& b, const Variant& v) {
     auto loop_2015 = [&](auto& cache) {
         for (int i = 0; i < b.n; ++i) store(i, ref::eval_grad(cache.of(b.reference_row(i)), at(b.wi, i), at(b.wo, i), v.mode));
     };
-    if (v.model == Model::kDisney2015Thin) {
-        ref::ThinGradientShading2015Cache cache;
-        loop_2015(cache);
-    } else if (v.solid()) {
-        ref::GradientShading2015Cache cache;
-        loop_2015(cache);
+    if (v.bsdf()) {
+        ref::with_cache2015<ref::GradientShading2015Cache>(v.model, loop_2015);
     } else {
         ref::GradientShadingCache cache;
         for (int i = 0; i < b.n; ++i) store(i, ref::eval_grad(cache.of(b.reference_row(i)), at(b.wi, i), at(b.wo, i), v.model));
@@ -520,12 +515,8 @@ std::vector<double> reference_direction_jacobian(const Batch& b, const Variant& 
         for (int i = 0; i < b.n; ++i)
             store(i, ref::eval_direction_grad(cache.of(b.reference_row(i)), at(b.wi, i), at(b.wo, i), cosine, v.mode));
     };
-    if (v.model == Model::kDisney2015Thin) {
-        ref::ThinDirectionShading2015Cache cache;
-        loop_2015(cache);
-    } else if (v.solid()) {
-        ref::DirectionShading2015Cache cache;
-        loop_2015(cache);
+    if (v.bsdf()) {
+        ref::with_cache2015<ref::DirectionShading2015Cache>(v.model, loop_2015);
     } else {
         ref::DirectionShadingCache cache;
         for (int i = 0; i < b.n; ++i)

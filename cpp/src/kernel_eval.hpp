@@ -51,29 +51,31 @@ struct CompensatedPrepared : Prepared<output> {
 // The 2015 models' (model/bsdf2015.hpp): their constants, over dual numbers for
 // the derivatives in the parameters (with their tangents) or, for those in
 // the directions, over dual numbers of double without tangents as well.
+template <Model model>
 struct DirectionShading2015 {
-    Shading2015<Floats> shading;
-    Halves<Shading2015<PassDual<Doubles>>> directions;
+    Shading2015<model, Floats> shading;
+    Halves<Shading2015<model, PassDual<Doubles>>> directions;
 };
 
-template <Output output>
-using Prepared2015 = std::conditional_t<in_parameters(output), GradientShading2015<Floats>,
-                                        std::conditional_t<in_directions(output), DirectionShading2015, Shading2015<Floats>>>;
+template <Model model, Output output>
+using Prepared2015 = std::conditional_t<
+        in_parameters(output), GradientShading2015<Shading2015<model, PassDual<Floats>>>,
+        std::conditional_t<in_directions(output), DirectionShading2015<model>, Shading2015<model, Floats>>>;
 
 // What a batch of `model` needs of its material.
 template <Model model, Output output, bool compensated>
-using PreparedOf = std::conditional_t<is_bsdf(model), Prepared2015<output>,
+using PreparedOf = std::conditional_t<is_bsdf(model), Prepared2015<model, output>,
                                       std::conditional_t<compensated, CompensatedPrepared<output>, Prepared<output>>>;
 
 template <Model model, Output output, bool compensated>
 PB_KERNEL_INLINE PreparedOf<model, output, compensated> prepare_for(const RawMaterial& m) {
     static_assert(!compensated || has_energy_table(model), "the energy compensation needs the model's table");
-    constexpr bool thin = model == Model::kDisney2015Thin;
     if constexpr (is_bsdf(model) && in_parameters(output)) {
-        return gradient_shading2015_of(m.slot, thin);
+        return gradient_shading2015_of<Shading2015<model, PassDual<Floats>>>(m.slot);
     } else if constexpr (is_bsdf(model) && in_directions(output)) {
-        return DirectionShading2015{shading2015_of(m.slot, thin),
-                                    halves_of(m, [&](const Doubles* p) { return constant_shading2015_of(p, thin); })};
+        return DirectionShading2015<model>{model_shading_of<model>(m), halves_of(m, [](const Doubles* p) {
+                                               return constant_shading2015_of<Shading2015<model, PassDual<Doubles>>>(p);
+                                           })};
     } else if constexpr (is_bsdf(model)) {
         return model_shading_of<model>(m);
     } else if constexpr (compensated) {
@@ -237,9 +239,9 @@ PB_KERNEL_INLINE Floats absolute(Floats x) { return xsimd::abs(x); }
 
 // A batch of the 2015 models (model/bsdf2015.hpp): every output over the whole
 // sphere, the cosine as |cos θl|.
-template <Output output, Layouts layouts, LobeSet lobes>
+template <Model model, Output output, Layouts layouts, LobeSet lobes>
 PB_KERNEL_INLINE void eval_bsdf_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
-                                      const Prepared2015<output>& s) {
+                                      const Prepared2015<model, output>& s) {
     auto weighted = [&](const Rgb<Floats>& c) { return job.cosine ? absolute(wi.z) * c : c; };
     if constexpr (in_parameters(output)) {
         derivative_batch<output == Output::kGradient, JacobianStore<layouts>, VjpSink<layouts>, layouts>(
@@ -268,7 +270,7 @@ template <Model model, Output output, Layouts layouts, bool compensated, LobeSet
 PB_KERNEL_INLINE void eval_batch(const EvalJob& job, std::int64_t i, const Vec3<Floats>& wi, const Vec3<Floats>& wo,
                                  const PreparedOf<model, output, compensated>& material) {
     if constexpr (is_bsdf(model)) {
-        eval_bsdf_batch<output, layouts, lobes>(job, i, wi, wo, material);
+        eval_bsdf_batch<model, output, layouts, lobes>(job, i, wi, wo, material);
     } else if constexpr (in_directions(output)) {
         eval_direction_batch<model, output, layouts>(job, i, wi, wo, material.shading, material.directions);
     } else {

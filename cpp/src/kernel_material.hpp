@@ -29,11 +29,11 @@ PB_KERNEL_INLINE RawMaterial load_material(const ParamSlot* params, std::int64_t
 
 PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shading_of(m.slot); }
 
-// A model's constants for f, the pdf and the draw: the BRDFs' Shading, the 2015 models' Shading2015.
+// A model's constants for f, the pdf and the draw: the BRDFs' Shading, the 2015 models' Solid2015 or ThinSheet2015.
 template <Model model>
 PB_KERNEL_INLINE auto model_shading_of(const RawMaterial& m) {
     if constexpr (is_bsdf(model)) {
-        return shading2015_of(m.slot, model == Model::kDisney2015Thin);
+        return Shading2015<model, Floats>::of(m.slot);
     } else {
         return shading_of(m);
     }

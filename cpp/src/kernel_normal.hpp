@@ -52,12 +52,13 @@ PB_KERNEL_INLINE ChannelResidual channel_residual(Loss loss, Floats x, Floats ta
 // A problem's material, prepared for its derivatives: the 2015 models' pass
 // by pass (model/bsdf2015_gradient.hpp), the others' with their partials.
 template <Model model>
-using NormalMaterial = std::conditional_t<is_bsdf(model), GradientShading2015<Floats>, Prepared<Output::kGradient>>;
+using NormalMaterial = std::conditional_t<is_bsdf(model), GradientShading2015<Shading2015<model, PassDual<Floats>>>,
+                                          Prepared<Output::kGradient>>;
 
 template <Model model>
-PB_KERNEL_INLINE NormalMaterial<model> prepare_normal(const NormalEquationsJob& job, const RawMaterial& m) {
+PB_KERNEL_INLINE NormalMaterial<model> prepare_normal(const RawMaterial& m) {
     if constexpr (is_bsdf(model)) {
-        return gradient_shading2015_of(m.slot, job.model == Model::kDisney2015Thin);
+        return gradient_shading2015_of<Shading2015<model, PassDual<Floats>>>(m.slot);
     } else {
         return prepare<Output::kGradient>(m);
     }
@@ -170,7 +171,7 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
     RawMaterial m;
     for (int s = 0; s < stored; ++s) m.slot[s] = Floats(job.slots[b * stored + s]);
     for (int s = stored; s < kParamSlots; ++s) m.slot[s] = Floats(static_cast<float>(default_of(Param(s))));
-    NormalMaterial<model> material = prepare_normal<model>(job, m);
+    NormalMaterial<model> material = prepare_normal<model>(m);
     Floats gain(job.gain != nullptr ? job.gain[b] : 1.0f);
     const std::int64_t directions = job.per_problem_directions ? 3 * n * b : 0;
     const float* wi = job.wi + directions;
@@ -218,13 +219,8 @@ void normal_equations_of(const NormalEquationsJob& job, std::int64_t j) {
 }
 
 inline void normal_equations_range(const NormalEquationsJob& job, std::int64_t begin, std::int64_t end) {
-    for (std::int64_t j = begin; j < end; ++j) {
-        if (job.model == Model::kDisney2012) {
-            normal_equations_of<Model::kDisney2012>(job, j);
-        } else if (is_bsdf(job.model)) {  // the solid and the thin sheet (prepare_normal tells them apart)
-            normal_equations_of<Model::kDisney2015>(job, j);
-        } else {
-            normal_equations_of<Model::kDisney2014>(job, j);
-        }
-    }
+    with_model(job.model, [&](auto model) {
+        for (std::int64_t j = begin; j < end; ++j) normal_equations_of<model()>(job, j);
+        return 0;
+    });
 }

@@ -5,15 +5,17 @@
 // each compilation instantiates only its part's loops. Without the macro (0)
 // one compilation holds the whole kernel.
 //
-// The evaluation's outputs are split into four families, each a part;
-// eval_range, in the table's part, sends a job to its family's.
+// The evaluation's outputs are split into four families, each a part, and
+// the samples into two; eval_range and sample_range, in the table's part, send
+// a job to its part.
 
-#define PB_KERNEL_PART_TABLE 1       // the table, eval_range and the normal equations
+#define PB_KERNEL_PART_TABLE 1       // the table, eval_range, sample_range and the normal equations
 #define PB_KERNEL_PART_VALUES 2      // f and its lobes
 #define PB_KERNEL_PART_DENSITIES 3   // the sampling pdf, and f with it
 #define PB_KERNEL_PART_GRADIENTS 4   // f's Jacobian and vector-Jacobian product in the parameters
 #define PB_KERNEL_PART_DIRECTIONS 5  // the same in the directions
-#define PB_KERNEL_PART_SAMPLING 6    // the samples
+#define PB_KERNEL_PART_SAMPLES 6     // the samples of a uniform material
+#define PB_KERNEL_PART_SAMPLES_PER_ELEMENT 7  // those of per-element materials
 #ifndef PRINCIPLED_BRDF_KERNEL_PART
 #define PRINCIPLED_BRDF_KERNEL_PART 0
 #endif
@@ -39,7 +41,8 @@ std::int64_t eval_values_range(const EvalJob& job, std::int64_t begin, std::int6
 std::int64_t eval_densities_range(const EvalJob& job, std::int64_t begin, std::int64_t end);
 std::int64_t eval_gradients_range(const EvalJob& job, std::int64_t begin, std::int64_t end);
 std::int64_t eval_directions_range(const EvalJob& job, std::int64_t begin, std::int64_t end);
-std::int64_t sample_range(const SampleJob& job, std::int64_t begin, std::int64_t end);
+std::int64_t sample_uniform_range(const SampleJob& job, std::int64_t begin, std::int64_t end);
+std::int64_t sample_per_element_range(const SampleJob& job, std::int64_t begin, std::int64_t end);
 
 #if PB_KERNEL_BUILDS(PB_KERNEL_PART_VALUES)
 std::int64_t eval_values_range(const EvalJob& job, std::int64_t begin, std::int64_t end) {
@@ -65,9 +68,15 @@ std::int64_t eval_directions_range(const EvalJob& job, std::int64_t begin, std::
 }
 #endif
 
-#if PB_KERNEL_BUILDS(PB_KERNEL_PART_SAMPLING)
-std::int64_t sample_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
-    return sample_job_range(job, begin, end);
+#if PB_KERNEL_BUILDS(PB_KERNEL_PART_SAMPLES)
+std::int64_t sample_uniform_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+    return sample_job_range<false>(job, begin, end);
+}
+#endif
+
+#if PB_KERNEL_BUILDS(PB_KERNEL_PART_SAMPLES_PER_ELEMENT)
+std::int64_t sample_per_element_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+    return sample_job_range<true>(job, begin, end);
 }
 #endif
 
@@ -78,5 +87,9 @@ std::int64_t eval_range(const EvalJob& job, std::int64_t begin, std::int64_t end
     if (GradientOutputs::holds(job.output)) return eval_gradients_range(job, begin, end);
     if (DirectionOutputs::holds(job.output)) return eval_directions_range(job, begin, end);
     return -1;  // (not reached: each_output_in_one_family)
+}
+
+std::int64_t sample_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+    return job.uniform_material() ? sample_uniform_range(job, begin, end) : sample_per_element_range(job, begin, end);
 }
 #endif

@@ -98,9 +98,8 @@ PB_KERNEL_INLINE void store_sample(const SampleJob& job, std::int64_t i, const L
 }
 
 // The 2015 models' sample, stored as store_sample's.
-template <Layouts layouts, bool with_lobes>
-PB_KERNEL_INLINE void store_sample2015(const SampleJob& job, std::int64_t i, const Sample2015<Floats>& drawn,
-                                       const Shading2015<Floats>& s) {
+template <Layouts layouts, bool with_lobes, class S>
+PB_KERNEL_INLINE void store_sample2015(const SampleJob& job, std::int64_t i, const Sample2015<Floats>& drawn, const S& s) {
     store_rgb<layouts>(job.wi, i, Rgb<Floats>{drawn.wi.x, drawn.wi.y, drawn.wi.z});
     drawn.pdf.store_unaligned(job.pdf + i);
     store_rgb<layouts>(job.weight, i, drawn.weight);
@@ -347,10 +346,8 @@ std::int64_t sample_range_for(const SampleJob& job, std::int64_t begin, std::int
     return sample_checked<model, per_element, Layouts::kMixed>(job, begin, end);
 }
 
-// The job's model's sampling loops.
-inline std::int64_t sample_job_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
-    const bool per_element = !job.uniform_material();
-    return with_model(job.model, [&](auto model) {
-        return per_element ? sample_range_for<model(), true>(job, begin, end) : sample_range_for<model(), false>(job, begin, end);
-    });
+// The job's model's sampling loops, for a uniform material or per-element ones.
+template <bool per_element>
+std::int64_t sample_job_range(const SampleJob& job, std::int64_t begin, std::int64_t end) {
+    return with_model(job.model, [&](auto model) { return sample_range_for<model(), per_element>(job, begin, end); });
 }

@@ -64,7 +64,6 @@ struct Material {
     }
 
     Shading<double> shading() const { return shading_of(slots().data()); }
-    Shading2015<double> shading2015() const { return shading2015_of(slots().data()); }
 };
 
 // What a run of packed material rows (slot order of params.hpp) prepares,
@@ -117,8 +116,21 @@ using ShadingCache = RowCache<Shading<double>, &shading_of<double>>;
 template <Model model>
 using CompensatedCache = RowCache<Compensated, &compensated_of<model>>;
 using GradientShadingCache = RowCache<GradientShading, &gradient_shading_of>;
-using Shading2015Cache = RowCache<Shading2015<double>, &solid_shading2015_of<double>>;
-using ThinShading2015Cache = RowCache<Shading2015<double>, &thin_shading2015_of<double>>;
+template <Model model>
+using Shading2015Cache = RowCache<Shading2015<model, double>, &Shading2015<model, double>::of>;
+
+// f(cache) with the row cache Cache<model> of a 2015 model (Shading2015Cache,
+// GradientShading2015Cache, DirectionShading2015Cache); nothing for the others.
+template <template <Model> class Cache, class Function>
+void with_cache2015(Model model, Function&& f) {
+    with_model(model, [&](auto constant) {
+        if constexpr (is_bsdf(constant())) {
+            Cache<constant()> cache;
+            f(cache);
+        }
+        return 0;
+    });
+}
 
 // The lobes of kLobeNames (params.hpp), in its order, each already weighted as it enters the sum.
 struct Lobes {
@@ -321,10 +333,14 @@ inline Sample sample(const Compensated& c, const Vector3d& wo, double u0, double
                                        : compensated_sample_of<Model::kDisney2014>(c, vec3(wo), u, sampler);
 }
 
-// ---------------------------------------------------------------- the 2015 solid (model/bsdf2015.hpp)
+// ---------------------------------------------------------------- the 2015 models (model/bsdf2015.hpp)
 // Directions anywhere on the sphere; f = 0 where either lies in the tangent plane.
+// The functions below take either model's constants, Solid2015 or ThinSheet2015 (over F).
+template <class S, class F = double>
+using If2015 = std::enable_if_t<std::is_base_of_v<Interface2015<F>, S>, int>;
 
-inline Lobes eval_lobes(const Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
+template <class S, If2015<S> = 0>
+inline Lobes eval_lobes(const S& s, const Vector3d& wi, const Vector3d& wo,
                         TransportMode mode = TransportMode::kRadiance) {
     const Lobes2015<double> v = eval_lobes2015(vec3(wi), vec3(wo), s, mode);
     Lobes out;
@@ -337,13 +353,15 @@ inline Lobes eval_lobes(const Shading2015<double>& s, const Vector3d& wi, const 
     return out;
 }
 
-inline Vector3d eval(const Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
+template <class S, If2015<S> = 0>
+inline Vector3d eval(const S& s, const Vector3d& wi, const Vector3d& wo,
                      TransportMode mode = TransportMode::kRadiance) {
     return vector3d(eval2015(vec3(wi), vec3(wo), s, mode));
 }
 
 // P_k at wo of the sampled lobes (kSampledLobeNames); a solid's interface counted as its split at h = n.
-inline std::array<double, kSampledLobeNames.size()> lobe_probabilities(const Shading2015<double>& s, const Vector3d& wo) {
+template <class S, If2015<S> = 0>
+inline std::array<double, kSampledLobeNames.size()> lobe_probabilities(const S& s, const Vector3d& wo) {
     const LobeWeights2015<double> w = lobe_weights2015(side_of(vec3(wo), vec3(wo), s), s);
     const double reflected = w.interface_reflection;
     return {w.cosine * w.inv_total, (w.specular + reflected) * w.inv_total, w.clearcoat * w.inv_total,
@@ -351,14 +369,16 @@ inline std::array<double, kSampledLobeNames.size()> lobe_probabilities(const Sha
 }
 
 // The mixture density of wi given wo over the whole sphere.
-inline double pdf(const Shading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
+template <class S, If2015<S> = 0>
+inline double pdf(const S& s, const Vector3d& wi, const Vector3d& wo,
                   SpecularSampler sampler = SpecularSampler::kVisibleNormals) {
     return pdf2015(vec3(wi), vec3(wo), s, sampler);
 }
 
 // As sample() of the BRDFs; lobe 3 is the transmission, 4 the thin sheet's diffuse transmission. wi = 0 where the
 // transmission's microfacet reflects totally (no refracted direction).
-inline Sample sample(const Shading2015<double>& s, const Vector3d& wo, double u0, double u1, double u2,
+template <class S, If2015<S> = 0>
+inline Sample sample(const S& s, const Vector3d& wo, double u0, double u1, double u2,
                      SpecularSampler sampler = SpecularSampler::kVisibleNormals,
                      TransportMode mode = TransportMode::kRadiance) {
     const Sample2015<double> drawn = sample2015(vec3(wo), Uniforms<double>{u0, u1, u2}, s, sampler, mode);
@@ -374,10 +394,12 @@ struct Gradient2015 {
             Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor>::Zero();
 };
 
-using GradientShading2015Cache = RowCache<GradientShading2015<double>, &solid_gradient_shading2015_of<double>>;
-using ThinGradientShading2015Cache = RowCache<GradientShading2015<double>, &thin_gradient_shading2015_of<double>>;
+template <Model model>
+using GradientShading2015Cache = RowCache<GradientShading2015<Shading2015<model, PassDual<double>>>,
+                                          &gradient_shading2015_of<Shading2015<model, PassDual<double>>, double>>;
 
-inline Gradient2015 eval_grad(const GradientShading2015<double>& s, const Vector3d& wi, const Vector3d& wo,
+template <class S>
+inline Gradient2015 eval_grad(const GradientShading2015<S>& s, const Vector3d& wi, const Vector3d& wo,
                               TransportMode mode = TransportMode::kRadiance) {
     struct Sink {
         Gradient2015& out;

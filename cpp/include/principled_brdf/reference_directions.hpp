@@ -36,11 +36,12 @@ inline DirectionGradient eval_direction_grad(const DirectionShading& s, const Ve
 }
 
 // The 2015 models' (model/bsdf2015_gradient.hpp): over the whole sphere, in `mode`.
-using DirectionShading2015 = Shading2015<PassDual<double>>;
-using DirectionShading2015Cache = RowCache<DirectionShading2015, &solid_constant_shading2015_of<double>>;
-using ThinDirectionShading2015Cache = RowCache<DirectionShading2015, &thin_constant_shading2015_of<double>>;
+template <Model model>
+using DirectionShading2015Cache = RowCache<Shading2015<model, PassDual<double>>,
+                                           &constant_shading2015_of<Shading2015<model, PassDual<double>>, double>>;
 
-inline DirectionGradient eval_direction_grad(const DirectionShading2015& s, const Vector3d& wi, const Vector3d& wo,
+template <class S, If2015<S, PassDual<double>> = 0>
+inline DirectionGradient eval_direction_grad(const S& s, const Vector3d& wi, const Vector3d& wo,
                                              bool cosine, TransportMode mode) {
     DirectionGradient out;
     out.value = vector3d(f64::eval_direction_gradient2015(

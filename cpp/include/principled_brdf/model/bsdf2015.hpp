@@ -26,11 +26,13 @@ PB_MODEL_INLINE F eta_minus_one_of_specular(F specular) {
     return max(F(2.0) * root / (F(1.0) - root), F(0.001));
 }
 
-// Everything the 2015 solid needs of a material, independent of the directions.
+// What the solid and the thin sheet share of a material, independent of the
+// directions: the 2014 lobes outside and the dielectric interface.
 template <class F>
-struct Shading2015 {
+struct Interface2015 {
     // the 2014 lobes' constants, the diffuse and sheen colors and the cosine
-    // lobe's weight times w_D = (1 - metallic)(1 - spec_trans)
+    // lobe's weight times the share of the diffuse that stays outside (w_D =
+    // (1 - metallic)(1 - spec_trans) of it, less the sheet's transmitted part)
     Shading<F> brdf;
     F flatness;
     // the specular's Fresnel factor F_s = dielectric F_D(cos θd; η) + schlick_f0 (1 - FH) + schlick_grazing FH:
@@ -39,32 +41,27 @@ struct Shading2015 {
     F dielectric;
     Rgb<F> schlick_f0;
     F schlick_grazing;
-    F transmission_weight;     // w_T = (1 - metallic) spec_trans
-    Rgb<F> transmission_color;  // sqrt(base_color)
-    F transmission_luminance;   // lum(sqrt(base_color))
+    F transmission_weight;      // w_T = (1 - metallic) spec_trans
+    Rgb<F> transmission_color;  // the transmitted light's color c
+    F transmission_luminance;   // lum(c)
     F eta, inv_eta;
     F eta_minus_one, inv_eta_minus_one;  // η - 1 and 1/η - 1 = -(η - 1)/η
-    // the thin sheet's: the transmission's GGX, alphas of r_t = clamp((0.65 η - 0.35) r, 0, 1) with
-    // roughness's anisotropy, and the diffuse transmission w_D dt c / π, its sampling weight w_D dt lum(c)
-    bool thin = false;
-    Ggx<F> thin_ggx;
-    Rgb<F> diffuse_transmission;
-    F diffuse_transmission_luminance;
 
     PB_MODEL_INLINE bool opaque() const { return !nonzero_anywhere(transmission_weight); }
 };
 
+// The interface's constants with `kept` of the diffuse and sheen outside
+// and transmitted light of color `transmitted`.
 template <class F>
-PB_MODEL_INLINE Shading2015<F> shading2015_of(const F* p, bool thin = false) {
+PB_MODEL_INLINE Interface2015<F> interface2015_of(const F* p, F kept, const Rgb<F>& transmitted) {
     F one(1.0);
-    Shading2015<F> s;
+    Interface2015<F> s;
     s.brdf = shading_of(p);
     F metallic = p[kMetallic], dielectric = one - metallic;
-    F opaque_fraction = one - p[kSpecTrans];
-    s.brdf.diffuse.color = opaque_fraction * s.brdf.diffuse.color;
+    s.brdf.diffuse.color = kept * s.brdf.diffuse.color;
     s.brdf.diffuse.subsurface = F(0.0);
-    s.brdf.sheen.color = opaque_fraction * s.brdf.sheen.color;
-    s.brdf.diffuse.cosine_lobe_weight = opaque_fraction * s.brdf.diffuse.cosine_lobe_weight;
+    s.brdf.sheen.color = kept * s.brdf.sheen.color;
+    s.brdf.diffuse.cosine_lobe_weight = kept * s.brdf.diffuse.cosine_lobe_weight;
     s.flatness = p[kFlatness];
 
     Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
@@ -74,36 +71,67 @@ PB_MODEL_INLINE Shading2015<F> shading2015_of(const F* p, bool thin = false) {
     s.schlick_f0 = (dielectric * specular_tint * F(0.08) * p[kSpecular]) * tint + metallic * base;
     s.schlick_grazing = mul_add(dielectric, specular_tint, metallic);
     s.transmission_weight = dielectric * p[kSpecTrans];
-    s.transmission_color = {square_root(base.r), square_root(base.g), square_root(base.b)};
-    s.transmission_luminance = luminance_of(s.transmission_color);
+    s.transmission_color = transmitted;
+    s.transmission_luminance = luminance_of(transmitted);
     s.eta_minus_one = eta_minus_one_of_specular(p[kSpecular]);
     s.eta = s.eta_minus_one + one;
     s.inv_eta = one / s.eta;
     s.inv_eta_minus_one = -s.eta_minus_one * s.inv_eta;
-    s.thin = thin;
-    if (thin) {
-        // dt = diff_trans / 2 of the diffuse goes through the sheet; transmitted light keeps c, not sqrt(c)
-        F kept = neg_mul_add(F(0.5), p[kDiffTrans], one);
-        F through = F(0.5) * p[kDiffTrans];
-        s.brdf.diffuse.color = kept * s.brdf.diffuse.color;
-        s.brdf.sheen.color = kept * s.brdf.sheen.color;
-        s.brdf.diffuse.cosine_lobe_weight = kept * s.brdf.diffuse.cosine_lobe_weight;
-        s.transmission_color = base;
-        s.transmission_luminance = luminance_of(base);
-        F diffuse_weight = dielectric * opaque_fraction * through;
-        s.diffuse_transmission = (diffuse_weight * F(kInvPi)) * base;
-        s.diffuse_transmission_luminance = diffuse_weight * s.transmission_luminance;
-        F thin_roughness = min(max(mul_add(F(0.65), s.eta, F(-0.35)) * p[kRoughness], F(0.0)), one);
-        s.thin_ggx = ggx_of_roughness(thin_roughness, p[kAnisotropic]);
-    }
     return s;
 }
 
-// (one model's each, for a function pointer)
+// The solid (disney2015): the interface refracts, transmitted light takes
+// c = sqrt(base_color) (it crosses the surface twice), the diffuse keeps 1 - spec_trans.
 template <class F>
-PB_MODEL_INLINE Shading2015<F> solid_shading2015_of(const F* p) { return shading2015_of(p, false); }
+struct Solid2015 : Interface2015<F> {
+    static constexpr bool thin = false;
+
+    static PB_MODEL_INLINE Solid2015 of(const F* p) {
+        Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
+        Rgb<F> root{square_root(base.r), square_root(base.g), square_root(base.b)};
+        return {interface2015_of(p, F(1.0) - p[kSpecTrans], root)};
+    }
+};
+
+// The thin sheet (disney2015_thin): dt = diff_trans / 2 of the diffuse goes
+// through the sheet as a diffuse transmission, w_D dt c / π, sampled with
+// weight w_D dt lum(c); the microfacet transmission takes its own GGX, of
+// r_t = clamp((0.65 η - 0.35) r, 0, 1) with roughness's anisotropy; the light
+// that passes keeps c = base_color.
 template <class F>
-PB_MODEL_INLINE Shading2015<F> thin_shading2015_of(const F* p) { return shading2015_of(p, true); }
+struct ThinSheet2015 : Interface2015<F> {
+    static constexpr bool thin = true;
+    Ggx<F> transmission_ggx;
+    Rgb<F> diffuse_transmission;
+    F diffuse_transmission_luminance;
+
+    static PB_MODEL_INLINE ThinSheet2015 of(const F* p) {
+        F one(1.0);
+        Rgb<F> base{p[kBaseColorR], p[kBaseColorG], p[kBaseColorB]};
+        F opaque_fraction = one - p[kSpecTrans];
+        F through = F(0.5) * p[kDiffTrans];
+        Interface2015<F> shared = interface2015_of(p, opaque_fraction * (one - through), base);
+        F diffuse_weight = (one - p[kMetallic]) * opaque_fraction * through;
+        F roughness = min(max(mul_add(F(0.65), shared.eta, F(-0.35)) * p[kRoughness], F(0.0)), one);
+        return {shared, ggx_of_roughness(roughness, p[kAnisotropic]), (diffuse_weight * F(kInvPi)) * base,
+                diffuse_weight * shared.transmission_luminance};
+    }
+};
+
+// The model's constants of a material: Solid2015 or ThinSheet2015.
+template <Model model, class F>
+using Shading2015 = std::conditional_t<model == Model::kDisney2015Thin, ThinSheet2015<F>, Solid2015<F>>;
+
+// The diffuse transmission's color (a solid has none).
+template <class S>
+PB_MODEL_INLINE auto diffuse_transmission_of(const S& s) {
+    using Number = decltype(s.eta);
+    if constexpr (S::thin) {
+        return s.diffuse_transmission;
+    } else {
+        return Rgb<Number>{Number(0.0), Number(0.0), Number(0.0)};
+    }
+}
 
 // The pair as the viewer sees it (the file's comment).
 template <class F>
@@ -118,11 +146,11 @@ struct Side {
 template <class F>
 PB_MODEL_INLINE Vec3<F> mirrored(const Vec3<F>& w) { return {w.x, w.y, -w.z}; }
 
-template <class F>
-PB_MODEL_INLINE Side<F> side_of(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s) {
+template <class F, class S>
+PB_MODEL_INLINE Side<F> side_of(const Vec3<F>& wi, const Vec3<F>& wo, const S& s) {
     Side<F> side;
     side.flipped = wo.z < F(0.0);
-    side.inside = s.thin ? MaskOf<F>(false) : side.flipped;
+    side.inside = S::thin ? MaskOf<F>(false) : side.flipped;
     side.wi = select(side.flipped, mirrored(wi), wi);
     side.wo = select(side.flipped, mirrored(wo), wo);
     side.eta_t = select(side.inside, s.inv_eta, s.eta);
@@ -163,7 +191,8 @@ template <class F>
 struct LobeValues2015 {
     F diffuse, sheen, specular_f0, specular_grey, clearcoat, transmission, diffuse_transmission;
 
-    Lobes2015<F> rgb(const Shading2015<F>& s) const {
+    template <class S>
+    Lobes2015<F> rgb(const S& s) const {
         auto grey = [](F x) { return Rgb<F>{x, x, x}; };
         auto specular = [&](F f0) { return mul_add(specular_f0, f0, specular_grey); };
         return {diffuse * s.brdf.diffuse.color,
@@ -171,28 +200,29 @@ struct LobeValues2015 {
                 {specular(s.schlick_f0.r), specular(s.schlick_f0.g), specular(s.schlick_f0.b)},
                 grey(clearcoat),
                 transmission * s.transmission_color,
-                diffuse_transmission * s.diffuse_transmission};
+                diffuse_transmission * diffuse_transmission_of(s)};
     }
 
     // f per channel, each lobe's product fused into one sum (a LobeSet's
     // left-out lobes are 0 for the materials it is chosen for, and so are the
     // transmissions of an opaque solid: their terms are skipped)
-    template <LobeSet lobes = LobeSet::kAll>
-    Rgb<F> total(const Shading2015<F>& s) const {
+    template <LobeSet lobes = LobeSet::kAll, class S>
+    Rgb<F> total(const S& s) const {
         F grey = lobes == LobeSet::kAll ? specular_grey + clearcoat : specular_grey;
         const bool transmits = !s.opaque();
         auto channel = [&](F diffuse_color, F sheen_color, F f0, F transmission_color, F diffuse_transmission_color) {
             F sum = mul_add(specular_f0, f0, grey);
             if (transmits) sum = mul_add(transmission, transmission_color, sum);
-            if (s.thin) sum = mul_add(diffuse_transmission, diffuse_transmission_color, sum);
+            if constexpr (S::thin) sum = mul_add(diffuse_transmission, diffuse_transmission_color, sum);
             if constexpr (lobes == LobeSet::kAll) sum = mul_add(sheen, sheen_color, sum);
             if constexpr (lobes != LobeSet::kSpecular) sum = mul_add(diffuse, diffuse_color, sum);
             return sum;
         };
         const Shading<F>& b = s.brdf;
-        return {channel(b.diffuse.color.r, b.sheen.color.r, s.schlick_f0.r, s.transmission_color.r, s.diffuse_transmission.r),
-                channel(b.diffuse.color.g, b.sheen.color.g, s.schlick_f0.g, s.transmission_color.g, s.diffuse_transmission.g),
-                channel(b.diffuse.color.b, b.sheen.color.b, s.schlick_f0.b, s.transmission_color.b, s.diffuse_transmission.b)};
+        Rgb<F> dt = diffuse_transmission_of(s);
+        return {channel(b.diffuse.color.r, b.sheen.color.r, s.schlick_f0.r, s.transmission_color.r, dt.r),
+                channel(b.diffuse.color.g, b.sheen.color.g, s.schlick_f0.g, s.transmission_color.g, dt.g),
+                channel(b.diffuse.color.b, b.sheen.color.b, s.schlick_f0.b, s.transmission_color.b, dt.b)};
     }
 };
 
@@ -265,11 +295,11 @@ struct Pair2015 {
     MaskOf<F> scattered;
 };
 
-template <class F>
-PB_MODEL_INLINE Pair2015<F> pair2015_of(const Side<F>& side, const Shading2015<F>& s) {
+template <class F, class S>
+PB_MODEL_INLINE Pair2015<F> pair2015_of(const Side<F>& side, const S& s) {
     Pair2015<F> p;
     p.side = side;
-    p.microfacet = microfacet_of(side, s.brdf.specular.ggx, !s.thin && !s.opaque());
+    p.microfacet = microfacet_of(side, s.brdf.specular.ggx, !S::thin && !s.opaque());
     p.fresnel = fresnel_dielectric_both(p.microfacet.cos_h, side.eta_t);
     p.scattered = scattered2015(side);
     return p;
@@ -294,11 +324,11 @@ PB_MODEL_INLINE Geometry<F> reflection_geometry(const Pair2015<F>& p) {
 // vector of (wi', wo),
 //   w_T c (1 - F_D(wo·h'; η)) D_t(h') G1_t(wo) G1_t(wi') / (4 |cos θl| |cos θv|),
 // formed as the specular's Ds Gs (SpecularLobe::ds_gs) with the sheet's GGX; c applied by the caller.
-template <class F>
-PB_MODEL_INLINE F thin_transmission_value(const Side<F>& side, const Shading2015<F>& s) {
+template <class F, class S>
+PB_MODEL_INLINE F thin_transmission_value(const Side<F>& side, const S& s) {
     Vec3<F> through = mirrored(side.wi);
     Geometry<F> g = geometry_of(through, side.wo);
-    F ds_gs = s.thin_ggx.d(g) / (s.thin_ggx.smith_denominator(through) * s.thin_ggx.smith_denominator(side.wo));
+    F ds_gs = s.transmission_ggx.d(g) / (s.transmission_ggx.smith_denominator(through) * s.transmission_ggx.smith_denominator(side.wo));
     F value = s.transmission_weight * fresnel_dielectric_transmittance(g.cos_theta_d, s.eta) * ds_gs;
     return select((side.wi.z < F(0.0)) & g.in_range, value, F(0.0));
 }
@@ -319,8 +349,8 @@ PB_MODEL_INLINE F thin_transmission_pdf(const Side<F>& side, const Ggx<F>& ggx, 
 // reflection, both directions on the viewer's side: outside, the 2014 lobes
 // with F_s; inside, only the interface. The transmission, the light below
 // (Walter et al. 2007 eq. 21, times η_t² in importance mode).
-template <LobeSet lobes = LobeSet::kAll, class F>
-PB_MODEL_INLINE LobeValues2015<F> lobe_values2015(const Pair2015<F>& p, const Shading2015<F>& s, TransportMode mode) {
+template <LobeSet lobes = LobeSet::kAll, class F, class S>
+PB_MODEL_INLINE LobeValues2015<F> lobe_values2015(const Pair2015<F>& p, const S& s, TransportMode mode) {
     const Shading<F>& b = s.brdf;
     const Side<F>& side = p.side;
     const Microfacet<F>& m = p.microfacet;
@@ -354,7 +384,7 @@ PB_MODEL_INLINE LobeValues2015<F> lobe_values2015(const Pair2015<F>& p, const Sh
     out.specular_grey = select(reflected, ds_gs * grey, zero);
     out.transmission = zero;
     out.diffuse_transmission = zero;
-    if (s.thin) {
+    if constexpr (S::thin) {
         // no η² in importance mode: the sheet does not bend the light, and it is reciprocal as it stands
         if (!s.opaque()) out.transmission = select(p.scattered, thin_transmission_value(side, s), zero);
         out.diffuse_transmission = select(p.scattered & (side.wi.z < zero), one, zero);
@@ -366,15 +396,15 @@ PB_MODEL_INLINE LobeValues2015<F> lobe_values2015(const Pair2015<F>& p, const Sh
     return out;
 }
 
-template <class F>
-PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s,
+template <class F, class S>
+PB_MODEL_INLINE Lobes2015<F> eval_lobes2015(const Vec3<F>& wi, const Vec3<F>& wo, const S& s,
                                              TransportMode mode) {
     return lobe_values2015(pair2015_of(side_of(wi, wo, s), s), s, mode).rgb(s);
 }
 
 // f, the lobes summed (LobeValues2015::total)
-template <LobeSet lobes = LobeSet::kAll, class F>
-PB_MODEL_INLINE Rgb<F> eval2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s, TransportMode mode) {
+template <LobeSet lobes = LobeSet::kAll, class F, class S>
+PB_MODEL_INLINE Rgb<F> eval2015(const Vec3<F>& wi, const Vec3<F>& wo, const S& s, TransportMode mode) {
     return lobe_values2015<lobes>(pair2015_of(side_of(wi, wo, s), s), s, mode).template total<lobes>(s);
 }
 
@@ -404,8 +434,8 @@ struct LobeWeights2015 {
     F interface_reflection;   // w_T F_D(cos θv): the interface's share that reflects at h = n
 };
 
-template <class F>
-PB_MODEL_INLINE LobeWeights2015<F> lobe_weights2015(const Side<F>& side, const Shading2015<F>& s) {
+template <class F, class S>
+PB_MODEL_INLINE LobeWeights2015<F> lobe_weights2015(const Side<F>& side, const S& s) {
     F zero(0.0), one(1.0);
     F cos_v = side.wo.z;
     F fv = schlick_weight(cos_v);
@@ -420,7 +450,7 @@ PB_MODEL_INLINE LobeWeights2015<F> lobe_weights2015(const Side<F>& side, const S
     w.interface_reflection = zero;
     w.cosine = select(side.inside, zero, s.brdf.diffuse.cosine_lobe_weight);
     w.clearcoat = select(side.inside, zero, s.brdf.clearcoat.weight(fv));
-    if (s.thin) {
+    if constexpr (S::thin) {
         w.specular = max(specular, F(0.02));
         w.transmission = transmitted;
         w.diffuse_transmission = s.diffuse_transmission_luminance;
@@ -459,8 +489,8 @@ PB_MODEL_INLINE InterfaceSplit<F> interface_split(const FresnelDielectric<F>& fr
 // / (wo·h + η_t wi·h)² (Walter et al. 2007 eq. 17):
 //   visible normals 2 norm η_t² (wo·H) |wi·H| / (Q² S(wo)),  the distribution norm η_t² Hz |wi·H| / Q².
 // The interface is split at the pair's own microfacet (interface_split).
-template <class F>
-PB_MODEL_INLINE F pdf2015(const Pair2015<F>& p, const LobeWeights2015<F>& w, const Shading2015<F>& s,
+template <class F, class S>
+PB_MODEL_INLINE F pdf2015(const Pair2015<F>& p, const LobeWeights2015<F>& w, const S& s,
                           SpecularSampler sampler) {
     F zero(0.0), half(0.5);
     const Side<F>& side = p.side;
@@ -473,9 +503,9 @@ PB_MODEL_INLINE F pdf2015(const Pair2015<F>& p, const LobeWeights2015<F>& w, con
     F reflected = mul_add(w.cosine * F(kInvPi), side.wi.z, mul_add(w.specular, specular, clearcoat));
     MaskOf<F> below = side.wi.z < zero;
     F pdf = select(below, zero, reflected);
-    if (s.thin) {
+    if constexpr (S::thin) {
         F through = mul_add(w.diffuse_transmission * F(kInvPi), -side.wi.z,
-                            w.transmission * thin_transmission_pdf(side, s.thin_ggx, sampler));
+                            w.transmission * thin_transmission_pdf(side, s.transmission_ggx, sampler));
         pdf = select(below, through, pdf);
     } else if (!s.opaque()) {
         InterfaceSplit<F> split = interface_split(p.fresnel, w.transmitted_luminance);
@@ -487,8 +517,8 @@ PB_MODEL_INLINE F pdf2015(const Pair2015<F>& p, const LobeWeights2015<F>& w, con
     return select(p.scattered, w.inv_total * pdf, zero);
 }
 
-template <class F>
-PB_MODEL_INLINE F pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s, SpecularSampler sampler) {
+template <class F, class S>
+PB_MODEL_INLINE F pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const S& s, SpecularSampler sampler) {
     Side<F> side = side_of(wi, wo, s);
     return pdf2015(pair2015_of(side, s), lobe_weights2015(side, s), s, sampler);
 }
@@ -500,8 +530,8 @@ struct ValuePdf2015 {
     F pdf;
 };
 
-template <LobeSet lobes = LobeSet::kAll, class F>
-PB_MODEL_INLINE ValuePdf2015<F> eval_pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<F>& s,
+template <LobeSet lobes = LobeSet::kAll, class F, class S>
+PB_MODEL_INLINE ValuePdf2015<F> eval_pdf2015(const Vec3<F>& wi, const Vec3<F>& wo, const S& s,
                                              TransportMode mode, SpecularSampler sampler) {
     Side<F> side = side_of(wi, wo, s);
     Pair2015<F> pair = pair2015_of(side, s);
@@ -554,8 +584,8 @@ struct Chosen2015 {
     LobeChoice2015<F> choice;
 };
 
-template <class F>
-PB_MODEL_INLINE Chosen2015<F> choose2015(const Vec3<F>& wo, F u0, const Shading2015<F>& s) {
+template <class F, class S>
+PB_MODEL_INLINE Chosen2015<F> choose2015(const Vec3<F>& wo, F u0, const S& s) {
     Chosen2015<F> c;
     c.weights = lobe_weights2015(side_of(wo, wo, s), s);
     c.choice = choose_lobe2015(u0, c.weights);
@@ -570,19 +600,21 @@ struct Drawn2015 {
     LobeChoice2015<F> choice;
 };
 
-template <class F>
+template <class F, class S>
 PB_MODEL_INLINE Drawn2015<F> draw2015(const Vec3<F>& wo, const Uniforms<F>& u, const Chosen2015<F>& c,
-                                      const Shading2015<F>& s, SpecularSampler sampler) {
+                                      const S& s, SpecularSampler sampler) {
     Side<F> view = side_of(wo, wo, s);
     LobeChoice2015<F> choice = c.choice;
     Vec3<F> wi = sample_direction(view.wo, u, choice.reflected, s.brdf, sampler).wi;
     wi = select(choice.diffuse_transmission, mirrored(wi), wi);
-    if (s.thin && any(choice.transmission)) {
-        // a reflection about a half vector of the sheet's GGX, mirrored below
-        Shading<F> sheet = s.brdf;
-        sheet.specular.ggx = s.thin_ggx;
-        LobeChoice<F> specular{MaskOf<F>(false), MaskOf<F>(true)};
-        wi = select(choice.transmission, mirrored(sample_direction(view.wo, u, specular, sheet, sampler).wi), wi);
+    if constexpr (S::thin) {
+        if (any(choice.transmission)) {
+            // a reflection about a half vector of the sheet's GGX, mirrored below
+            Shading<F> sheet = s.brdf;
+            sheet.specular.ggx = s.transmission_ggx;
+            LobeChoice<F> specular{MaskOf<F>(false), MaskOf<F>(true)};
+            wi = select(choice.transmission, mirrored(sample_direction(view.wo, u, specular, sheet, sampler).wi), wi);
+        }
     } else if (any(choice.transmission)) {
         // the solid's interface: h drawn as the specular's, then a reflection about it with probability
         // q(h) = F / (F + T t), else the refraction (the sampling mixture's comment)
@@ -608,9 +640,9 @@ PB_MODEL_INLINE Drawn2015<F> draw2015(const Vec3<F>& wo, const Uniforms<F>& u, c
 }
 
 // (LobeSet as for lobe_values2015)
-template <LobeSet lobes = LobeSet::kAll, class F>
+template <LobeSet lobes = LobeSet::kAll, class F, class S>
 PB_MODEL_INLINE Sample2015<F> weigh2015(const Vec3<F>& wo, const Chosen2015<F>& c, const Drawn2015<F>& drawn,
-                                       const Shading2015<F>& s, SpecularSampler sampler, TransportMode mode) {
+                                       const S& s, SpecularSampler sampler, TransportMode mode) {
     F zero(0.0);
     Side<F> side = side_of(wo, wo, s);
     Vec3<F> wi = drawn.wi;
@@ -636,8 +668,8 @@ PB_MODEL_INLINE Sample2015<F> weigh2015(const Vec3<F>& wo, const Chosen2015<F>& 
     return out;
 }
 
-template <LobeSet lobes = LobeSet::kAll, class F>
-PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u, const Shading2015<F>& s,
+template <LobeSet lobes = LobeSet::kAll, class F, class S>
+PB_MODEL_INLINE Sample2015<F> sample2015(const Vec3<F>& wo, const Uniforms<F>& u, const S& s,
                                         SpecularSampler sampler, TransportMode mode) {
     Chosen2015<F> c = choose2015(wo, u.u0, s);
     return weigh2015<lobes>(wo, c, draw2015(wo, u, c, s, sampler), s, sampler, mode);

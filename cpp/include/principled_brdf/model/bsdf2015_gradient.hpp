@@ -20,37 +20,32 @@ static_assert(kGradientPasses * kSlotsAPass == kParamSlots, "the passes cover th
 template <class F>
 using PassDual = Dual<F, kSlotsAPass>;
 
-// The material's constants, pass by pass: pass q's tangents are those of slots
-// q kSlotsAPass ... (q + 1) kSlotsAPass - 1.
-template <class F>
+// The material's constants S (Solid2015 or ThinSheet2015 over PassDual<F>),
+// pass by pass: pass q's tangents are those of slots q kSlotsAPass ... (q + 1) kSlotsAPass - 1.
+template <class S>
 struct GradientShading2015 {
-    Shading2015<PassDual<F>> pass[kGradientPasses];
+    S pass[kGradientPasses];
 };
 
-template <class F>
-PB_MODEL_INLINE GradientShading2015<F> gradient_shading2015_of(const F* p, bool thin = false) {
-    GradientShading2015<F> g;
+template <class S, class F>
+PB_MODEL_INLINE GradientShading2015<S> gradient_shading2015_of(const F* p) {
+    GradientShading2015<S> g;
     for (int q = 0; q < kGradientPasses; ++q) {
         PassDual<F> slots[kParamSlots];
         for (int k = 0; k < kParamSlots; ++k) {
             const int tangent = k - q * kSlotsAPass;
             slots[k] = tangent >= 0 && tangent < kSlotsAPass ? PassDual<F>::variable(p[k], tangent) : PassDual<F>(p[k]);
         }
-        g.pass[q] = shading2015_of(slots, thin);
+        g.pass[q] = S::of(slots);
     }
     return g;
 }
 
-template <class F>
-PB_MODEL_INLINE GradientShading2015<F> solid_gradient_shading2015_of(const F* p) { return gradient_shading2015_of(p, false); }
-template <class F>
-PB_MODEL_INLINE GradientShading2015<F> thin_gradient_shading2015_of(const F* p) { return gradient_shading2015_of(p, true); }
-
 // f (times |cos θl| if `cosine`), returned, and ∂f_c/∂p given to
 // `jacobian(c, p, value)` for every channel c and every slot p the sink
 // wants (jacobian.wants(p)).
-template <class F, class Sink>
-PB_MODEL_INLINE Rgb<F> eval_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, const GradientShading2015<F>& s,
+template <class F, class S, class Sink>
+PB_MODEL_INLINE Rgb<F> eval_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, const GradientShading2015<S>& s,
                                          TransportMode mode, bool cosine, Sink&& jacobian) {
     using D = PassDual<F>;
     Vec3<D> dwi{D(wi.x), D(wi.y), D(wi.z)}, dwo{D(wo.x), D(wo.y), D(wo.z)};
@@ -79,23 +74,19 @@ PB_MODEL_INLINE Rgb<F> eval_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, c
 // kDirectionPasses2015 evaluations.
 inline constexpr int kDirectionPasses2015 = (kDirectionSlots + kSlotsAPass - 1) / kSlotsAPass;
 
-template <class F>
-PB_MODEL_INLINE Shading2015<PassDual<F>> constant_shading2015_of(const F* p, bool thin = false) {
+// S over PassDual<F>, its tangents 0
+template <class S, class F>
+PB_MODEL_INLINE S constant_shading2015_of(const F* p) {
     PassDual<F> slots[kParamSlots];
     for (int k = 0; k < kParamSlots; ++k) slots[k] = PassDual<F>(p[k]);
-    return shading2015_of(slots, thin);
+    return S::of(slots);
 }
-
-template <class F>
-PB_MODEL_INLINE Shading2015<PassDual<F>> solid_constant_shading2015_of(const F* p) { return constant_shading2015_of(p, false); }
-template <class F>
-PB_MODEL_INLINE Shading2015<PassDual<F>> thin_constant_shading2015_of(const F* p) { return constant_shading2015_of(p, true); }
 
 // f (times |cos θl| if `cosine`), returned, and ∂f_c/∂w_k given to
 // `jacobian(c, k, value)` for every channel c and component k (wi_x ... wo_z);
 // 0 wherever f is (a direction in the tangent plane, or not finite).
-template <class F, class Sink>
-PB_MODEL_INLINE Rgb<F> eval_direction_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, const Shading2015<PassDual<F>>& s,
+template <class F, class S, class Sink>
+PB_MODEL_INLINE Rgb<F> eval_direction_gradient2015(const Vec3<F>& wi, const Vec3<F>& wo, const S& s,
                                                    TransportMode mode, bool cosine, Sink&& jacobian) {
     using D = PassDual<F>;
     const F components[kDirectionSlots] = {wi.x, wi.y, wi.z, wo.x, wo.y, wo.z};
