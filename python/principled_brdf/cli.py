@@ -36,6 +36,8 @@ from .render import ENVIRONMENT_NAMES, MAX_RESOLUTION, MAX_SAMPLE_WORK, MAX_SAMP
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator, Sequence
 
+    from .measured import MerlBRDF
+
 # Each pair holds about 100 bytes across the benchmarks' arrays: 2**27 pairs is 13 GB.
 MAX_PAIRS = 1 << 27
 # Timed runs: each one evaluates every pair (the benchmark's numpy model at ~10 M pairs/s on two cores).
@@ -235,14 +237,24 @@ def _render(args: argparse.Namespace, report: Callable[[str], object]) -> None:
     from . import presets
     from .render import render_sphere, save_image
 
-    params = presets.parameters(args.preset) if args.preset else {}
-    params.update(dict(args.param or []))
-    material = Material(**params)
+    if args.merl is not None:
+        if args.preset or args.param or args.energy_compensation or args.model != _models.DEFAULT_MODEL:
+            raise ValueError("--merl: measured data is rendered as it is (no --preset, --param, --model or "
+                             "--energy-compensation)")
+        from .measured import load_merl
+
+        material: Material | MerlBRDF = load_merl(args.merl)
+        name = f"the MERL data {args.merl}"
+    else:
+        params = presets.parameters(args.preset) if args.preset else {}
+        params.update(dict(args.param or []))
+        material = Material(**params)
+        name = str(material)
     environment = None if args.environment == "none" else args.environment
     lighting = "a key light" if environment is None else f"the {environment} environment"
     if environment is not None and args.samples is not None:
         lighting += f" ({args.samples} samples per pixel)"
-    report(f"rendering {material} at {args.resolution}x{args.resolution} under {lighting} ...")
+    report(f"rendering {name} at {args.resolution}x{args.resolution} under {lighting} ...")
     image = render_sphere(material, resolution=args.resolution, light=args.light, light_intensity=args.light_intensity,
                           model=args.model, environment=environment, samples=args.samples,
                           energy_compensation=args.energy_compensation)
@@ -296,6 +308,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .render import DEFAULT_MAP_SAMPLES, DEFAULT_SAMPLES, IMAGE_FORMATS, TONE_CURVES
 
     render.add_argument("--preset", choices=presets.names(), help="start from a named preset")
+    render.add_argument("--merl", metavar="PATH.binary",
+                        help="render measured data, a MERL file, instead of a material (no --preset, --param, "
+                             "--model or --energy-compensation)")
     render.add_argument("--param", action="append", type=_parameter, metavar="NAME=VALUE",
                         help="set a parameter (repeatable), e.g. roughness=0.3 or base_color=0.9,0.6,0.2")
     render.add_argument("--resolution", type=_at_most(MAX_RESOLUTION, "pixels", lower=2), default=512,

@@ -43,6 +43,7 @@ from .directional_albedo import albedo as _albedo
 from .material import Material
 from ._gradient import DIFFERENTIABLE as _DIFFERENTIABLE
 from . import measured as _measured
+from ._data_brdf import data_brdf as _data_brdf
 from . import render as _render
 
 if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
@@ -127,31 +128,12 @@ def _brdf(name: str, value: object, model: Model, cosine: bool = False) -> _Brdf
         material = _uniform_material(name, value)
         return _Brdf(lambda wi, wo: _eval(material, wi.astype(np.float32), wo.astype(np.float32), model=model,
                                           cosine=cosine).astype(np.float64), material)
-    if isinstance(value, _measured.MerlBRDF):
-        table = value
+    data = _data_brdf(name, value)  # (anything else: a TypeError naming what a plot takes)
 
-        def measured(wi: Float64Array, wo: Float64Array) -> Float64Array:
-            f = table.eval(wi, wo)
-            return f * np.abs(wi[..., 2:3]) if cosine else f
-        return _Brdf(measured, None)
-    if callable(value):
-        function = value
-
-        def called(wi: Float64Array, wo: Float64Array) -> Float64Array:
-            wi, wo = np.broadcast_arrays(wi, wo)
-            f = np.asarray(function(wi, wo), dtype=np.float64)
-            if f.shape != wi.shape:
-                raise ValueError(f"{name}: expected the callable to return f of shape {wi.shape} (RGB per pair), "
-                                 f"got {f.shape}")
-            bad = ~((f >= 0.0) & (f < np.inf)) & ~np.isnan(f)
-            if bad.any():
-                i = _validate.first_true(bad)
-                raise ValueError(f"{name}: the callable returned {float(f.ravel()[i])!r}; expected f >= 0, finite "
-                                 "(or NaN where there is no data)")
-            return f * np.abs(wi[..., 2:3]) if cosine else f
-        return _Brdf(called, None)
-    raise TypeError(f"{name}: expected a principled_brdf.Material, a preset name, a MerlBRDF or a callable "
-                    f"f(wi, wo), got {type(value).__name__}")
+    def measured(wi: Float64Array, wo: Float64Array) -> Float64Array:
+        f = data(wi, wo)
+        return f * np.abs(wi[..., 2:3]) if cosine else f
+    return _Brdf(measured, None)
 
 
 def _channel(value: object) -> Float64Array:

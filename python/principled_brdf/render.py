@@ -34,8 +34,12 @@ from ._batch import sample as _sample
 from .environment import MAP_FORMATS as _MAP_FORMATS
 from .environment import Environment
 from ._model_checks import model_and_mode as _model_and_mode
+from ._data_brdf import DataBrdf as _DataBrdf
+from ._data_brdf import data_brdf as _data_brdf
+from ._data_brdf import is_data as _is_data
 from .material import Material
 from .material import require_material as _require_material
+from .measured import MerlBRDF
 from .procedural_environments import BUILT_IN as _BUILT_IN
 from .procedural_environments import built_in as _built_in
 
@@ -169,7 +173,8 @@ def environment_of(value: _EnvironmentArg) -> Environment | _Environment | None:
     return value
 
 
-def render_sphere(material: Material, resolution: int = 256, light: RealArrayLike = DEFAULT_LIGHT,
+def render_sphere(material: Material | MerlBRDF | Callable[..., Any], resolution: int = 256,
+                  light: RealArrayLike = DEFAULT_LIGHT,
                   light_intensity: float | None = None, ambient: float = 0.0, model: Model = "disney2014", *,
                   environment: _EnvironmentArg = "sky", samples: int | None = None,
                   seed: int = 0, energy_compensation: bool = False) -> Float32Array:
@@ -201,9 +206,21 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
     goes on inside, every event drawn by ``pb.sample``, until it leaves
     (docs/rendering-and-plots.md, "Light through the sphere"); the environment
     and the key light light each point only from its side of its tangent plane.
+
+    ``material`` may also be data: measured (a :class:`~principled_brdf.measured.MerlBRDF`,
+    its nearest cell) or any callable ``f(wi, wo)`` of shading-frame directions ``(..., 3)``
+    to f ``(..., 3)`` in 1/sr (finite and >= 0, NaN where there is no data), a BRDF seen
+    from above. Data has no sampler of its own: the environment's integral draws from a
+    cosine lobe and, for a map, from the map, weighted by the power heuristic; cells
+    without data add nothing. ``model`` and ``energy_compensation`` are a Material's,
+    and ``ambient`` needs its base color: 0 and False with data.
     """
     light = _light_direction(light)
     lighting = environment_of(environment)
+    if _is_data(material):
+        return _data_sphere(_data_brdf("material", material), resolution, light, light_intensity, ambient,
+                            lighting, samples, seed, energy_compensation)
+    material = typing.cast(Material, material)  # (anything else is refused by the kernels' checks, naming it)
     is_map = isinstance(lighting, Environment)
     if light_intensity is None:
         light_intensity = DEFAULT_LIGHT_INTENSITY if lighting is None or lighting is sky_environment else 0.0
@@ -226,6 +243,65 @@ def render_sphere(material: Material, resolution: int = 256, light: RealArrayLik
                                        energy_compensation=energy_compensation).astype(np.float32)
     radiance[..., ~inside, :] = 0.0
     return radiance
+
+
+def _data_sphere(f: _DataBrdf, resolution: int, light: Float64Array, light_intensity: float | None, ambient: float,
+                 lighting: Environment | _Environment | None, samples: int | None, seed: int,
+                 energy_compensation: bool) -> Float32Array:
+    """render_sphere of data f (its docstring): the key light's f cos θl, and the environment's
+    integral by a cosine lobe's draws and, for a map, the map's, with the power heuristic."""
+    if energy_compensation:
+        raise ValueError("energy_compensation: the compensation is a Material's; data keeps its own energy")
+    if _validate.real_number("ambient", ambient, 0.0) > 0.0:
+        raise ValueError("ambient: the ambient term is ambient x a Material's base_color; data has none (use 0)")
+    resolution = _validate.resolution("resolution", resolution)
+    is_map = isinstance(lighting, Environment)
+    if light_intensity is None:
+        light_intensity = DEFAULT_LIGHT_INTENSITY if lighting is None or lighting is sky_environment else 0.0
+    light_intensity = _validate.real_number("light_intensity", light_intensity, 0.0)
+    pixels = resolution * resolution
+    if samples is None:
+        samples = max(1, min(DEFAULT_MAP_SAMPLES, MAX_SAMPLE_WORK // pixels)) if is_map else DEFAULT_SAMPLES
+    samples = _samples(samples, pixels)
+    inside, to_local = sphere_frames(resolution)
+    wo = to_local((0.0, 0.0, 1.0)).astype(np.float64)
+    frame = [to_local(e).astype(np.float64) for e in np.eye(3)]  # frame[k][..., j]: axis j's camera component k
+
+    def value(wi: Float64Array) -> Float64Array:  # f |cos θl| above the surface, 0 below and where no data
+        fc = np.nan_to_num(f(wi, np.broadcast_to(wo, wi.shape)), nan=0.0) * np.maximum(wi[..., 2:3], 0.0)
+        return np.where(wi[..., 2:3] > 0.0, fc, 0.0)
+
+    wi = to_local(light).astype(np.float64)
+    radiance = light_intensity * value(wi)
+    chunk = max(1, (1 << 20) // pixels)
+    for start in range(0, samples if lighting is not None else 0, chunk):
+        count = min(chunk, samples - start)
+        points = lattice_uniforms(count, inside.shape, seed, first=start).astype(np.float64)
+        # the cosine lobe's strategy: wi = (√u1 cos 2πu2, √u1 sin 2πu2, √(1 - u1)), pdf cos θl / π
+        radius, angle = np.sqrt(points[..., 0]), 2.0 * np.pi * points[..., 1]
+        local = np.stack([radius * np.cos(angle), radius * np.sin(angle), np.sqrt(1.0 - points[..., 0])], axis=-1)
+        cosine_pdf = local[..., 2] / np.pi
+        camera = np.stack([sum(local[..., j] * frame[k][..., j] for j in range(3)) for k in range(3)], axis=-1)
+        if is_map:
+            environment_map = typing.cast(Environment, lighting)
+            light_radiance, light_pdf = environment_map._lookup_unchecked(camera.astype(np.float32))
+            weight = _power_heuristic(cosine_pdf, light_pdf)
+        else:
+            light_radiance = _sphere_paths.callable_radiance(typing.cast("Callable[..., Any]", lighting),
+                                                             camera.astype(np.float32))
+            weight = np.ones_like(cosine_pdf)
+        estimate = np.divide(weight, cosine_pdf, out=np.zeros_like(weight), where=cosine_pdf > 0.0)
+        radiance += (value(local) * light_radiance * estimate[..., None]).sum(axis=0) / samples
+        if is_map:
+            towards, light_pdf, light_radiance = environment_map._sample_unchecked(points[..., 1:])
+            towards = towards.astype(np.float64)
+            local = towards[..., 0, None] * frame[0] + towards[..., 1, None] * frame[1] + towards[..., 2, None] * frame[2]
+            local /= np.linalg.norm(local, axis=-1, keepdims=True)
+            weight = _power_heuristic(light_pdf, np.maximum(local[..., 2], 0.0) / np.pi)
+            estimate = np.divide(weight, light_pdf, out=np.zeros_like(weight), where=light_pdf > 0.0)
+            radiance += (value(local) * light_radiance * estimate[..., None]).sum(axis=0) / samples
+    radiance[~inside] = 0.0
+    return radiance.astype(np.float32)
 
 
 def sky_environment(direction: RealArrayLike, zenith: RealArrayLike = (0.65, 0.75, 0.9),
