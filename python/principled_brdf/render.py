@@ -39,7 +39,6 @@ from ._data_brdf import data_brdf as _data_brdf
 from ._data_brdf import is_data as _is_data
 from .material import Material
 from .material import require_material as _require_material
-from .measured import MerlBRDF
 from .procedural_environments import BUILT_IN as _BUILT_IN
 from .procedural_environments import built_in as _built_in
 
@@ -50,6 +49,7 @@ if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public 
     from numpy.typing import ArrayLike, NDArray
 
     from ._typing import Float32Array, Float64Array, FloatArray, Model, RealArrayLike
+    from .measured import MerlBRDF
 
     #: L(direction): camera-space directions (..., 3) to RGB radiance (..., 3)
     _Environment = Callable[[Float32Array], ArrayLike]
