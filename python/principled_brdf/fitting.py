@@ -16,6 +16,7 @@ import contextlib
 import math
 import threading
 import time
+import typing
 
 from collections.abc import Mapping as _Mapping
 from dataclasses import dataclass
@@ -28,11 +29,16 @@ from ._batch import eval
 from ._derivatives import eval_grad
 from ._gradient import GRADIENT_NAMES_2015
 from ._loss_scale import log_scale, log_scales
+from .fit_pictures import DEFAULT_ENVIRONMENTS
+from .fit_pictures import Comparison
+from .fit_pictures import compare as _compare
 from .material import PARAMETERS, Material
 
 if TYPE_CHECKING:
-    from collections.abc import Callable, Iterator, Mapping
+    from collections.abc import Callable, Iterator, Mapping, Sequence
     from typing import Literal, SupportsFloat, SupportsIndex
+
+    from .measured import MerlBRDF
 
     from numpy.typing import NDArray
 
@@ -89,6 +95,21 @@ class FitResult:
     message: str | tuple[str, ...]  # why the solver stopped, per problem, or why it was not fitted
     names: tuple[str, ...]  # the fitted parameters (slot names, base_color as three)
     notes: tuple[str, ...] = ()  # what the fit decided by itself (e.g. a parameter the data cannot determine)
+    model: str = "disney2014"  # the model fitted
+
+    def compare(self, data: MerlBRDF | Callable[..., Any], *, texel: SupportsIndex | tuple[SupportsIndex, ...] | None = None,
+                environments: Sequence[str] = DEFAULT_ENVIRONMENTS, resolution: int = 128, samples: int = 256,
+                seed: int = 0) -> Comparison:
+        """The data and the fit rendered side by side (:func:`~principled_brdf.fit_pictures.compare`):
+        ``data`` a MerlBRDF or a callable ``f(wi, wo)`` (for a batched fit, the data of ``texel``,
+        the index of the problem to show along the batch axes); under each of ``environments``
+        (the studio and the outdoor by default), ``samples`` per pixel. ``.figure()`` of the
+        result draws them with their difference and the image error."""
+        if texel is None and self.material.shape != ():
+            raise ValueError(f"texel: a batched fit (batch shape {self.material.shape}) shows one problem: give its index")
+        material = self.material if texel is None else self.material[texel]
+        return _compare(material, typing.cast("Model", self.model), data, environments=environments,
+                        resolution=resolution, samples=samples, seed=seed)
 
     def summary(self) -> str:
         rows = np.atleast_2d(self.slots)
@@ -433,7 +454,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     return FitResult(material=_material_of(fitted if batched else fitted[0]), slots=take(fitted), cost=take(costs),
                      residuals=take(residuals_out), iterations=take(iterations), success=take(success),
                      message=tuple(messages) if batched else messages[0], names=tuple(names[k] for k in slots),
-                     notes=tuple(notes))
+                     notes=tuple(notes), model=model)
 
 
 def _joined(parts: list[_FitArrays]) -> _FitArrays:
