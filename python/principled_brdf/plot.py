@@ -44,6 +44,7 @@ from .material import Material
 from ._gradient import DIFFERENTIABLE as _DIFFERENTIABLE
 from . import measured as _measured
 from ._data_brdf import data_brdf as _data_brdf
+from ._data_brdf import is_data as _is_data
 from . import render as _render
 
 if typing.TYPE_CHECKING:  # (typing.TYPE_CHECKING: this module shows its public names only)
@@ -422,7 +423,7 @@ def polar_lobes(material: Material | str | _measured.MerlBRDF | Callable[..., An
 # 3. lit sphere, optionally with an environment
 
 
-def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealArrayLike = _render.DEFAULT_LIGHT,
+def lit_sphere(material: Material | str | _measured.MerlBRDF | Callable[..., Any], *, resolution: int = 256, light: RealArrayLike = _render.DEFAULT_LIGHT,
                light_intensity: float | None = None, environment: _EnvironmentArg = "sky",
                environment_samples: int | None = None, seed: int = 0, exposure: float = 1.0,
                model: Model = "disney2014", ax: Axes | None = None, energy_compensation: bool = False) -> Axes:
@@ -441,22 +442,28 @@ def lit_sphere(material: Material | str, *, resolution: int = 256, light: RealAr
     64 for the sky or a callable, 256 for a map; deterministic for a ``seed``;
     :func:`pb.render.render_environment`). ``exposure`` scales the linear image
     before the tone curve (``pb.render.tone_map``). Off the sphere is transparent.
-    ``energy_compensation`` as in ``pb.eval``.
+    ``energy_compensation`` as in ``pb.eval``. ``material`` may also be data, measured (a
+    :class:`~principled_brdf.measured.MerlBRDF`) or any callable ``f(wi, wo)``, as
+    ``render_sphere`` takes it (docs/rendering-and-plots.md, "Pictures of data").
     """
-    material = _material("material", material)
     n = _validate.resolution("resolution", resolution)
     exposure = _validate.real_number("exposure", exposure, 0.0)
     intensity = None if light_intensity is None else _validate.real_number("light_intensity", light_intensity, 0.0)
-    if material.shape not in ((), (n, n)):
-        raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
-                         f"got {material.shape}")
+    shown: Material | _measured.MerlBRDF | Callable[..., Any]
+    if isinstance(material, (Material, str)) or not _is_data(material):
+        shown = _material("material", material)
+        if shown.shape not in ((), (n, n)):
+            raise ValueError(f"material: expected a uniform material or one of leading shape {(n, n)}, "
+                             f"got {shown.shape}")
+    else:
+        shown = material
     count = None if environment_samples is None else _validate.integer_in(
         "environment_samples", environment_samples, 1, _render.MAX_SAMPLES, " per pixel")
     _validate.model_index(model)
     environment = _render.environment_of(environment)
     ax = _axes(ax)
 
-    image = _render.render_sphere(material, n, light=light, light_intensity=intensity, model=model,
+    image = _render.render_sphere(shown, n, light=light, light_intensity=intensity, model=model,
                                   environment=environment, samples=count, seed=seed,
                                   energy_compensation=energy_compensation)
     inside, _ = _render.sphere_frames(n)

@@ -100,3 +100,19 @@ def test_the_command_line_renders_a_merl_file(tmp_path, capsys):
     assert "MERL" in capsys.readouterr().out
     assert main(["render", "--merl", str(path), "--preset", "gold", "--output", str(tmp_path / "x.png")]) == 2
     assert "--merl" in capsys.readouterr().err and not (tmp_path / "x.png").exists()
+
+
+def test_lit_sphere_takes_data():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ax = pb.plot.lit_sphere(reference_of(PLASTIC), resolution=16, environment_samples=8)
+    drawn = np.asarray(ax.get_images()[0].get_array())
+    assert drawn.shape == (16, 16, 4)
+    expected = pb.render.to_srgb8(render_sphere(reference_of(PLASTIC), 16, samples=8))
+    inside = drawn[..., 3] > 0
+    assert np.abs(drawn[inside, :3].astype(float) - expected[inside].astype(float)).max() <= 1
+    plt.close(ax.figure)
+    with pytest.raises(TypeError, match="material"):
+        pb.plot.lit_sphere(3, resolution=16)
