@@ -336,7 +336,8 @@ def lattice_uniforms(count: int, shape: tuple[int, ...], seed: int = 0, first: i
     return _low_discrepancy.shifted_points(index, shift)
 
 
-def render_environment(material: Material, resolution: int = 256, environment: _EnvironmentArg = "sky",
+def render_environment(material: Material | MerlBRDF | Callable[..., Any], resolution: int = 256,
+                       environment: _EnvironmentArg = "sky",
                        samples: int = DEFAULT_SAMPLES, seed: int = 0, model: Model = "disney2014", *,
                        energy_compensation: bool = False) -> Float64Array:
     """Linear RGB ``(resolution, resolution, 3)`` (or ``S + (resolution, resolution, 3)`` as
@@ -352,8 +353,13 @@ def render_environment(material: Material, resolution: int = 256, environment: _
     small bright lights and sharp lobes both converge; for a callable ``L(direction)``,
     the BSDF samples alone. ``samples``: 1 to :data:`MAX_SAMPLES`, and pixels (every sphere
     of a batch) x samples at most :data:`MAX_SAMPLE_WORK`. ``energy_compensation`` as in
-    ``pb.sample``."""
+    ``pb.sample``. ``material`` may also be data, as :func:`render_sphere` takes it (the
+    cosine lobe's and the map's draws)."""
     lighting = environment_of(environment)
+    if _is_data(material):
+        return _data_sphere(_data_brdf("material", material), resolution, np.array([0.0, 0.0, 1.0]), 0.0, 0.0,
+                            lighting, samples, seed, energy_compensation).astype(np.float64)
+    material = typing.cast(Material, material)  # (anything else is refused by the kernels' checks, naming it)
     resolution = _validate.resolution("resolution", resolution)
     samples = _samples(samples, _pixels(material, resolution))
     if lighting is None:  # no environment, no light: a black picture, of the checked arguments' shape

@@ -116,3 +116,11 @@ def test_lit_sphere_takes_data():
     plt.close(ax.figure)
     with pytest.raises(TypeError, match="material"):
         pb.plot.lit_sphere(3, resolution=16)
+
+
+def test_render_environment_takes_data_as_render_sphere_without_its_key_light():
+    data = reference_of(GOLD)
+    alone = pb.render.render_environment(data, 24, "studio", samples=16)
+    assert alone.dtype == np.float64 and alone.shape == (24, 24, 3) and alone.max() > 0.1
+    np.testing.assert_array_equal(alone.astype(np.float32),
+                                  render_sphere(data, 24, environment="studio", samples=16, light_intensity=0.0))
