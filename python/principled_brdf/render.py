@@ -217,10 +217,6 @@ def render_sphere(material: Material | MerlBRDF | Callable[..., Any], resolution
     """
     light = _light_direction(light)
     lighting = environment_of(environment)
-    if _is_data(material):
-        return _data_sphere(_data_brdf("material", material), resolution, light, light_intensity, ambient,
-                            lighting, samples, seed, energy_compensation)
-    material = typing.cast(Material, material)  # (anything else is refused by the kernels' checks, naming it)
     is_map = isinstance(lighting, Environment)
     if light_intensity is None:
         light_intensity = DEFAULT_LIGHT_INTENSITY if lighting is None or lighting is sky_environment else 0.0
@@ -231,6 +227,10 @@ def render_sphere(material: Material | MerlBRDF | Callable[..., Any], resolution
     ambient = _validate.real_number("ambient", ambient, 0.0)
     resolution = _validate.resolution("resolution", resolution)
     _samples(samples, _pixels(material, resolution) if lighting is not None else 0)  # (unused without one)
+    if _is_data(material):
+        return _data_sphere(_data_brdf("material", material), resolution, light, light_intensity, ambient,
+                            lighting, samples, seed, energy_compensation)
+    material = typing.cast(Material, material)  # (anything else is refused by the kernels' checks, naming it)
     inside, to_local = sphere_frames(resolution)
     wi, wo = to_local(light), to_local((0.0, 0.0, 1.0))
     radiance = np.float32(light_intensity) * _eval(material, wi, wo, cosine=True, model=model,
@@ -245,24 +245,18 @@ def render_sphere(material: Material | MerlBRDF | Callable[..., Any], resolution
     return radiance
 
 
-def _data_sphere(f: _DataBrdf, resolution: int, light: Float64Array, light_intensity: float | None, ambient: float,
-                 lighting: Environment | _Environment | None, samples: int | None, seed: int,
+def _data_sphere(f: _DataBrdf, resolution: int, light: Float64Array, light_intensity: float, ambient: float,
+                 lighting: Environment | _Environment | None, samples: int, seed: int,
                  energy_compensation: bool) -> Float32Array:
-    """render_sphere of data f (its docstring): the key light's f cos θl, and the environment's
-    integral by a cosine lobe's draws and, for a map, the map's, with the power heuristic."""
+    """render_sphere of data f (its docstring), its arguments checked there: the key light's
+    f cos θl, and the environment's integral by a cosine lobe's draws and, for a map, the
+    map's, with the power heuristic."""
     if energy_compensation:
         raise ValueError("energy_compensation: the compensation is a Material's; data keeps its own energy")
-    if _validate.real_number("ambient", ambient, 0.0) > 0.0:
+    if ambient > 0.0:
         raise ValueError("ambient: the ambient term is ambient x a Material's base_color; data has none (use 0)")
-    resolution = _validate.resolution("resolution", resolution)
     is_map = isinstance(lighting, Environment)
-    if light_intensity is None:
-        light_intensity = DEFAULT_LIGHT_INTENSITY if lighting is None or lighting is sky_environment else 0.0
-    light_intensity = _validate.real_number("light_intensity", light_intensity, 0.0)
     pixels = resolution * resolution
-    if samples is None:
-        samples = max(1, min(DEFAULT_MAP_SAMPLES, MAX_SAMPLE_WORK // pixels)) if is_map else DEFAULT_SAMPLES
-    samples = _samples(samples, pixels)
     inside, to_local = sphere_frames(resolution)
     wo = to_local((0.0, 0.0, 1.0)).astype(np.float64)
     frame = [to_local(e).astype(np.float64) for e in np.eye(3)]  # frame[k][..., j]: axis j's camera component k
@@ -356,12 +350,12 @@ def render_environment(material: Material | MerlBRDF | Callable[..., Any], resol
     ``pb.sample``. ``material`` may also be data, as :func:`render_sphere` takes it (the
     cosine lobe's and the map's draws)."""
     lighting = environment_of(environment)
+    resolution = _validate.resolution("resolution", resolution)
+    samples = _samples(samples, _pixels(material, resolution))
     if _is_data(material):
         return _data_sphere(_data_brdf("material", material), resolution, np.array([0.0, 0.0, 1.0]), 0.0, 0.0,
                             lighting, samples, seed, energy_compensation).astype(np.float64)
     material = typing.cast(Material, material)  # (anything else is refused by the kernels' checks, naming it)
-    resolution = _validate.resolution("resolution", resolution)
-    samples = _samples(samples, _pixels(material, resolution))
     if lighting is None:  # no environment, no light: a black picture, of the checked arguments' shape
         _model_and_mode(_require_material("material", material), model, "radiance", energy_compensation)
         shape = _validate.broadcast_leading(material=material.shape, resolution=(resolution, resolution))
