@@ -42,6 +42,7 @@ no kernel): tests set ``explorer.sliders["roughness"].value`` and read
 
 from __future__ import annotations
 
+import base64
 import contextlib
 import functools
 import math
@@ -95,11 +96,23 @@ _DEPENDS = {
     "slice": ("material", "model", "energy_compensation", "light", "view"),
     "albedo": ("material", "model", "energy_compensation", "view"),
 }
+
+
+def _inputs(name: str, state: Mapping[str, Any]) -> tuple[Any, ...]:
+    """What picture ``name`` shows of ``state``: under a map the sphere has no key light (the map
+    brings its lights), so the light's direction does not change it (None in its place)."""
+    lit_by_map = state["sky"] and state["environment"] != "sky"
+    return tuple(None if (name == "sphere" and k == "light" and lit_by_map) else state[k] for k in _DEPENDS[name])
+
+
 _KEY_STYLES: dict[str, dict[str, Any]] = {  # the legend entries of the plots, beyond the lobes
     "wo": dict(color="0.45", ls="--", lw=1.0, label="view"),
     "wi": dict(color="tab:red", ls=":", lw=1.4, label="light (projected)"),
     "θv": dict(color="0.45", ls="--", lw=1.0, label="θv"),
 }
+# a slider's value within this many steps of its grid is on it: the front end sends 130 back as
+# 130.00000000000003, which would otherwise redraw the pictures and stay in the value
+_ECHO = 1e-9
 _UI_MAX = 1.0  # the BRDF Explorer's slider range for the unbounded parameters (their domains go on)
 _MAX_EXPOSURE_STOPS = 64.0  # |exposure| a slider takes (2^64: far beyond any picture, and finite)
 _POLAR_STEPS = 360
@@ -158,7 +171,10 @@ def _slider_class(widgets: ModuleType) -> type[Any]:
             if abs(value) > self.limit:
                 raise RefusedValue(f"{self.name}: {value!r} is beyond {self.limit:g}, the most it takes "
                                    f"(the slider keeps {self.value!r})")
-            return cast(float, super()._validate_value(proposal))
+            steps = value / self.step if self.step else 0.0
+            if steps and abs(steps - round(steps)) < _ECHO:  # the front end's rounding of a value on the grid
+                value = round(round(steps) * self.step, 12)
+            return cast(float, super()._validate_value(dict(proposal, value=value)))
 
     Slider.__qualname__ = Slider.__name__ = "FiniteFloatSlider"
     RefusedValue.__qualname__ = RefusedValue.__name__ = "RefusedSliderValue"
@@ -406,7 +422,7 @@ class Explorer:
         start = time.perf_counter()
         drawn = {}
         for name in OUTPUTS:
-            key = tuple(state[k] for k in _DEPENDS[name])
+            key = _inputs(name, state)
             if self._rendered.get(name) == key:
                 continue
             begin = time.perf_counter()
@@ -546,7 +562,7 @@ class Explorer:
         return _render.png_bytes(np.asarray(canvas.buffer_rgba()))
 
     def _draw_sphere(self, material: Material, state: Mapping[str, Any]) -> bytes:
-        key = tuple(state[k] for k in _DEPENDS["sphere"] if k != "exposure")
+        key = tuple(v for k, v in zip(_DEPENDS["sphere"], _inputs("sphere", state)) if k != "exposure")
         if self._sphere_linear[0] != key:  # an exposure change only tone maps again
             self._sphere_linear = (key, self._render_sphere(material, state))
         assert self._sphere_linear[1] is not None  # rendered above (key is never None)
@@ -773,7 +789,16 @@ class Explorer:
         self._figures.clear()
 
     def _repr_mimebundle_(self, **kwargs: Any) -> dict[str, Any] | None:
-        return self.widget._repr_mimebundle_(**kwargs)
+        """The live widget, and beside it what a page without the widget's JavaScript shows
+        (nbconvert's HTML, GitHub, any static viewer): the four pictures as PNG in HTML, the
+        sphere as ``image/png`` and a text summary."""
+        bundle = dict(self.widget._repr_mimebundle_(**kwargs) or {})
+        pictures = "".join(f'<img alt="{name}" style="margin:2px" src="data:image/png;base64,'
+                           f'{base64.b64encode(self.images[name].value).decode()}"/>' for name in OUTPUTS)
+        bundle["text/html"] = f'<div style="display:flex;flex-wrap:wrap;align-items:center">{pictures}</div>'
+        bundle["image/png"] = base64.b64encode(self.images["sphere"].value).decode()
+        bundle["text/plain"] = f"{self!r}\n(the pictures: {', '.join(OUTPUTS)}; run the notebook for the controls)"
+        return bundle
 
     def __repr__(self) -> str:
         return f"Explorer({self.material!r}, model={self.model.value!r}, resolution={self.resolution})"

@@ -187,6 +187,49 @@ def test_no_op_changes_redraw_nothing(explorer):
     assert explorer.refresh() == {}
 
 
+def test_under_a_map_the_light_moves_the_plots_and_not_the_sphere(explorer):
+    """A map brings its own lights (no key light): the light's direction is still f's in the
+    polar plot and the slice, and the sphere is not drawn again for it."""
+    explorer.environment.value = "studio"
+    before = snapshot(explorer)
+    explorer.light_phi.value = 200.0
+    explorer.light_theta.value = 30.0
+    assert changed(before, snapshot(explorer)) == {"polar", "slice"}
+    explorer.sky.value = False  # the key light alone: now it lights the sphere
+    before = snapshot(explorer)
+    explorer.light_phi.value = 100.0
+    assert changed(before, snapshot(explorer)) == {"sphere", "polar", "slice"}
+
+
+def test_the_front_ends_float_echo_redraws_nothing(explorer):
+    """The browser sends a slider's value back through JavaScript's float formatting: 130 as
+    130.00000000000003. On the slider's grid within 1e-9 of a step, it is the grid value."""
+    explorer.light_phi.value = 130.0
+    before = snapshot(explorer)
+    explorer.light_phi.value = 130.00000000000003
+    assert explorer.light_phi.value == 130.0
+    explorer.sliders["roughness"].value = 0.29000000000000004
+    assert explorer.sliders["roughness"].value == 0.29
+    explorer.sliders["roughness"].value = 0.5
+    assert snapshot(explorer) == before and explorer.refresh() == {}
+    explorer.sliders["roughness"].value = 0.333  # off the grid: kept as given
+    assert explorer.sliders["roughness"].value == 0.333
+
+
+def test_static_output_carries_the_pictures(explorer):
+    """nbconvert, GitHub and other pages without the widget's JavaScript show the pictures."""
+    import base64
+
+    bundle = explorer._repr_mimebundle_()
+    assert "application/vnd.jupyter.widget-view+json" in bundle
+    assert base64.b64decode(bundle["image/png"]) == explorer.images["sphere"].value
+    html = bundle["text/html"]
+    for name in OUTPUTS:
+        encoded = base64.b64encode(explorer.images[name].value).decode()
+        assert f'alt="{name}"' in html and encoded in html
+    assert bundle["text/plain"].startswith("Explorer(Material(")
+
+
 def test_preset_sets_every_slider_in_one_update(explorer, monkeypatch):
     calls = []
     real = explorer_module.Explorer.refresh
