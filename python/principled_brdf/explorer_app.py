@@ -42,6 +42,7 @@ no kernel): tests set ``explorer.sliders["roughness"].value`` and read
 
 from __future__ import annotations
 
+import asyncio
 import base64
 import contextlib
 import functools
@@ -105,6 +106,14 @@ def _inputs(name: str, state: Mapping[str, Any]) -> tuple[Any, ...]:
     return tuple(None if (name == "sphere" and k == "light" and lit_by_map) else state[k] for k in _DEPENDS[name])
 
 
+
+def _pass_samples(state: Mapping[str, Any]) -> int:
+    """Samples per pixel of one pass of the sphere: what keeps a first picture near 0.2 s."""
+    if _models.is_whole_sphere(state["model"]):
+        return _THROUGH_SAMPLES
+    return _MAP_SAMPLES if state["sky"] and state["environment"] != "sky" else _SKY_SAMPLES
+
+
 _KEY_STYLES: dict[str, dict[str, Any]] = {  # the legend entries of the plots, beyond the lobes
     "wo": dict(color="0.45", ls="--", lw=1.0, label="view"),
     "wi": dict(color="tab:red", ls=":", lw=1.4, label="light (projected)"),
@@ -129,6 +138,12 @@ _HALF_DISC_AXES = (0.117, 0.028, 0.767, 1.023)  # the polar plot's Axes: a half 
 _DISC_AXES = (0.27, 0.2, 0.46, 0.6)  # the whole circle, radius 79 px, between the legend and the title
 _ALBEDO_SAMPLES = 1 << 12
 _SKY_SAMPLES = 32  # render_sphere uses 64; 32 shows little grain and keeps an update near 0.2 s
+# the first picture's samples per pixel where light must be found in a map's bright spots or through the
+# sphere (a pass of the 2015 models takes about as long at 4 as a BRDF's at 32); more passes while idle
+_MAP_SAMPLES = 16
+_THROUGH_SAMPLES = 4
+_REFINED_SAMPLES = 512  # samples per pixel at which the refinement stops
+_REFINE_DELAY = 0.05  # seconds between passes, in which the kernel answers the front end
 _AMBIENT = 0.03  # times base_color, without the sky: the unlit side is not black
 _DPI = 80
 _FIGSIZE = (4.4, 3.3)
@@ -257,7 +272,7 @@ class Explorer:
     _rendered: dict[str, tuple[Any, ...]]
     _figures: dict[str, Figure]
     _legend_cache: dict[tuple[tuple[str, ...], int, bool], NDArray[np.float32]]
-    _sphere_linear: tuple[tuple[Any, ...] | None, Float32Array | None]
+    _sphere: dict[str, Any]  # what it shows but the exposure: key, material, state, sum of passes, samples
     _initial: tuple[Material, str | None, dict[Any, tuple[Any, float | None]]]
     _polar: dict[str, Any]  # the polar plot's Axes, angles, lines, legend image and title
     _slice: dict[str, Any]
@@ -278,7 +293,9 @@ class Explorer:
         self.last_update_seconds = 0.0
         self._base_color = tuple(float(c) for c in material.base_color)
         self._inside = _render.sphere_frames(resolution)[0]
-        self._sphere_linear = (None, None)  # (what it shows but the exposure, linear image)
+        self._sphere = {"key": None, "samples": 0}
+        self._refinement: Any = None  # the event loop's handle of the next pass, while one is scheduled
+        self._timing_status = ""
 
         style = {"description_width": _LABEL_WIDTH}
         layout = widgets.Layout(width=_CONTROL_WIDTH)
@@ -446,8 +463,8 @@ class Explorer:
         if drawn:
             self.last_update_seconds = time.perf_counter() - start
             parts = " · ".join(f"{name} {seconds * 1e3:.0f}" for name, seconds in drawn.items())
-            self.status.value = (f'<small style="white-space:nowrap">{self.last_update_seconds * 1e3:.0f} ms: '
-                                 f"{parts}</small>")
+            self._timing_status = f"{self.last_update_seconds * 1e3:.0f} ms: {parts}"
+            self._sphere_status()
         return drawn
 
     def _changed(self, change: Mapping[str, Any]) -> None:
@@ -576,18 +593,81 @@ class Explorer:
 
     def _draw_sphere(self, material: Material, state: Mapping[str, Any]) -> bytes:
         key = tuple(v for k, v in zip(_DEPENDS["sphere"], _inputs("sphere", state)) if k != "exposure")
-        if self._sphere_linear[0] != key:  # an exposure change only tone maps again
-            self._sphere_linear = (key, self._render_sphere(material, state))
-        assert self._sphere_linear[1] is not None  # rendered above (key is never None)
-        return _render.png_bytes(_rgba(self._sphere_linear[1], self._inside, 2.0 ** state["exposure"]))
+        if self._sphere["key"] != key:  # an exposure change only tone maps again
+            samples = _pass_samples(state)
+            self._sphere = {"key": key, "material": material, "state": dict(state), "passes": 1,
+                            "samples": samples, "sum": self._render_sphere(material, state, samples, 0) * samples}
+            self._schedule_refinement()
+        self._sphere["state"]["exposure"] = state["exposure"]  # the passes to come are shown at it
+        return self._sphere_png(state["exposure"])
 
-    def _render_sphere(self, material: Material, state: Mapping[str, Any]) -> Float32Array:
+    def _sphere_png(self, exposure: float) -> bytes:
+        mean = self._sphere["sum"] / self._sphere["samples"]
+        return _render.png_bytes(_rgba(mean, self._inside, 2.0 ** exposure))
+
+    def _render_sphere(self, material: Material, state: Mapping[str, Any], samples: int, seed: int) -> Float32Array:
         light = _direction(*state["light"])
         model = state["model"]
         n = self.resolution
         return _render.render_sphere(material, n, light=light, ambient=0.0 if state["sky"] else _AMBIENT, model=model,
-                                     environment=state["environment"] if state["sky"] else None, samples=_SKY_SAMPLES,
-                                     energy_compensation=state["energy_compensation"])
+                                     environment=state["environment"] if state["sky"] else None, samples=samples,
+                                     seed=seed, energy_compensation=state["energy_compensation"])
+
+    @property
+    def sphere_samples(self) -> int:
+        """Samples per pixel of the sphere shown: its first pass's, and more as it refines."""
+        return int(self._sphere["samples"])
+
+    def refine(self, passes: int = 1) -> int:
+        """Render ``passes`` more passes of the sphere into the picture shown (each with its own
+        lattice shift, averaged), up to 512 samples per pixel; returns the samples per pixel.
+        In a notebook the explorer does this by itself while the controls rest."""
+        passes = _validate.integer("passes", passes)
+        for _ in range(passes):
+            if self._closed or not self._refinable():
+                break
+            sphere = self._sphere
+            samples = _pass_samples(sphere["state"])
+            sphere["sum"] = sphere["sum"] + self._render_sphere(sphere["material"], sphere["state"], samples,
+                                                                sphere["passes"]) * samples
+            sphere["passes"] += 1
+            sphere["samples"] += samples
+            self.images["sphere"].value = self._sphere_png(sphere["state"]["exposure"])
+            self._sphere_status()
+        return self.sphere_samples
+
+    def _refinable(self) -> bool:
+        """Whether more passes change the sphere: it samples an environment or light through itself."""
+        sphere = self._sphere
+        if sphere["key"] is None or sphere["samples"] >= _REFINED_SAMPLES:
+            return False
+        state = sphere["state"]
+        return bool(state["sky"]) or _models.is_whole_sphere(state["model"])
+
+    def _schedule_refinement(self) -> None:
+        """In a running event loop (a notebook's kernel), the next pass after a short rest; the
+        kernel answers the front end between passes, and a change starts the sphere afresh."""
+        if self._refinement is not None:
+            self._refinement.cancel()
+            self._refinement = None
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:  # no loop (a script, a test): refine() by hand
+            return
+        if self._refinable():
+            self._refinement = loop.call_later(_REFINE_DELAY, self._refine_step)
+
+    def _refine_step(self) -> None:
+        self._refinement = None
+        if self._closed or self._holding:
+            return
+        self.refine(1)
+        self._schedule_refinement()
+
+    def _sphere_status(self) -> None:
+        more = " (refining)" if self._refinable() else ""
+        self.status.value = (f'<small style="white-space:nowrap">{self._timing_status} · sphere '
+                             f"{self.sphere_samples} samples/px{more}</small>")
 
     def _build_polar(self, Figure: type[Figure]) -> None:
         fig = Figure(figsize=_FIGSIZE, dpi=_DPI)
@@ -788,6 +868,9 @@ class Explorer:
         if self._closed:
             return
         self._closed = True
+        if self._refinement is not None:
+            self._refinement.cancel()
+            self._refinement = None
         for control in self._controls():
             handler = (self._preset_chosen if control is self.preset else
                        self._color_picked if control is self.base_color else self._changed)

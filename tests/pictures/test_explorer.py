@@ -201,6 +201,42 @@ def test_under_a_map_the_light_moves_the_plots_and_not_the_sphere(explorer):
     assert changed(before, snapshot(explorer)) == {"sphere", "polar", "slice"}
 
 
+def test_the_sphere_refines_pass_after_pass(explorer):
+    """Each pass its own lattice shift, the picture their mean; a change starts afresh."""
+    explorer.environment.value = "studio"
+    first = explorer.sphere_samples
+    assert first == explorer_module._MAP_SAMPLES
+    one = explorer.images["sphere"].value
+    assert explorer.refine(2) == 3 * first
+    assert explorer.images["sphere"].value != one
+    light = explorer_module._direction(explorer.light_theta.value, explorer.light_phi.value)
+    passes = [pb.render.render_sphere(explorer.material, 64, light=light, environment="studio", samples=first, seed=k)
+              for k in range(3)]
+    mean = (passes[0] * first + passes[1] * first + passes[2] * first) / (3 * first)
+    expected = explorer_module._rgba(mean, explorer._inside, 1.0)
+    np.testing.assert_array_equal(pixels(explorer.images["sphere"].value), pixels(pb.render.png_bytes(expected)))
+    assert "48 samples/px (refining)" in explorer.status.value
+    explorer.sliders["roughness"].value = 0.3
+    assert explorer.sphere_samples == first
+
+
+def test_glass_starts_fast_and_refines_while_the_kernel_is_idle(explorer):
+    """In a running event loop (a notebook's kernel) the passes come by themselves."""
+    import asyncio
+
+    async def change_then_rest():
+        explorer.model.value = "disney2015"
+        explorer.sliders["spec_trans"].value = 1.0
+        assert explorer.sphere_samples == explorer_module._THROUGH_SAMPLES
+        await asyncio.sleep(2.0)
+        return explorer.sphere_samples
+    assert asyncio.run(change_then_rest()) > explorer_module._THROUGH_SAMPLES
+    # and nothing refines a sphere without sampling: the key light alone on a BRDF
+    explorer.model.value = "disney2014"
+    explorer.sky.value = False
+    assert explorer.refine(3) == explorer.sphere_samples == explorer_module._SKY_SAMPLES
+
+
 def test_the_front_ends_float_echo_redraws_nothing(explorer):
     """The browser sends a slider's value back through JavaScript's float formatting: 130 as
     130.00000000000003. On the slider's grid within 1e-9 of a step, it is the grid value."""

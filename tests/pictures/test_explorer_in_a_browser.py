@@ -18,6 +18,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -34,6 +35,8 @@ from selenium import webdriver  # noqa: E402 - the browser group: a missing one 
 from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.support.ui import Select  # noqa: E402
+
+from principled_brdf.explorer_app import _THROUGH_SAMPLES  # noqa: E402 - the 2015 models' first pass
 
 PACKAGE = Path(__import__("principled_brdf").__file__).resolve().parents[1]
 TOKEN = "principled-brdf-test"
@@ -147,6 +150,14 @@ def _changes(driver, action, what: str) -> np.ndarray:
     return _sphere_pixels(driver)
 
 
+def _samples_shown(driver) -> int:
+    """The sphere's samples per pixel in the status line."""
+    text = driver.execute_script("return [...document.querySelectorAll('.jp-OutputArea-output .widget-html')]"
+                                 ".pop().textContent")
+    match = re.search(r"(\d+) samples/px", text)
+    return int(match.group(1)) if match else 0
+
+
 def _status_height(driver) -> float:
     return driver.execute_script(
         "const s = [...document.querySelectorAll('.jp-OutputArea-output .widget-html')].pop();"
@@ -175,6 +186,8 @@ def test_the_explorer_works_in_jupyterlab(lab):
         select = Select(model.find_element(By.TAG_NAME, "select"))
         glass = _changes(driver, lambda: select.select_by_visible_text("disney2015"), "switching the model")
         assert glass.std() > 0.02 and np.abs(glass - moved).max() > 0.05
+        # while the controls rest, the kernel renders more passes of the sphere into the picture
+        _wait(lambda: _samples_shown(driver) >= 3 * _THROUGH_SAMPLES, "the sphere to refine")
         assert driver.execute_script(LAYOUT_FAULTS) == []
         assert _status_height(driver) == status
     finally:
