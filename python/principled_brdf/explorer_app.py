@@ -694,7 +694,11 @@ class Explorer:
             ax.set_position(_HALF_DISC_AXES if span == 90.0 else _DISC_AXES)
             ax.set_thetamin(-span)
             ax.set_thetamax(span)
-            ax.set_thetagrids([-90, -60, -30, 0, 30, 60, 90] if span == 90.0 else [-135, -90, -45, 0, 45, 90, 135, 180])
+            if span == 90.0:
+                ax.set_thetagrids([-90, -60, -30, 0, 30, 60, 90])
+            else:  # the spoke straight down unlabelled: its label would sit on the legend below
+                ax.set_thetagrids([-135, -90, -45, 0, 45, 90, 135, 180],
+                                  ["-135°", "-90°", "-45°", "0°", "45°", "90°", "135°", ""])
             self._polar["span"] = span
         return np.radians((np.arange(_POLAR_STEPS) + 0.5) * (2.0 * span / _POLAR_STEPS) - span)
 
