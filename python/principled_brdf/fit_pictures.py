@@ -65,14 +65,24 @@ def compare(material: Material, model: Model, data: MerlBRDF | Callable[..., Any
     each of ``environments`` (names or anything ``environment=`` takes, no key light), with
     ``samples`` per pixel. Both go through the data's estimator (a cosine lobe's draws and the
     map's) on the same points, so that their difference is the BRDFs' and not the sampling
-    noise's; the image error is ``‖data - fit‖ / ‖data‖`` over the pixels."""
+    noise's, and where the data has no value (NaN) neither picture takes one. The image
+    error is ``‖data - fit‖ / ‖data‖`` over the pixels. Data without a value anywhere is a
+    ValueError naming ``data``."""
     if not getattr(material, "is_uniform", False):
         raise ValueError("material: expected one fitted material (for a batch, pick its texel: result.compare(data, "
                          "texel=...))")
     f = data_brdf("data", data)
+    values_seen = [0]
+
+    def measured(wi: Float64Array, wo: Float64Array) -> Float64Array:
+        values = f(wi, wo)
+        values_seen[0] += int(np.count_nonzero(~np.isnan(values)))
+        return values
 
     def fitted(wi: Float64Array, wo: Float64Array) -> Float64Array:
-        return _eval(material, wi.astype(np.float32), wo.astype(np.float32), model=model).astype(np.float64)
+        values = _eval(material, wi.astype(np.float32), wo.astype(np.float32), model=model).astype(np.float64)
+        # where the data has no value, neither picture takes one: the difference stays the BRDFs'
+        return np.where(np.isnan(f(wi, wo)), np.nan, values)
     if isinstance(environments, str) or len(environments) == 0:
         raise ValueError(f"environments: expected a non-empty sequence of environments, got {environments!r}")
     resolution = _validate.resolution("resolution", resolution)
@@ -81,7 +91,9 @@ def compare(material: Material, model: Model, data: MerlBRDF | Callable[..., Any
         def picture(brdf: Callable[..., Any]) -> Float32Array:
             return render_sphere(brdf, resolution, environment=environment, samples=samples, seed=seed,
                                  light_intensity=0.0)
-        data_pictures.append(picture(f))
+        data_pictures.append(picture(measured))
+        if values_seen[0] == 0:
+            raise ValueError("data: no value at any pair the pictures use (f is NaN, no data, everywhere)")
         # the fit through the data's estimator, on the same points: the difference is the BRDFs', not the noise's
         fit_pictures.append(picture(fitted))
         norm = float(np.linalg.norm(data_pictures[-1]))

@@ -62,6 +62,14 @@ METHODS = ("batched", "scipy")
 # relative loss settles on a dark dielectric of a rough conductor's data (Beckmann copper,
 # α 0.5: metallic 0, 91 % of the albedo missing) where a metal start reaches a lower cost.
 _SECOND_STARTS: dict[str, dict[str, Any]] = {"relative": {"metallic": 1.0}}
+#: The lobes model selection may hold off (docs/fitting.md#lobes-the-data-do-not-need), each with
+#: the parameter only it reads (set back to its start when the lobe is held off) and the largest
+#: value at which it is tried: metallic as a dielectric's metallic share (above a half the fit is
+#: a metal, and a dielectric in its place is another material, not the same one without a lobe).
+OPTIONAL_LOBES: dict[str, tuple[str | None, float]] = {
+    "clearcoat": ("clearcoat_gloss", math.inf), "sheen": ("sheen_tint", math.inf), "metallic": (None, 0.5)}
+#: A lobe a fit turned on is kept where it divides the cost by more than this.
+LOBE_GAIN = 2.0
 # The batched solver stops when a taken step lowers the cost by less than this
 # fraction: the float32 kernels' cost is exact to about 1e-7 of itself.
 _FTOL = {"float32": 1e-7, "float64": 1e-10}
@@ -313,7 +321,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
         bounds: Mapping[str, tuple[SupportsFloat, SupportsFloat]] | None = None, model: Model = "disney2014",
         cosine: bool = True, precision: Literal["float32", "float64"] = "float32",
         max_iterations: SupportsIndex = 200, method: Literal["batched", "scipy"] = "batched",
-        threads: SupportsIndex | None = None) -> FitResult:
+        threads: SupportsIndex | None = None, select_lobes: bool = True) -> FitResult:
     """The material that best matches ``measured`` values of f (1/sr) at the pairs (wi, wo).
 
     ``wi``, ``wo``: unit directions ``(N, 3)``; ``measured``: ``(N, 3)``, or
@@ -348,6 +356,15 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     ``"float64"`` (the reference). ``max_iterations``: an integer >= 1, the
     most evaluations of the model per problem.
 
+    ``select_lobes`` (default True): each of ``clearcoat``, ``sheen`` and
+    ``metallic`` (up to 0.5: a dielectric's metallic share) that the fit
+    turns on is fitted again held at 0, and stays
+    off where it does not divide the cost by more than :data:`LOBE_GAIN` (2):
+    a lobe imitating another model's shape (a clearcoat for a Beckmann tail)
+    lowers the cost by tens of percent, one the data need by far more
+    (docs/fitting.md#lobes-the-data-do-not-need); ``notes`` and ``summary()``
+    name the lobes held off and the factor.
+
     ``method``: ``"batched"`` (default) solves all problems together by
     Levenberg-Marquardt with the bounds (docs/fitting.md): each iteration
     evaluates every unfinished problem in one pass of the kernels, reduced per
@@ -375,6 +392,7 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
     if not isinstance(precision, str) or precision not in ("float32", "float64"):
         raise ValueError(f"precision: expected 'float32' or 'float64', got {precision!r}")
     cosine = _validate.flag("cosine", cosine)
+    select_lobes = _validate.flag("select_lobes", select_lobes)
     max_iterations = _validate.integer("max_iterations", max_iterations)
     if max_iterations < 1:
         raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations}")
@@ -427,26 +445,36 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
         start[requested] = np.clip(start[requested], lower[requested], upper[requested])
     slots = [k for k in requested if lower[k] < upper[k]]  # equal bounds hold a parameter (clipped to it above)
 
-    def solve(start: Float64Array) -> _FitArrays:
+    def solve(start: Float64Array, slots: list[int], lower: Float64Array, upper: Float64Array,
+              rows: NDArray[np.int64] | None = None) -> _FitArrays:
+        """The fit of the problems ``rows`` (default all) from ``start`` ``(P,)`` or one per row."""
+        chosen = np.arange(count) if rows is None else rows
         if method == "scipy":
-            return _fit_scipy(wi_rows, wo_rows, problems, weights, start, lower, upper, slots, loss, cosine, model,
-                              precision, max_iterations)
+            return _fit_scipy(wi_rows[chosen], wo_rows[chosen], problems[chosen],
+                              None if weights is None else weights[chosen], start, lower, upper, slots, loss, cosine,
+                              model, precision, max_iterations)
         if wi.ndim == wo.ndim:
-            pair_wi, pair_wo = wi, wo
+            pair_wi, pair_wo = (wi, wo) if wi.ndim == 2 else (wi[chosen], wo[chosen])
         else:  # one of them per problem: both
-            pair_wi, pair_wo = np.ascontiguousarray(wi_rows), np.ascontiguousarray(wo_rows)
+            pair_wi, pair_wo = np.ascontiguousarray(wi_rows[chosen]), np.ascontiguousarray(wo_rows[chosen])
         # a few million samples at a time: the solver's arrays stay small whatever the texture
         # (a problem's result does not depend on the problems solved with it)
         parts = []
-        for begin in range(0, max(count, 1), _batch_problems(n)):
-            rows = slice(begin, min(count, begin + _batch_problems(n)))
-            parts.append(_fit_batched(pair_wi[rows] if pair_wi.ndim == 3 else pair_wi,
-                                      pair_wo[rows] if pair_wo.ndim == 3 else pair_wo, problems[rows],
-                                      None if weights is None else weights[rows], start, lower, upper, slots, loss,
+        for begin in range(0, max(len(chosen), 1), _batch_problems(n)):
+            part = slice(begin, min(len(chosen), begin + _batch_problems(n)))
+            parts.append(_fit_batched(pair_wi[part] if pair_wi.ndim == 3 else pair_wi,
+                                      pair_wo[part] if pair_wo.ndim == 3 else pair_wo, problems[chosen[part]],
+                                      None if weights is None else weights[chosen[part]],
+                                      start if start.ndim == 1 else start[part], lower, upper, slots, loss,
                                       cosine, model, precision, max_iterations, thread_count))
         return _joined(parts)
 
-    fitted, costs, iterations, success, messages, residuals_out, reset_names = _lowest_cost([solve(s) for s in starts])
+    fits = _lowest_cost([solve(s, slots, lower, upper) for s in starts])
+    if select_lobes:
+        has_data = ~np.all(np.isnan(problems), axis=(1, 2))
+        fits, held = _select_lobes(fits, solve, starts[0], slots, lower, upper, names, has_data)
+        notes += _held_notes(held, count)
+    fitted, costs, iterations, success, messages, residuals_out, reset_names = fits
     if (note := _inert.note(reset_names, count)) is not None:
         notes.append(note)
 
@@ -456,6 +484,57 @@ def fit(wi: RealArrayLike, wo: RealArrayLike, measured: RealArrayLike, *,
                      message=tuple(messages) if batched else messages[0], names=tuple(names[k] for k in slots),
                      notes=tuple(notes), model=model)
 
+
+def _select_lobes(fits: _FitArrays, solve: Callable[..., _FitArrays], start: Float64Array, slots: list[int],
+                  lower: Float64Array, upper: Float64Array,
+                  names: Sequence[str],
+                  has_data: NDArray[np.bool_]) -> tuple[_FitArrays, dict[str, list[tuple[int, float]]]]:
+    """Model selection (docs/fitting.md#lobes-the-data-do-not-need): each of OPTIONAL_LOBES that
+    a problem's fit turned on (up to its largest value) is fitted again held at 0, from that fit (the parameters it
+    alone reads back at their start); the lobe stays off where that costs less than
+    LOBE_GAIN times the cost with it. Returns the fits and, per lobe held off, the problems
+    and their cost ratios."""
+    fitted, costs, iterations, success, messages, residuals, reset_names = fits
+    fitted, costs, iterations, success = fitted.copy(), costs.copy(), iterations.copy(), success.copy()
+    messages, residuals, reset_names = list(messages), residuals.copy(), list(reset_names)
+    held: dict[str, list[tuple[int, float]]] = {}
+    held_by_row: list[tuple[int, ...]] = [()] * len(fitted)  # the slots held at 0 so far, per problem
+    for lobe, (follower, largest) in OPTIONAL_LOBES.items():
+        k = names.index(lobe)
+        if k not in slots:
+            continue
+        candidates = np.flatnonzero((fitted[:, k] > 0.0) & (fitted[:, k] <= largest) & has_data)
+        # problems with the same lobes held off so far are fitted together, with those held too
+        for already in sorted({held_by_row[row] for row in candidates}):
+            rows = np.array([row for row in candidates if held_by_row[row] == already], dtype=np.int64)
+            zero = already + (k,)
+            without = fitted[rows].copy()
+            without[:, k] = 0.0
+            if follower is not None:
+                without[:, names.index(follower)] = start[names.index(follower)]
+            held_lower, held_upper = lower.copy(), upper.copy()
+            held_lower[list(zero)] = held_upper[list(zero)] = 0.0
+            other = solve(without, [j for j in slots if j not in zero], held_lower, held_upper, rows)
+            ratio = other[1] / np.maximum(costs[rows], np.finfo(np.float64).tiny)
+            for j in np.flatnonzero(other[1] <= LOBE_GAIN * costs[rows]):
+                row = rows[j]
+                fitted[row], costs[row], success[row] = other[0][j], other[1][j], other[3][j]
+                iterations[row] += other[2][j]
+                messages[row], residuals[row], reset_names[row] = other[4][j], other[5][j], other[6][j]
+                held_by_row[row] = zero
+                held.setdefault(lobe, []).append((int(row), float(ratio[j])))
+    return (fitted, costs, iterations, success, messages, residuals, reset_names), held
+
+
+def _held_notes(held: dict[str, list[tuple[int, float]]], count: int) -> list[str]:
+    """The result's notes on the lobes model selection held off."""
+    notes = []
+    for lobe, rows in held.items():
+        worst = max(ratio for _, ratio in rows)
+        where = "" if count == 1 else f" in {len(rows)} of {count} problems"
+        notes.append(f"{lobe} held off{where}: the fit without it costs at most {worst:.3g} times the fit with it "
+                     f"(a lobe is kept where that is more than {LOBE_GAIN:g}); select_lobes=False keeps it")
+    return notes
 
 def _joined(parts: list[_FitArrays]) -> _FitArrays:
     """The results of consecutive parts of a batch as one."""
@@ -493,7 +572,8 @@ def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[A
     except ImportError as error:  # pragma: no cover - scipy is in the test and fit extras
         raise ImportError("pb.fit(method='scipy') needs scipy: pip install 'principled-brdf[fit]'") from error
     count = problems.shape[0]
-    fitted = np.empty((count, len(start)))
+    fitted = np.empty((count, start.shape[-1]))
+    start_rows = np.broadcast_to(start, fitted.shape)  # one start, or one per problem
     costs, iterations, success, messages = np.empty(count), np.empty(count, np.int64), np.empty(count, bool), []
     residuals_out = np.full(problems.shape, np.nan)
     reset_names: list[list[str]] = [[] for _ in range(count)]  # per problem, the parameters set back to their start
@@ -505,7 +585,7 @@ def _fit_scipy(wi_rows: NDArray[Any], wo_rows: NDArray[Any], problems: NDArray[A
 
     with _one_blas_thread():
         for row in range(count):
-            target = problems[row]
+            target, start = problems[row], start_rows[row]
             present = ~np.isnan(target).any(axis=-1)
             if not present.any():
                 fitted[row], costs[row], iterations[row], success[row] = start, 0.0, 0, False
@@ -592,7 +672,7 @@ def _fit_batched(wi: NDArray[Any], wo: NDArray[Any], problems: NDArray[Any], wei
     # each problem's scale divided by its largest (the same minimum; float32 sums stay in range)
     top = scale.max(axis=(1, 2))
     scale = scale / np.where(top > 0.0, top, 1.0)[:, None, None]
-    full_start = np.broadcast_to(start, (count, len(start))).copy()
+    full_start = np.broadcast_to(start, (count, start.shape[-1])).copy()
     solved = np.flatnonzero(has_data).astype(np.int64)
     slot_index = np.asarray(slots, dtype=np.int64)
     fitted = full_start.copy()

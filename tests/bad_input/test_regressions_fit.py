@@ -22,7 +22,7 @@ from conftest import random_direction_pairs, seeded_rng
 from principled_brdf._gradient import GRADIENT_NAMES_2015
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "fitting"))
-from fit_quality import normal_albedo  # noqa: E402
+from known_answers import normal_albedo  # noqa: E402
 
 METHODS = [dict(method="batched"), dict(method="batched", precision="float64"), dict(method="scipy")]
 METHOD_IDS = ["batched", "float64", "scipy"]

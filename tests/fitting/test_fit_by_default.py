@@ -7,7 +7,7 @@ with 5 % noise. The call a newcomer makes, ``pb.fit(wi, wo, values)``, must
 recover the directional albedo at normal incidence within 5 % per channel and
 the peak of the reflected lobe within one table cell, and hold ``anisotropic``
 at 0 on a table's isotropic data, saying so. How the figures are measured:
-tests/fitting/fit_quality.py.
+tests/fitting/known_answers.py.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import principled_brdf as pb
-import fit_quality as quality
+import known_answers as quality
 from principled_brdf._loss_scale import log_scale
 
 pytest.importorskip("scipy")

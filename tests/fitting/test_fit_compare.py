@@ -58,11 +58,26 @@ def test_a_batched_fit_shows_the_texel_asked_for():
     assert max(second.image_error) < 1e-3 < min(first.image_error)
 
 
+def test_cells_without_data_are_left_out_of_both_pictures():
+    """Data missing half its pairs against the material that made it: no difference."""
+    result = fitted(GOLD)
+    complete = data_of(result.material)
+
+    def half_missing(wi, wo):
+        return np.where(wi[..., :1] > 0.0, np.nan, complete(wi, wo))
+    comparison = result.compare(half_missing, resolution=24, samples=16)
+    assert max(comparison.image_error) < 1e-4
+
+
 def test_bad_data_is_a_named_error():
     result = fitted(GOLD)
     with pytest.raises(ValueError, match="^data:"):
         result.compare(lambda wi, wo: -np.ones(np.broadcast(wi, wo).shape), resolution=8, samples=4)
     with pytest.raises(TypeError, match="^data:"):
         result.compare(3, resolution=8, samples=4)
+    with pytest.raises(ValueError, match="^data: the callable returned f of shape|^data: expected the callable"):
+        result.compare(lambda wi, wo: np.ones(np.broadcast(wi, wo).shape[:-1]), resolution=8, samples=4)
+    with pytest.raises(ValueError, match="^data: no value"):
+        result.compare(lambda wi, wo: np.full(np.broadcast(wi, wo).shape, np.nan), resolution=8, samples=4)
     with pytest.raises(ValueError, match="environments"):
         result.compare(data_of(GOLD), environments="studio", resolution=8, samples=4)

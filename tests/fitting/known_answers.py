@@ -17,7 +17,7 @@ Two figures compare a fitted material with the BRDF that made the measurement:
 The measurements: microfacet BRDFs of other models (``pb.synthetic``), Lambert +
 Blinn-Phong plastics (``blinn_phong_plastic``) and the library's own model with 5 %
 multiplicative noise. ``python
-tests/fitting/fit_quality.py`` prints the table of docs/fitting.md (every
+tests/fitting/known_answers.py`` prints the table of docs/fitting.md (every
 case × loss).
 """
 
@@ -60,7 +60,6 @@ def own_model(wi, wo):
 CASES = {
     "gold, Beckmann α 0.2": (pb.synthetic.conductor("gold", 0.2), 0.0),
     "copper, GGX α 0.15": (pb.synthetic.conductor("copper", 0.15, distribution="ggx"), 0.0),
-    "aluminium, Beckmann α 0.3": (pb.synthetic.conductor("aluminium", 0.3), 0.0),
     "red plastic, GGX α 0.1": (pb.synthetic.plastic((0.5, 0.1, 0.05), 0.1), 0.0),
     "blue plastic, GGX α 0.3": (pb.synthetic.plastic((0.05, 0.15, 0.5), 0.3), 0.0),
     "dusty dielectric, Beckmann α 0.15": (pb.synthetic.dusty_dielectric(0.15), 0.0),
@@ -68,6 +67,9 @@ CASES = {
 }
 # beyond what the principled model represents (docs/fitting.md): shown in the table, not held by the tests
 LIMITS = {
+    # its 3.6 % came from a clearcoat imitating Beckmann's tail; without it (docs/fitting.md#lobes-the-data-do-not-need)
+    # the GGX that fits the lobe's shape best is 12.5 % dark
+    "aluminium, Beckmann α 0.3": (pb.synthetic.conductor("aluminium", 0.3), 0.0),
     "aluminium, Beckmann α 0.06": (pb.synthetic.conductor("aluminium", 0.06), 0.0),
     "dusty dielectric, Beckmann α 0.05": (pb.synthetic.dusty_dielectric(0.05), 0.0),
     "gold, Beckmann α 0.6": (pb.synthetic.conductor("gold", 0.6), 0.0),
