@@ -503,7 +503,9 @@ def _select_lobes(fits: _FitArrays, solve: Callable[..., _FitArrays], start: Flo
         k = names.index(lobe)
         if k not in slots:
             continue
-        candidates = np.flatnonzero((fitted[:, k] > 0.0) & (fitted[:, k] <= largest) & has_data)
+        # (a lobe without effect at the fit, set back to its start by module _inert, is no candidate)
+        candidates = [row for row in np.flatnonzero((fitted[:, k] > 0.0) & (fitted[:, k] <= largest) & has_data)
+                      if lobe not in reset_names[row]]
         # problems with the same lobes held off so far are fitted together, with those held too
         for already in sorted({held_by_row[row] for row in candidates}):
             rows = np.array([row for row in candidates if held_by_row[row] == already], dtype=np.int64)

@@ -244,7 +244,8 @@ class LayeredPlastic:
 
     def __call__(self, wi: RealArrayLike, wo: RealArrayLike) -> Float64Array:
         eta = np.full(3, self.ior)
-        body_scale = self.albedo / (self.ior**2 * (1.0 - self.albedo * self.internal_reflectance))
+        albedo = np.asarray(self.albedo, dtype=np.float64)
+        body_scale = albedo / (self.ior**2 * (1.0 - albedo * self.internal_reflectance))
 
         def f(l: Float64Array, v: Float64Array, h: Float64Array) -> Float64Array:
             dg = self.distribution.d(h) * self.distribution.g2(l, v)
