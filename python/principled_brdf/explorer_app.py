@@ -107,11 +107,15 @@ def _inputs(name: str, state: Mapping[str, Any]) -> tuple[Any, ...]:
 
 
 
-def _pass_samples(state: Mapping[str, Any]) -> int:
-    """Samples per pixel of one pass of the sphere: what keeps a first picture near 0.2 s."""
+def _pass_samples(state: Mapping[str, Any], first: bool = True) -> int:
+    """Samples per pixel of a pass of the sphere: the first keeps its picture near 0.2 s, the
+    others take twice as many."""
+    lit_by_map = state["sky"] and state["environment"] != "sky"
     if _models.is_whole_sphere(state["model"]):
-        return _THROUGH_SAMPLES
-    return _MAP_SAMPLES if state["sky"] and state["environment"] != "sky" else _SKY_SAMPLES
+        samples = _THROUGH_SAMPLES // 2 if lit_by_map else _THROUGH_SAMPLES
+    else:
+        samples = _MAP_SAMPLES if lit_by_map else _SKY_SAMPLES
+    return samples if first else 2 * samples
 
 
 _KEY_STYLES: dict[str, dict[str, Any]] = {  # the legend entries of the plots, beyond the lobes
@@ -139,8 +143,9 @@ _DISC_AXES = (0.27, 0.2, 0.46, 0.6)  # the whole circle, radius 79 px, between t
 _ALBEDO_SAMPLES = 1 << 12
 _SKY_SAMPLES = 32  # render_sphere uses 64; 32 shows little grain and keeps an update near 0.2 s
 # the first picture's samples per pixel where light must be found in a map's bright spots or through the
-# sphere (a pass of the 2015 models takes about as long at 4 as a BRDF's at 32); more passes while idle
-_MAP_SAMPLES = 16
+# sphere, each first picture near 0.2 s on two cores (the 2015 models under a map: 2); the passes after it
+# take twice as many, while the controls rest
+_MAP_SAMPLES = 8
 _THROUGH_SAMPLES = 4
 _REFINED_SAMPLES = 512  # samples per pixel at which the refinement stops
 _REFINE_DELAY = 0.05  # seconds between passes, in which the kernel answers the front end
@@ -627,7 +632,7 @@ class Explorer:
             if self._closed or not self._refinable():
                 break
             sphere = self._sphere
-            samples = _pass_samples(sphere["state"])
+            samples = _pass_samples(sphere["state"], first=False)
             sphere["sum"] = sphere["sum"] + self._render_sphere(sphere["material"], sphere["state"], samples,
                                                                 sphere["passes"]) * samples
             sphere["passes"] += 1

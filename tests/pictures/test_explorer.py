@@ -202,20 +202,21 @@ def test_under_a_map_the_light_moves_the_plots_and_not_the_sphere(explorer):
 
 
 def test_the_sphere_refines_pass_after_pass(explorer):
-    """Each pass its own lattice shift, the picture their mean; a change starts afresh."""
+    """Each pass its own lattice shift, twice the first's samples, the picture their mean
+    weighted by samples; a change starts afresh."""
     explorer.environment.value = "studio"
     first = explorer.sphere_samples
     assert first == explorer_module._MAP_SAMPLES
     one = explorer.images["sphere"].value
-    assert explorer.refine(2) == 3 * first
+    assert explorer.refine(2) == 5 * first
     assert explorer.images["sphere"].value != one
     light = explorer_module._direction(explorer.light_theta.value, explorer.light_phi.value)
-    passes = [pb.render.render_sphere(explorer.material, 64, light=light, environment="studio", samples=first, seed=k)
-              for k in range(3)]
-    mean = (passes[0] * first + passes[1] * first + passes[2] * first) / (3 * first)
+    passes = [pb.render.render_sphere(explorer.material, 64, light=light, environment="studio", samples=s, seed=k)
+              for k, s in enumerate((first, 2 * first, 2 * first))]
+    mean = (passes[0] * first + passes[1] * (2 * first) + passes[2] * (2 * first)) / (5 * first)
     expected = explorer_module._rgba(mean, explorer._inside, 1.0)
     np.testing.assert_array_equal(pixels(explorer.images["sphere"].value), pixels(pb.render.png_bytes(expected)))
-    assert "48 samples/px (refining)" in explorer.status.value
+    assert f"{5 * first} samples/px (refining)" in explorer.status.value
     explorer.sliders["roughness"].value = 0.3
     assert explorer.sphere_samples == first
 
