@@ -49,6 +49,7 @@ CONDUCTORS: dict[str, tuple[tuple[float, float, float], tuple[float, float, floa
     "silver": ((0.15943, 0.14512, 0.13547), (3.9291, 3.1900, 2.3808)),
     "chrome": ((3.1071, 3.1812, 2.3230), (3.3314, 3.3291, 3.1350)),
 }
+_MAX_IOR = 1e3  # a coat's index: beyond, no dielectric
 _DISTRIBUTIONS = {"beckmann": _microfacet.Beckmann, "ggx": _microfacet.GGX, "blinn_phong": _microfacet.BlinnPhong}
 
 
@@ -88,12 +89,8 @@ class MicrofacetSurface:
         if not (hasattr(self.distribution, "d") and hasattr(self.distribution, "g2")):
             raise TypeError("distribution: expected a pb.microfacet distribution with d and g2 (GGX, Beckmann), "
                             f"got {type(self.distribution).__name__}")
-        object.__setattr__(self, "eta", _rgb("eta", self.eta, 0.0, open_lower=True))
-        object.__setattr__(self, "k", _rgb("k", self.k, 0.0))
-        diffuse = _rgb("diffuse", self.diffuse, 0.0)
-        if np.any(diffuse > 1.0):
-            raise ValueError(f"diffuse: {diffuse.tolist()} is not an albedo in [0, 1]")
-        object.__setattr__(self, "diffuse", diffuse)
+        _set_index(self)
+        _set_albedos(self, ("diffuse",))
         weight = float(_validate.as_real_array("specular_weight", self.specular_weight))
         if not 0.0 <= weight <= 1.0:
             raise ValueError(f"specular_weight: {weight!r} is not in [0, 1]")
@@ -114,6 +111,32 @@ class MicrofacetSurface:
             specular = (dg / (4.0 * l[:, 2] * v[:, 2]))[:, None] * self.fresnel(np.sum(l * h, axis=-1))
             return self.specular_weight * specular + np.asarray(self.diffuse, dtype=np.float64) / np.pi
         return _above_horizon(wi, wo, f)
+
+
+def _set_index(surface: object) -> None:
+    """A frozen dataclass's ``eta`` (> 0) and ``k`` (>= 0) as checked RGB arrays."""
+    object.__setattr__(surface, "eta", _rgb("eta", getattr(surface, "eta"), 0.0, open_lower=True))
+    object.__setattr__(surface, "k", _rgb("k", getattr(surface, "k"), 0.0))
+
+
+def _set_in_range(surface: object, names: tuple[str, ...], lower: float, upper: float, what: str, *,
+                  open_lower: bool = False) -> None:
+    """A frozen dataclass's scalar fields ``names`` as floats in [lower, upper] ((lower, upper]
+    with ``open_lower``); a ValueError saying they are not ``what`` otherwise."""
+    for name in names:
+        value = float(_validate.as_real_array(name, getattr(surface, name)))
+        if not ((lower < value) if open_lower else (lower <= value)) or not value <= upper:
+            raise ValueError(f"{name}: {value!r} is not {what}")
+        object.__setattr__(surface, name, value)
+
+
+def _set_albedos(surface: object, names: tuple[str, ...]) -> None:
+    """A frozen dataclass's fields ``names`` as RGB arrays in [0, 1]."""
+    for name in names:
+        value = _rgb(name, getattr(surface, name), 0.0)
+        if np.any(value > 1.0):
+            raise ValueError(f"{name}: {value.tolist()} is not an albedo in [0, 1]")
+        object.__setattr__(surface, name, value)
 
 
 def _fresnel(cos_theta_d: RealArrayLike, eta: RealArrayLike, k: RealArrayLike) -> Float64Array:
@@ -210,18 +233,9 @@ class LayeredPlastic:
     sigma: float = 0.0
 
     def __post_init__(self) -> None:
-        ior = float(_validate.as_real_array("ior", self.ior))
-        if not 1.0 < ior < np.inf:
-            raise ValueError(f"ior: {ior!r} is not above 1")
-        albedo = _rgb("albedo", self.albedo, 0.0)
-        if np.any(albedo > 1.0):
-            raise ValueError(f"albedo: {albedo.tolist()} is not an albedo in [0, 1]")
-        sigma = float(_validate.as_real_array("sigma", self.sigma))
-        if not 0.0 <= sigma <= np.pi / 2:
-            raise ValueError(f"sigma: {sigma!r} is not a slope deviation in [0, π/2] radians")
-        object.__setattr__(self, "ior", ior)
-        object.__setattr__(self, "albedo", albedo)
-        object.__setattr__(self, "sigma", sigma)
+        _set_in_range(self, ("ior",), 1.0, _MAX_IOR, f"an index of refraction in (1, {_MAX_IOR:g}]", open_lower=True)
+        _set_albedos(self, ("albedo",))
+        _set_in_range(self, ("sigma",), 0.0, np.pi / 2, "a slope deviation in [0, π/2] radians")
 
     @property
     def internal_reflectance(self) -> float:
@@ -270,13 +284,8 @@ class Ward:
     alpha_y: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "eta", _rgb("eta", self.eta, 0.0, open_lower=True))
-        object.__setattr__(self, "k", _rgb("k", self.k, 0.0))
-        for name in ("alpha_x", "alpha_y"):
-            value = float(_validate.as_real_array(name, getattr(self, name)))
-            if not 0.0 < value <= 1.0:
-                raise ValueError(f"{name}: {value!r} is not in (0, 1]")
-            object.__setattr__(self, name, value)
+        _set_index(self)
+        _set_in_range(self, ("alpha_x", "alpha_y"), 0.0, 1.0, "in (0, 1]", open_lower=True)
 
     def __call__(self, wi: RealArrayLike, wo: RealArrayLike) -> Float64Array:
         def f(l: Float64Array, v: Float64Array, h: Float64Array) -> Float64Array:
@@ -302,13 +311,8 @@ class AshikhminShirley:
     nv: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "eta", _rgb("eta", self.eta, 0.0, open_lower=True))
-        object.__setattr__(self, "k", _rgb("k", self.k, 0.0))
-        for name in ("nu", "nv"):
-            value = float(_validate.as_real_array(name, getattr(self, name)))
-            if not 0.0 <= value <= 1e6:
-                raise ValueError(f"{name}: {value!r} is not an exponent in [0, 1e6]")
-            object.__setattr__(self, name, value)
+        _set_index(self)
+        _set_in_range(self, ("nu", "nv"), 0.0, 1e6, "an exponent in [0, 1e6]")
 
     def __call__(self, wi: RealArrayLike, wo: RealArrayLike) -> Float64Array:
         def f(l: Float64Array, v: Float64Array, h: Float64Array) -> Float64Array:
@@ -339,15 +343,8 @@ class Satin:
     alpha: float
 
     def __post_init__(self) -> None:
-        for name in ("diffuse", "sheen"):
-            value = _rgb(name, getattr(self, name), 0.0)
-            if np.any(value > 1.0):
-                raise ValueError(f"{name}: {value.tolist()} is not in [0, 1]")
-            object.__setattr__(self, name, value)
-        alpha = float(_validate.as_real_array("alpha", self.alpha))
-        if not 0.0 < alpha <= 1.0:
-            raise ValueError(f"alpha: {alpha!r} is not in (0, 1]")
-        object.__setattr__(self, "alpha", alpha)
+        _set_albedos(self, ("diffuse", "sheen"))
+        _set_in_range(self, ("alpha",), 0.0, 1.0, "in (0, 1]", open_lower=True)
 
     def __call__(self, wi: RealArrayLike, wo: RealArrayLike) -> Float64Array:
         def f(l: Float64Array, v: Float64Array, h: Float64Array) -> Float64Array:
