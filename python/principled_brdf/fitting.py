@@ -49,7 +49,7 @@ if TYPE_CHECKING:
     _FitArrays = tuple[Float64Array, Float64Array, NDArray[np.int64], NDArray[np.bool_], list[str], Float64Array,
                        list[list[str]]]
 
-__all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES", "METHODS"]
+__all__ = ["fit", "FitResult", "FIT_BOUNDS", "LOSSES", "METHODS", "LOBE_GAIN", "OPTIONAL_LOBES"]
 
 # Default bounds for fitting: the domains, with the unbounded parameters held
 # to [0, 1] as the BRDF Explorer's sliders are (pass bounds= to widen them).
