@@ -300,7 +300,7 @@ class Explorer:
         self._inside = _render.sphere_frames(resolution)[0]
         self._sphere = {"key": None, "samples": 0}
         self._refinement: Any = None  # the event loop's handle of the next pass, while one is scheduled
-        self._timing_status = ""
+        self._timing_status = self._timing_detail = ""
 
         style = {"description_width": _LABEL_WIDTH}
         layout = widgets.Layout(width=_CONTROL_WIDTH)
@@ -467,8 +467,9 @@ class Explorer:
             drawn[name] = self.timings[name] = time.perf_counter() - begin
         if drawn:
             self.last_update_seconds = time.perf_counter() - start
-            parts = " · ".join(f"{name} {seconds * 1e3:.0f}" for name, seconds in drawn.items())
-            self._timing_status = f"{self.last_update_seconds * 1e3:.0f} ms: {parts}"
+            self._timing_status = f"{self.last_update_seconds * 1e3:.0f} ms"
+            # each picture's time in the tooltip: one line stays short enough for the controls' width
+            self._timing_detail = ", ".join(f"{name} {seconds * 1e3:.0f} ms" for name, seconds in drawn.items())
             self._sphere_status()
         return drawn
 
@@ -671,8 +672,8 @@ class Explorer:
 
     def _sphere_status(self) -> None:
         more = " (refining)" if self._refinable() else ""
-        self.status.value = (f'<small style="white-space:nowrap">{self._timing_status} · sphere '
-                             f"{self.sphere_samples} samples/px{more}</small>")
+        self.status.value = (f'<small style="white-space:nowrap" title="{self._timing_detail}">updated in '
+                             f"{self._timing_status} · sphere {self.sphere_samples} samples/px{more}</small>")
 
     def _build_polar(self, Figure: type[Figure]) -> None:
         fig = Figure(figsize=_FIGSIZE, dpi=_DPI)

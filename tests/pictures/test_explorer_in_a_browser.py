@@ -5,7 +5,7 @@ widget's four pictures, moves the roughness slider and switches the model,
 and after each change checks from screenshots that the sphere is not blank and
 has changed. At a 1100 px window with the file browser open (a notebook area
 of about 650 px) and at 800 px nothing of the widget lies outside the output
-area, no label is cut short, and the status line keeps its height.
+area, no label or line of text is cut short, and the status line keeps its height.
 
 With ``PB_EXPLORER_SCREENSHOTS=folder`` it writes the widget at 800, 1100 and
 1600 px there (docs/rendering-and-plots.md shows them). Needs the ``browser``
@@ -58,7 +58,7 @@ for (const element of output.querySelectorAll('*')) {
   if (box.right > area.right + 0.5 || box.left < area.left - 0.5)
     faults.push(`${element.className || element.tagName} spans ${box.left}-${box.right}, the area ${area.left}-${area.right}`);
 }
-for (const label of output.querySelectorAll('.widget-label, .widget-readout, label'))
+for (const label of output.querySelectorAll('.widget-label, .widget-readout, label, .widget-html-content'))
   if (label.scrollWidth > label.clientWidth + 1) faults.push(`label "${label.textContent}" cut short`);
 return faults;
 """
