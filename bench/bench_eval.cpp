@@ -147,6 +147,7 @@ void simd_sample_job(benchmark::State& state, const std::string& isa, const pb::
     Data& d = data_for(state.range(0));
     pb::SampleJob job;
     job.model = model;
+    job.energy_compensation = eval_job.energy_compensation;
     job.wo = eval_job.wo;
     job.seed = 7;
     for (int s = 0; s < pb::kParamSlots; ++s) job.params[s] = eval_job.params[s];
@@ -176,12 +177,14 @@ void simd_sample_material(benchmark::State& state, std::string isa, int index) {
 // The models over their domains (bench/RESULTS.md, "The 2015 BSDF"): a rough
 // glass-like uniform material (the benchmark material's base color, roughness
 // 0.3, specular 0.5) with spec_trans 0, 0.5 or 1, on pairs over the upper
-// hemisphere or the whole sphere; one thread.
+// hemisphere or the whole sphere, and that glass with its energy compensation
+// (pb.eval(..., energy_compensation=True)); one thread.
 struct ModelCase {
     const char* name;
     pb::Model model;
     float spec_trans;
     bool sphere;
+    bool compensated = false;
 };
 constexpr ModelCase kModelCases[] = {
     {"disney2014/upper", pb::Model::kDisney2014, 0.0f, false},
@@ -189,6 +192,7 @@ constexpr ModelCase kModelCases[] = {
     {"disney2015/sphere/spec_trans_0", pb::Model::kDisney2015, 0.0f, true},
     {"disney2015/sphere/spec_trans_0.5", pb::Model::kDisney2015, 0.5f, true},
     {"disney2015/sphere/spec_trans_1", pb::Model::kDisney2015, 1.0f, true},
+    {"disney2015/sphere/spec_trans_1/compensated", pb::Model::kDisney2015, 1.0f, true, true},
 };
 
 pb::EvalJob make_model_job(Data& d, const ModelCase& c) {
@@ -197,6 +201,7 @@ pb::EvalJob make_model_job(Data& d, const ModelCase& c) {
     job.params[pb::kSubsurface].value = 0.0f;  // (the 2015 models read flatness instead)
     job.params[pb::kRoughness].value = 0.3f;
     job.params[pb::kSpecTrans].value = c.spec_trans;
+    job.energy_compensation = c.compensated;
     return job;
 }
 

@@ -279,14 +279,19 @@ float* derivative_output(Float32Array& a, const std::vector<py::ssize_t>& width,
     return a.mutable_data();
 }
 
+// The BRDFs' energy compensation has no derivatives (the 2015 solid's has).
+void refuse_compensated_derivative(const EvalOptions& options) {
+    if (options.energy_compensation && !is_bsdf(model_from(options.model)))
+        throw std::invalid_argument("energy_compensation: not with the gradient of the BRDFs (their lobe's derivative is not implemented)");
+}
+
 // f (out) and its Jacobian in the P slots of `columns` (None: all): (N, 3) and
 // (N, 3, P) arrays, or (3, N) and (3, P, N) with out_layout rows.
 std::int64_t batch_eval_grad(const Float32Array& wi, int wi_layout, const Float32Array& wo, int wo_layout,
                              const py::sequence& params, Float32Array out, Float32Array jacobian, int out_layout,
                              std::int64_t n, const EvalOptions options, const py::object& columns,
                              const py::object& segments) {
-    if (options.energy_compensation)
-        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
+    refuse_compensated_derivative(options);
     py::list keep_alive;
     const SegmentTables tables = segments_from(segments, n);
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kGradient, options, keep_alive, tables);
@@ -307,8 +312,7 @@ std::int64_t batch_eval_vjp(const Float32Array& wi, int wi_layout, const Float32
                             const py::sequence& params, const Float32Array& cotangent, int cotangent_layout,
                             Float32Array vjp, int out_layout, std::int64_t n, const EvalOptions options,
                             const py::object& columns, const py::object& segments) {
-    if (options.energy_compensation)
-        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
+    refuse_compensated_derivative(options);
     py::list keep_alive;
     const SegmentTables tables = segments_from(segments, n);
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kVjp, options, keep_alive, tables);
@@ -329,8 +333,7 @@ std::int64_t batch_eval_direction_grad(const Float32Array& wi, int wi_layout, co
                                        const py::sequence& params, Float32Array out, Float32Array jacobian,
                                        int out_layout, std::int64_t n, const EvalOptions options,
                                        const py::object& segments) {
-    if (options.energy_compensation)
-        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
+    refuse_compensated_derivative(options);
     py::list keep_alive;
     const SegmentTables tables = segments_from(segments, n);
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kDirectionGradient, options, keep_alive,
@@ -351,8 +354,7 @@ std::int64_t batch_eval_direction_vjp(const Float32Array& wi, int wi_layout, con
                                       const py::sequence& params, const Float32Array& cotangent, int cotangent_layout,
                                       Float32Array vjp, int out_layout, std::int64_t n, const EvalOptions options,
                                       const py::object& segments) {
-    if (options.energy_compensation)
-        throw std::invalid_argument("energy_compensation: not with the gradient (its derivative is not implemented)");
+    refuse_compensated_derivative(options);
     py::list keep_alive;
     const SegmentTables tables = segments_from(segments, n);
     EvalJob job = eval_job(wi, wi_layout, wo, wo_layout, params, n, Output::kDirectionVjp, options, keep_alive, tables);

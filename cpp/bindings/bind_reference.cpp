@@ -44,7 +44,7 @@ py::dict model_row(const ModelRow& row) {
     d["gradient_slots"] = row.gradient_slots;
     d["lobes"] = names_in(row.lobes, kLobeNames);
     d["sampled_lobes"] = names_in(row.sampled_lobes, kSampledLobeNames);
-    d["energy_compensation"] = row.energy_table != kNoEnergyTable;
+    d["energy_compensation"] = row.energy_compensation;
     d["max_ior"] = row.max_ior;
     d["max_specular"] = max_specular(row);
     return d;
@@ -155,7 +155,7 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
         };
         if (is_bsdf(which_model)) {
             const TransportMode transport = mode_from(mode);
-            reference::with_cache2015<reference::Shading2015Cache>(which_model, [&](auto& shading) {
+            reference::with_cache2015<reference::Shading2015Cache>(which_model, energy_compensation, [&](auto& shading) {
                 for (py::ssize_t i = 0; i < n; ++i) {
                     const auto& material = shading.of(material_rows.row(i));
                     const Eigen::Vector3d in(wi_data + 3 * i), view(wo_data + 3 * i);
@@ -197,7 +197,7 @@ py::array_t<double> reference_eval(const Float64Array& wi, const Float64Array& w
 // f (N,3) and its Jacobian (N,3,P), P = gradient_slots(model) (13, or 16 for the 2015 models), for N packed
 // rows: wi (N,3), wo (N,3), params (N,16) or one shared row.
 py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, const Float64Array& params, int model,
-                              int mode) {
+                              int mode, bool energy_compensation) {
     const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
     require_rows(wi, n, 3, "wi");
     require_rows(wo, n, 3, "wo");
@@ -223,7 +223,7 @@ py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, co
                     store(i, reference::eval_grad(prepared.of(material_rows.row(i)), in, view, transport));
                 }
             };
-            reference::with_cache2015<reference::GradientShading2015Cache>(which_model, run);
+            reference::with_cache2015<reference::GradientShading2015Cache>(which_model, energy_compensation, run);
         } else {
             reference::GradientShadingCache prepared;
             for (py::ssize_t i = 0; i < n; ++i) {
@@ -237,7 +237,8 @@ py::tuple reference_eval_grad(const Float64Array& wi, const Float64Array& wo, co
 
 // ∂f/∂(wi, wo) (N,3,6) for N packed rows as reference_eval_grad's, f times |cos θl| if cosine.
 py::array_t<double> reference_eval_direction_grad(const Float64Array& wi, const Float64Array& wo,
-                                                  const Float64Array& params, int model, bool cosine, int mode) {
+                                                  const Float64Array& params, int model, bool cosine, int mode,
+                                                  bool energy_compensation) {
     const py::ssize_t n = wi.ndim() == 2 ? wi.shape(0) : -1;
     require_rows(wi, n, 3, "wi");
     require_rows(wo, n, 3, "wo");
@@ -261,7 +262,7 @@ py::array_t<double> reference_eval_direction_grad(const Float64Array& wi, const 
     {
         py::gil_scoped_release release;
         if (is_bsdf(which_model)) {
-            reference::with_cache2015<reference::DirectionShading2015Cache>(which_model,
+            reference::with_cache2015<reference::DirectionShading2015Cache>(which_model, energy_compensation,
                                                                              [&](auto& prepared) { run(prepared, bsdf); });
         } else {
             reference::DirectionShadingCache prepared;
@@ -306,7 +307,7 @@ py::tuple reference_sample(const Float64Array& wo, const Float64Array& u, const 
         };
         if (is_bsdf(which_model)) {
             const TransportMode transport = mode_from(mode);
-            reference::with_cache2015<reference::Shading2015Cache>(which_model, [&](auto& shading) {
+            reference::with_cache2015<reference::Shading2015Cache>(which_model, energy_compensation, [&](auto& shading) {
                 for (py::ssize_t i = 0; i < n; ++i) {
                     const double* ui = uniforms.row(i);
                     store(i, reference::sample(shading.of(material_rows.row(i)), Eigen::Vector3d(view.row(i)), ui[0], ui[1],
@@ -346,7 +347,7 @@ py::array_t<double> reference_pdf(const Float64Array& wi, const Float64Array& wo
             }
         };
         if (is_bsdf(which_model)) {
-            reference::with_cache2015<reference::Shading2015Cache>(which_model, run);
+            reference::with_cache2015<reference::Shading2015Cache>(which_model, energy_compensation, run);
         } else if (energy_compensation) {
             each_compensated(which_model, run);
         } else {
@@ -376,7 +377,7 @@ py::array_t<double> reference_lobe_probabilities(const Float64Array& wo, const F
             }
         };
         if (is_bsdf(model_from(model))) {
-            reference::with_cache2015<reference::Shading2015Cache>(model_from(model), run);
+            reference::with_cache2015<reference::Shading2015Cache>(model_from(model), energy_compensation, run);
         } else if (energy_compensation) {
             each_compensated(model_from(model), run);
         } else {
@@ -394,10 +395,10 @@ void bind_reference(py::module_& m) {
           py::arg("lobes"), py::arg("energy_compensation") = false, py::arg("mode") = 0,
           "Float64 reference f (N,3) or lobes (N,7,3) for packed, already validated rows.");
     m.def("reference_eval_grad", &reference_eval_grad, py::arg("wi"), py::arg("wo"), py::arg("params"), py::arg("model"),
-          py::arg("mode") = 0,
+          py::arg("mode") = 0, py::arg("energy_compensation") = false,
           "Float64 reference f (N,3) and its Jacobian (N,3,P) over the model's P parameter slots, for packed validated rows.");
     m.def("reference_eval_direction_grad", &reference_eval_direction_grad, py::arg("wi"), py::arg("wo"), py::arg("params"),
-          py::arg("model"), py::arg("cosine") = false, py::arg("mode") = 0,
+          py::arg("model"), py::arg("cosine") = false, py::arg("mode") = 0, py::arg("energy_compensation") = false,
           "Float64 reference derivatives (N,3,6) of f (times |cos θl| if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z.");
     m.def("reference_sample", &reference_sample, py::arg("wo"), py::arg("u"), py::arg("params"), py::arg("model"),
           py::arg("sampler"), py::arg("energy_compensation") = false, py::arg("mode") = 0,

@@ -26,6 +26,7 @@
 #endif
 
 #include "kernel_api.hpp"
+#include "principled_brdf/dielectric_energy_tables.hpp"
 #include "principled_brdf/energy_corners.hpp"
 #include "principled_brdf/energy_intercepts.hpp"
 

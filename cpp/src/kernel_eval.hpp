@@ -67,17 +67,19 @@ template <Model model, Output output, bool compensated>
 using PreparedOf = std::conditional_t<is_bsdf(model), Prepared2015<model, output>,
                                       std::conditional_t<compensated, CompensatedPrepared<output>, Prepared<output>>>;
 
+// (`compensated` a template parameter: the BRDFs' energy compensation, a type of
+// its own; `bsdf_compensated` the 2015 solid's, a value of its constants.)
 template <Model model, Output output, bool compensated>
-PB_KERNEL_INLINE PreparedOf<model, output, compensated> prepare_for(const RawMaterial& m) {
+PB_KERNEL_INLINE PreparedOf<model, output, compensated> prepare_for(const RawMaterial& m, bool bsdf_compensated = false) {
     static_assert(!compensated || has_energy_table(model), "the energy compensation needs the model's table");
     if constexpr (is_bsdf(model) && in_parameters(output)) {
-        return gradient_shading2015_of<Shading2015<model, PassDual<Floats>>>(m.slot);
+        return gradient_shading2015_of<Shading2015<model, PassDual<Floats>>>(m.slot, bsdf_compensated);
     } else if constexpr (is_bsdf(model) && in_directions(output)) {
-        return DirectionShading2015<model>{model_shading_of<model>(m), halves_of(m, [](const Doubles* p) {
-                                               return constant_shading2015_of<Shading2015<model, PassDual<Doubles>>>(p);
+        return DirectionShading2015<model>{model_shading_of<model>(m, bsdf_compensated), halves_of(m, [&](const Doubles* p) {
+                                               return constant_shading2015_of<Shading2015<model, PassDual<Doubles>>>(p, bsdf_compensated);
                                            })};
     } else if constexpr (is_bsdf(model)) {
-        return model_shading_of<model>(m);
+        return model_shading_of<model>(m, bsdf_compensated);
     } else if constexpr (compensated) {
         Shading<Floats> s = shading_of(m);
         return {{s, NoPartials{}, NoPartials{}}, multiple_scattering_of(m.slot, s, model)};
@@ -346,16 +348,19 @@ PB_KERNEL_INLINE bool eval_one_batch(const EvalJob& job, std::int64_t i, const P
         RawMaterial m = load_material(job.params, i);
         switch (lobe_set_of<model>(m)) {
             case LobeSet::kSpecular:
-                eval_batch<model, output, layouts, false, LobeSet::kSpecular>(job, i, wi, wo, prepare_for<model, output, false>(m));
+                eval_batch<model, output, layouts, false, LobeSet::kSpecular>(job, i, wi, wo,
+                                                                              prepare_for<model, output, false>(m, job.energy_compensation));
                 break;
             case LobeSet::kPlain:
-                eval_batch<model, output, layouts, false, LobeSet::kPlain>(job, i, wi, wo, prepare_for<model, output, false>(m));
+                eval_batch<model, output, layouts, false, LobeSet::kPlain>(job, i, wi, wo,
+                                                                           prepare_for<model, output, false>(m, job.energy_compensation));
                 break;
             default:
-                eval_batch<model, output, layouts, false>(job, i, wi, wo, prepare_for<model, output, false>(m));
+                eval_batch<model, output, layouts, false>(job, i, wi, wo, prepare_for<model, output, false>(m, job.energy_compensation));
         }
     } else if constexpr (per_element) {
-        eval_batch<model, output, layouts, compensated>(job, i, wi, wo, prepare_for<model, output, false>(load_material(job.params, i)));
+        eval_batch<model, output, layouts, compensated>(job, i, wi, wo,
+                                                        prepare_for<model, output, false>(load_material(job.params, i), job.energy_compensation));
     } else {
         eval_batch<model, output, layouts, compensated, lobes>(job, i, wi, wo, uniform);
     }
@@ -421,7 +426,7 @@ std::int64_t eval_batches(const EvalJob& job, std::int64_t begin, std::int64_t e
     PreparedOf<model, output, compensated> uniform{};
     BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
-        uniform = prepare_for<model, output, compensated>(load_material(job.params, 0));
+        uniform = prepare_for<model, output, compensated>(load_material(job.params, 0), job.energy_compensation);
         if constexpr (compensated) row.template use_for<model>(uniform.ms);
     }
     std::int64_t i = begin;

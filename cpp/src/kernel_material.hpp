@@ -29,11 +29,12 @@ PB_KERNEL_INLINE RawMaterial load_material(const ParamSlot* params, std::int64_t
 
 PB_KERNEL_INLINE Shading<Floats> shading_of(const RawMaterial& m) { return shading_of(m.slot); }
 
-// A model's constants for f, the pdf and the draw: the BRDFs' Shading, the 2015 models' Solid2015 or ThinSheet2015.
+// A model's constants for f, the pdf and the draw: the BRDFs' Shading, the 2015 models' Solid2015 or
+// ThinSheet2015 (with the solid's energy compensation where `compensated`; the BRDFs' is their own type).
 template <Model model>
-PB_KERNEL_INLINE auto model_shading_of(const RawMaterial& m) {
+PB_KERNEL_INLINE auto model_shading_of(const RawMaterial& m, bool compensated = false) {
     if constexpr (is_bsdf(model)) {
-        return Shading2015<model, Floats>::of(m.slot);
+        return shading2015_of<Shading2015<model, Floats>>(m.slot, compensated);
     } else {
         return shading_of(m);
     }

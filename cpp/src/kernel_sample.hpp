@@ -165,7 +165,7 @@ PB_KERNEL_INLINE bool sample_one_batch(const SampleJob& job, std::int64_t i, con
     SamplingShading<model> per_batch;
     if constexpr (per_element) {
         m = load_material(job.params, i);
-        per_batch = model_shading_of<model>(m);
+        per_batch = model_shading_of<model>(m, job.energy_compensation);
     }
     const SamplingShading<model>& s = per_element ? per_batch : uniform;
     ChosenOf<model> chosen;
@@ -255,7 +255,7 @@ std::int64_t sample_loop(const SampleJob& job, std::int64_t begin, std::int64_t 
     BlendedEnergyRow row;  // (left uninitialised; the loops without the compensation never touch it)
     if constexpr (!per_element) {
         RawMaterial m = load_material(job.params, 0);
-        uniform = model_shading_of<model>(m);
+        uniform = model_shading_of<model>(m, job.energy_compensation);
         if constexpr (compensated) {
             uniform_ms = multiple_scattering_of(m.slot, uniform, model);
             row.template use_for<model>(uniform_ms);

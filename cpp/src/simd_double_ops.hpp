@@ -34,6 +34,19 @@ PB_KERNEL_INLINE bool all(const DoubleMask& m) { return xsimd::all(m); }
 PB_KERNEL_INLINE Doubles log(Doubles x) { return xsimd::log(x); }
 PB_KERNEL_INLINE Doubles exp(Doubles x) { return xsimd::exp(x); }
 PB_KERNEL_INLINE Doubles exp_minus_one(Doubles x) { return xsimd::expm1(x); }
+// table lookups of whole nodes (model/dielectric_energy.hpp): floor(x) for x >= 0, and
+// (table[i], table[i + 1]) per lane for a whole i held as a real
+PB_KERNEL_INLINE Doubles floor_of(Doubles x) { return xsimd::floor(x); }
+PB_KERNEL_INLINE std::pair<Doubles, Doubles> table_pair(const float* table, Doubles index) {
+    alignas(64) double at[Doubles::size], below[Doubles::size], above[Doubles::size];
+    index.store_aligned(at);
+    for (std::size_t l = 0; l < Doubles::size; ++l) {
+        const std::int64_t i = static_cast<std::int64_t>(at[l]);
+        below[l] = table[i];
+        above[l] = table[i + 1];
+    }
+    return {Doubles::load_aligned(below), Doubles::load_aligned(above)};
+}
 
 // ---------------------------------------------------------------- a float batch as two double batches
 // Lanes [0, kLanes / 2) of a Floats are half 0, the rest half 1.

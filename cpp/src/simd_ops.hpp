@@ -590,6 +590,19 @@ PB_KERNEL_INLINE std::pair<Floats, Floats> value_and_slope_in_row(const float* r
     return gather_pair(row, interval + interval);
 }
 #endif
+// table lookups of whole nodes (model/dielectric_energy.hpp): floor(x) for x >= 0,
+// and (table[i], table[i + 1]) per lane for a whole i held as a real
+PB_KERNEL_INLINE Floats floor_of(Floats x) { return xsimd::floor(x); }
+#if defined(__AVX512F__)
+PB_KERNEL_INLINE std::pair<Floats, Floats> table_pair(const float* table, Floats index) {
+    const __m512i i = _mm512_cvttps_epi32(index);
+    return {_mm512_i32gather_ps(i, table, 4), _mm512_i32gather_ps(_mm512_add_epi32(i, _mm512_set1_epi32(1)), table, 4)};
+}
+#else
+PB_KERNEL_INLINE std::pair<Floats, Floats> table_pair(const float* table, Floats index) {
+    return gather_pair(table, truncate_to_index(index));
+}
+#endif
 
 // An interval's value and slope in two adjacent rows, for each lane, from a
 // corner table (energy_corners.hpp), one 16-byte load a lane. On AVX2

@@ -339,7 +339,7 @@ def _evaluate(material: Material, wi: object, wo: object, model_id: int, cosine:
     vjp = cotangent is not None
     require_material("material", material)
     if gradient or vjp or directions:
-        refuse_energy_compensation_derivative(energy_compensation)
+        refuse_energy_compensation_derivative(energy_compensation, _core.MODEL_NAMES[model_id])
     energy_compensation = flag("energy_compensation", energy_compensation)
     layout = checked_layout(layout)
     thread_count = _threads(threads)
@@ -532,7 +532,7 @@ DIRECTION_COMPONENTS = 6
 
 def direction_grad(material: Material, wi: object, wo: object, *, model_id: int, mode_id: int, cosine: bool,
                    layout: Layout, threads: SupportsIndex | None, check: bool,
-                   isa: str | None) -> tuple[Float32Array, Float32Array]:
+                   isa: str | None, energy_compensation: bool = False) -> tuple[Float32Array, Float32Array]:
     """f and its derivatives in the six direction components, ``(..., 3)`` and
     ``(..., 3, 6)`` (``(3, ...)`` and ``(3, 6, ...)`` for ``layout="soa"``), by the model's
     forward mode over double batches (``model/direction_gradient.hpp``)."""
@@ -542,7 +542,7 @@ def direction_grad(material: Material, wi: object, wo: object, *, model_id: int,
                 np.empty(_jacobian_shape(leading, layout, DIRECTION_COMPONENTS), np.float32)]
 
     value, jacobian = _evaluate(material, wi, wo, model_id, cosine, layout, threads, check, isa, outputs,
-                                directions=True, mode_id=mode_id)
+                                directions=True, mode_id=mode_id, energy_compensation=energy_compensation)
     return value, jacobian
 
 

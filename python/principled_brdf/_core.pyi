@@ -63,12 +63,18 @@ def reference_eval(
     """Float64 reference f (N,3) or lobes (N,6,3) for packed, already validated rows."""
 
 def reference_eval_grad(
-    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, mode: _Int = 0
+    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, mode: _Int = 0, energy_compensation: bool = False
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Float64 reference f (N,3) and its Jacobian (N,3,P) over the model's P parameter slots, for packed validated rows."""
 
 def reference_eval_direction_grad(
-    wi: _Float64In, wo: _Float64In, params: _Float64In, model: _Int, cosine: bool = False, mode: _Int = 0
+    wi: _Float64In,
+    wo: _Float64In,
+    params: _Float64In,
+    model: _Int,
+    cosine: bool = False,
+    mode: _Int = 0,
+    energy_compensation: bool = False,
 ) -> NDArray[np.float64]:
     """Float64 reference derivatives (N,3,6) of f (times |cos θl| if cosine) in wi_x, wi_y, wi_z, wo_x, wo_y, wo_z."""
 

@@ -104,8 +104,8 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
         return _batch.parameter_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
                                      threads=threads, out=out, check=check, isa=isa,
                                      energy_compensation=energy_compensation, mode=mode)
-    refuse_energy_compensation_derivative(energy_compensation)
-    model_id, mode_id = model_and_mode(material, model, mode)
+    refuse_energy_compensation_derivative(energy_compensation, model)
+    model_id, mode_id = model_and_mode(material, model, mode, energy_compensation)
     names = _gradient.gradient_names(model)
     parameters, directions = split(wrt, names=names)
     layout = checked_layout(layout)
@@ -114,11 +114,13 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     parts = []
     if parameters:  # f and the parameter columns first, the directions checked on the way
         first = _batch.parameter_grad(material, wi, wo, wrt=[names[k] for k in parameters], model=model,
-                                      cosine=cosine, layout=layout, threads=threads, check=check, isa=isa, mode=mode)
+                                      cosine=cosine, layout=layout, threads=threads, check=check, isa=isa, mode=mode,
+                                      energy_compensation=energy_compensation)
         parts.append(first.jacobian)
         check = False
     value, by_direction = _batch.direction_grad(material, wi, wo, model_id=model_id, mode_id=mode_id, cosine=cosine,
-                                                layout=layout, threads=threads, check=check, isa=isa)
+                                                layout=layout, threads=threads, check=check, isa=isa,
+                                                energy_compensation=energy_compensation)
     if parameters:
         value = first.value
     parts.append(by_direction if len(directions) == len(DIRECTION_NAMES) else
@@ -143,18 +145,20 @@ def reference_eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike
     if not asks_for_directions(wrt):
         return _float64.parameter_grad(material, wi, wo, wrt=wrt, model=model, cosine=cosine, layout=layout,
                                        energy_compensation=energy_compensation, mode=mode)
-    refuse_energy_compensation_derivative(energy_compensation)
-    mode_id = model_and_mode(material, model, mode)[1]
+    refuse_energy_compensation_derivative(energy_compensation, model)
+    mode_id = model_and_mode(material, model, mode, energy_compensation)[1]
     names = _gradient.gradient_names(model)
     parameters, directions = split(wrt, names=names)
     soa = checked_layout(layout) == "soa"
     if parameters:
         first = _float64.parameter_grad(material, wi, wo, wrt=[names[k] for k in parameters], model=model,
-                                        cosine=cosine, layout=layout, mode=mode)
+                                        cosine=cosine, layout=layout, mode=mode, energy_compensation=energy_compensation)
         value, parts = first.value, [first.jacobian]
     else:
-        value, parts = _float64.eval(material, wi, wo, model=model, cosine=cosine, layout=layout, mode=mode), []
-    by_direction = _float64.direction_grad(material, wi, wo, model=model, cosine=cosine, layout=layout, mode_id=mode_id)
+        value, parts = _float64.eval(material, wi, wo, model=model, cosine=cosine, layout=layout, mode=mode,
+                                     energy_compensation=energy_compensation), []
+    by_direction = _float64.direction_grad(material, wi, wo, model=model, cosine=cosine, layout=layout, mode_id=mode_id,
+                                           energy_compensation=energy_compensation)
     parts.append(by_direction[:, directions] if soa else by_direction[..., directions])
     return Gradient(value, np.concatenate(parts, axis=1 if soa else -1), _names(names, parameters, directions))
 

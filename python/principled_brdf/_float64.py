@@ -80,14 +80,15 @@ def parameter_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
                    cosine: bool = False, layout: Layout = "aos", energy_compensation: bool = False,
                    mode: Mode = "radiance") -> Gradient:
     """pb.reference.eval_grad in the parameters only (its arguments, checked as it checks them)."""
-    _validate.refuse_energy_compensation_derivative(energy_compensation)
-    mode_id = model_and_mode(material, model, mode)[1]
+    _validate.refuse_energy_compensation_derivative(energy_compensation, model)
+    mode_id = model_and_mode(material, model, mode, energy_compensation)[1]
+    compensated = _validate.flag("energy_compensation", energy_compensation)
     soa = _is_soa(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     cosine = _validate.flag("cosine", cosine)
     names = _gradient.gradient_names(model)
     wanted = _gradient.columns(wrt, names=names)
-    value, jacobian = _core.reference_eval_grad(wi_rows, wo_rows, params, model_id, mode_id)
+    value, jacobian = _core.reference_eval_grad(wi_rows, wo_rows, params, model_id, mode_id, compensated)
     if cosine:
         cos_theta_l = _cosine_factor(wi_rows[:, 2], model)
         value *= cos_theta_l[:, None]
@@ -97,13 +98,13 @@ def parameter_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
 
 
 def direction_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *, model: Model, cosine: bool,
-                   layout: Layout, mode_id: int) -> Float64Array:
+                   layout: Layout, mode_id: int, energy_compensation: bool = False) -> Float64Array:
     """f's derivatives in the six direction components, ``(..., 3, 6)`` (``(3, 6, ...)``
     for ``layout="soa"``), by the model's forward mode in float64."""
     soa = _is_soa(layout)
     shape, wi_rows, wo_rows, params, model_id = _prepare(material, _as_aos("wi", wi, soa), _as_aos("wo", wo, soa), model)
     jacobian = _core.reference_eval_direction_grad(wi_rows, wo_rows, params, model_id, _validate.flag("cosine", cosine),
-                                                   mode_id)
+                                                   mode_id, _validate.flag("energy_compensation", energy_compensation))
     return _as_layout(jacobian.reshape(shape + jacobian.shape[1:]), soa, trailing=2)
 
 

@@ -101,12 +101,14 @@ def _unit(v: Float64Array) -> Float64Array:
 
 def through_the_sphere(material_at: Callable[[np.ndarray], Material], element: np.ndarray, normal: FloatArray,
                        direction: FloatArray, throughput: FloatArray, radiance: Callable[[Float32Array], ArrayLike],
-                       model: Model, sample: np.ndarray, pixel: np.ndarray, seed: int) -> Float64Array:
+                       model: Model, sample: np.ndarray, pixel: np.ndarray, seed: int,
+                       energy_compensation: bool = False) -> Float64Array:
     """The radiance ``(P, 3)`` each path brings back: paths entering the sphere at the camera's
     hit points ``normal`` (``(P, 3)``, camera space) along ``direction`` (``(P, 3)``, into the
     sphere) with ``throughput`` (``(P, 3)``, the first event's weight). ``material_at(element)``
     gives the material of the paths' elements; ``radiance(direction)`` the environment;
-    ``sample`` and ``pixel`` (``(P,)`` integers) name the paths for their random numbers."""
+    ``sample`` and ``pixel`` (``(P,)`` integers) name the paths for their random numbers;
+    ``energy_compensation`` as in ``pb.eval``."""
     out = np.zeros((len(element), 3))
     path = np.arange(len(element))
     point = np.asarray(normal, dtype=np.float64)
@@ -124,11 +126,12 @@ def through_the_sphere(material_at: Callable[[np.ndarray], Material], element: n
         if isinstance(radiance, Environment):  # the map's strategy: f |cos θl| L / pdf_light, weighted
             towards, light_pdf, light = radiance._sample_unchecked(u[:, 4:6])
             local = _local(towards.astype(np.float64), tangent, bitangent, point)
-            value, bsdf_pdf = _eval_pdf(material, local.astype(np.float32), wo, cosine=True, model=model, check=False)
+            value, bsdf_pdf = _eval_pdf(material, local.astype(np.float32), wo, cosine=True, model=model, check=False,
+                                        energy_compensation=energy_compensation)
             share = np.divide(power_heuristic(light_pdf, bsdf_pdf), light_pdf, out=np.zeros(len(path)),
                               where=(light_pdf > 0.0) & (local[:, 2] > 0.0))
             out[path] += weight * value * light * share[:, None]
-        drawn = _sample(material, wo, u=u[:, :3], model=model, check=False)
+        drawn = _sample(material, wo, u=u[:, :3], model=model, check=False, energy_compensation=energy_compensation)
         wi = drawn.wi.astype(np.float64)
         leaving = wi[:, 0:1] * tangent + wi[:, 1:2] * bitangent + wi[:, 2:3] * point
         weight = weight * drawn.weight

@@ -249,12 +249,16 @@ def require_energy_compensation_offered(model: object, energy_compensation: obje
         raise ValueError(f"energy_compensation: not available for model {model!r} (docs/model-2015.md)")
 
 
-def refuse_energy_compensation_derivative(energy_compensation: object) -> None:
-    """The derivatives (eval_grad, eval_vjp, in the parameters or the directions) take f
-    without the multiple-scattering lobe: NotImplementedError for ``energy_compensation=True``."""
-    if flag("energy_compensation", energy_compensation):
-        raise NotImplementedError("eval_grad: energy_compensation=True is not supported (the derivative of the "
-                                  "multiple-scattering lobe is not implemented); evaluate f with pb.eval")
+def refuse_energy_compensation_derivative(energy_compensation: object, model: object) -> None:
+    """The BRDFs' derivatives (eval_grad, in the parameters or the directions) take f without
+    their multiple-scattering lobe: NotImplementedError for ``energy_compensation=True``
+    (the 2015 solid's compensation has its derivatives)."""
+    from . import _models
+
+    if flag("energy_compensation", energy_compensation) and not _models.is_whole_sphere(model):
+        raise NotImplementedError("eval_grad: energy_compensation=True is not supported with the BRDFs (the "
+                                  "derivative of their multiple-scattering lobe is not implemented); evaluate f "
+                                  "with pb.eval")
 
 
 def layout(value: object) -> Layout:

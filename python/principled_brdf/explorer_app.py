@@ -416,11 +416,13 @@ class Explorer:
                 for name, s in self.sliders.items()}
 
     def _grey_out_unread(self) -> None:
-        """The model's controls: the sliders of the parameters it does not read greyed out, and the
-        view from below (θ to 180°) for the 2015 models."""
+        """The model's controls: the sliders of the parameters it does not read greyed out, the
+        energy compensation where it offers none (the thin sheet), and the view from below (θ to
+        180°) for the 2015 models."""
         unread = unread_parameters(self.model.value)
         for name, slider in self.sliders.items():
             slider.disabled = name in unread
+        self.energy_compensation.disabled = not _models.offers_energy_compensation(self.model.value)
         self.view_theta.max = 180.0 if _models.is_whole_sphere(self.model.value) else 90.0
 
     def _state(self) -> dict[str, Any]:
@@ -433,7 +435,8 @@ class Explorer:
             "sky": bool(self.sky.value),
             "environment": self.environment.value,
             "log": bool(self.log_radius.value),
-            "energy_compensation": bool(self.energy_compensation.value),
+            "energy_compensation": bool(self.energy_compensation.value)
+            and _models.offers_energy_compensation(self.model.value),
         }
 
     @contextlib.contextmanager

@@ -404,7 +404,7 @@ def render_environment(material: Material | MerlBRDF | Callable[..., Any], resol
             pixel = np.ravel_multi_index(entering[-2:], inside.shape).astype(np.uint64)
             paths = _sphere_paths.through_the_sphere(material_at, element, normals[element], direction[entering],
                                                      drawn.weight[entering], lighting, model,
-                                                     start + entering[0], pixel, seed)
+                                                     start + entering[0], pixel, seed, energy_compensation)
             np.add.at(total.reshape(-1, 3), element, paths)
         if not is_map:
             radiance = _sphere_paths.callable_radiance(lighting, direction)

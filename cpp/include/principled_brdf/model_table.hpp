@@ -48,7 +48,8 @@ struct ModelRow {
     int gradient_slots;            // its derivatives' columns: the first gradient_slots packed slots
     BitSet lobes;                  // the lobes f can have nonzero (Lobe)
     BitSet sampled_lobes;          // the lobes sampling can draw (SampledLobe)
-    int energy_table;              // the energy compensation's table (energy_tables.hpp's first index), or -1: none
+    int energy_table;              // the BRDFs' energy compensation's table (energy_tables.hpp's first index), or -1: none
+    bool energy_compensation;      // whether it offers energy_compensation=True (the 2015 solid's: dielectric_energy_tables.hpp)
     double max_ior;                // the largest index of refraction, from specular (docs/model-2015.md); +inf: unbounded
 };
 
@@ -67,18 +68,21 @@ inline constexpr BitSet kBrdfSampled = bits_of({SampledLobe::kCosine, SampledLob
 inline constexpr BitSet kSolidLobes =
         bits_of({Lobe::kDiffuse, Lobe::kSheen, Lobe::kSpecular, Lobe::kClearcoat, Lobe::kTransmission});
 inline constexpr BitSet kSolidSampled = kBrdfSampled | bits_of({SampledLobe::kTransmission});
+// the solid's energy compensation adds a lobe, its transmitted part drawn as a diffuse transmission
+inline constexpr BitSet kCompensatedSolidLobes = kSolidLobes | bits_of({Lobe::kMultipleScattering});
+inline constexpr BitSet kSolidOrSheetSampled = kSolidSampled | bits_of({SampledLobe::kDiffuseTransmission});
 }  // namespace model_rows
 
 inline constexpr std::array<ModelRow, 4> kModels{{
     {Model::kDisney2014, "disney2014", false, parameters_where(model_rows::before_spec_trans), kGradientSlots,
-     model_rows::kBrdfLobes, model_rows::kBrdfSampled, 0, std::numeric_limits<double>::infinity()},
+     model_rows::kBrdfLobes, model_rows::kBrdfSampled, 0, true, std::numeric_limits<double>::infinity()},
     {Model::kDisney2012, "disney2012", false, parameters_where(model_rows::before_spec_trans), kGradientSlots,
-     model_rows::kBrdfLobes, model_rows::kBrdfSampled, 1, std::numeric_limits<double>::infinity()},
+     model_rows::kBrdfLobes, model_rows::kBrdfSampled, 1, true, std::numeric_limits<double>::infinity()},
     {Model::kDisney2015, "disney2015", true, parameters_where(model_rows::solid_reads), kParamSlots,
-     model_rows::kSolidLobes, model_rows::kSolidSampled, kNoEnergyTable, kMaxIor2015},
+     model_rows::kCompensatedSolidLobes, model_rows::kSolidOrSheetSampled, kNoEnergyTable, true, kMaxIor2015},
     {Model::kDisney2015Thin, "disney2015_thin", true, parameters_where(model_rows::sheet_reads), kParamSlots,
      model_rows::kSolidLobes | bits_of({Lobe::kDiffuseTransmission}),
-     model_rows::kSolidSampled | bits_of({SampledLobe::kDiffuseTransmission}), kNoEnergyTable, kMaxIor2015},
+     model_rows::kSolidOrSheetSampled, kNoEnergyTable, false, kMaxIor2015},
 }};
 
 constexpr const ModelRow& row_of(Model model) {

@@ -116,16 +116,24 @@ using ShadingCache = RowCache<Shading<double>, &shading_of<double>>;
 template <Model model>
 using CompensatedCache = RowCache<Compensated, &compensated_of<model>>;
 using GradientShadingCache = RowCache<GradientShading, &gradient_shading_of>;
-template <Model model>
-using Shading2015Cache = RowCache<Shading2015<model, double>, &Shading2015<model, double>::of>;
+template <Model model, bool compensated>
+using Shading2015Cache = RowCache<Shading2015<model, double>, &shading2015_of_row<Shading2015<model, double>, double, compensated>>;
 
-// f(cache) with the row cache Cache<model> of a 2015 model (Shading2015Cache,
-// GradientShading2015Cache, DirectionShading2015Cache); nothing for the others.
-template <template <Model> class Cache, class Function>
-void with_cache2015(Model model, Function&& f) {
+// f(cache) with the row cache Cache<model, compensated> of a 2015 model
+// (Shading2015Cache, GradientShading2015Cache, DirectionShading2015Cache), with
+// the energy compensation where `compensated` and the model offers it; nothing for the others.
+template <template <Model, bool> class Cache, class Function>
+void with_cache2015(Model model, bool compensated, Function&& f) {
     with_model(model, [&](auto constant) {
         if constexpr (is_bsdf(constant())) {
-            Cache<constant()> cache;
+            if constexpr (row_of(constant()).energy_compensation) {
+                if (compensated) {
+                    Cache<constant(), true> cache;
+                    f(cache);
+                    return 0;
+                }
+            }
+            Cache<constant(), false> cache;
             f(cache);
         }
         return 0;
@@ -350,6 +358,7 @@ inline Lobes eval_lobes(const S& s, const Vector3d& wi, const Vector3d& wo,
     out.clearcoat = vector3d(v.clearcoat);
     out.transmission = vector3d(v.transmission);
     out.diffuse_transmission = vector3d(v.diffuse_transmission);
+    out.multiple_scattering = vector3d(v.multiple_scattering);
     return out;
 }
 
@@ -394,9 +403,10 @@ struct Gradient2015 {
             Eigen::Matrix<double, 3, kParamSlots, Eigen::RowMajor>::Zero();
 };
 
-template <Model model>
-using GradientShading2015Cache = RowCache<GradientShading2015<Shading2015<model, PassDual<double>>>,
-                                          &gradient_shading2015_of<Shading2015<model, PassDual<double>>, double>>;
+template <Model model, bool compensated>
+using GradientShading2015Cache =
+        RowCache<GradientShading2015<Shading2015<model, PassDual<double>>>,
+                 &gradient_shading2015_of_row<Shading2015<model, PassDual<double>>, double, compensated>>;
 
 template <class S>
 inline Gradient2015 eval_grad(const GradientShading2015<S>& s, const Vector3d& wi, const Vector3d& wo,

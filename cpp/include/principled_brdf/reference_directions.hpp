@@ -36,9 +36,9 @@ inline DirectionGradient eval_direction_grad(const DirectionShading& s, const Ve
 }
 
 // The 2015 models' (model/bsdf2015_gradient.hpp): over the whole sphere, in `mode`.
-template <Model model>
+template <Model model, bool compensated>
 using DirectionShading2015Cache = RowCache<Shading2015<model, PassDual<double>>,
-                                           &constant_shading2015_of<Shading2015<model, PassDual<double>>, double>>;
+                                           &constant_shading2015_of_row<Shading2015<model, PassDual<double>>, double, compensated>>;
 
 template <class S, If2015<S, PassDual<double>> = 0>
 inline DirectionGradient eval_direction_grad(const S& s, const Vector3d& wi, const Vector3d& wo,

@@ -46,6 +46,7 @@ struct Interface2015 {
     F transmission_luminance;   // lum(c)
     F eta, inv_eta;
     F eta_minus_one, inv_eta_minus_one;  // η - 1 and 1/η - 1 = -(η - 1)/η
+    DielectricCompensation<F> compensation;  // the energy compensation's (the solid's, under the option; else none)
 
     PB_MODEL_INLINE bool opaque() const { return !nonzero_anywhere(transmission_weight); }
 };
@@ -122,6 +123,23 @@ struct ThinSheet2015 : Interface2015<F> {
 template <Model model, class F>
 using Shading2015 = std::conditional_t<model == Model::kDisney2015Thin, ThinSheet2015<F>, Solid2015<F>>;
 
+// S::of(p), with the energy compensation (model/dielectric_energy.hpp) where
+// `compensated` (the solid's; a thin sheet has none)
+template <class S, class F>
+PB_MODEL_INLINE S shading2015_of(const F* p, bool compensated) {
+    S s = S::of(p);
+    if constexpr (!S::thin) {
+        if (compensated) s.compensation = dielectric_compensation_of(p, s.eta, s.eta_minus_one, s.transmission_weight);
+    }
+    return s;
+}
+
+// (the reference's row caches take a function of the row alone)
+template <class S, class F, bool compensated>
+PB_MODEL_INLINE S shading2015_of_row(const F* p) {
+    return shading2015_of<S>(p, compensated);
+}
+
 // The diffuse transmission's color (a solid has none).
 template <class S>
 PB_MODEL_INLINE auto diffuse_transmission_of(const S& s) {
@@ -161,7 +179,7 @@ PB_MODEL_INLINE Side<F> side_of(const Vec3<F>& wi, const Vec3<F>& wo, const S& s
 // The lobes of f at a pair, per channel.
 template <class F>
 struct Lobes2015 {
-    Rgb<F> diffuse, sheen, specular, clearcoat, transmission, diffuse_transmission;
+    Rgb<F> diffuse, sheen, specular, clearcoat, transmission, diffuse_transmission, multiple_scattering;
 
     LobeColors<F> colors() const {
         LobeColors<F> lobes = no_lobes<F>();
@@ -171,6 +189,7 @@ struct Lobes2015 {
         lobe_of(lobes, Lobe::kClearcoat) = clearcoat;
         lobe_of(lobes, Lobe::kTransmission) = transmission;
         lobe_of(lobes, Lobe::kDiffuseTransmission) = diffuse_transmission;
+        lobe_of(lobes, Lobe::kMultipleScattering) = multiple_scattering;
         return lobes;
     }
 };
@@ -185,22 +204,36 @@ struct Lobes2015 {
 //   clearcoat     (grey)                      outside, reflected
 //   transmission  of transmission_color       through the interface or the sheet
 //   diffuse_transmission of diffuse_transmission  1 through the sheet, else 0
+//   compensation  (grey, transmission_color, the metal's color)  the energy compensation's lobes
 // F_s per channel is schlick_f0 (1 - FH) + the grey part, so the specular is
 // specular_f0 schlick_f0 + specular_grey.
 template <class F>
 struct LobeValues2015 {
     F diffuse, sheen, specular_f0, specular_grey, clearcoat, transmission, diffuse_transmission;
+    CompensationValues<F> compensation{F(0.0), F(0.0), F(0.0)};
+
+    template <class S>
+    Rgb<F> compensation_rgb(const S& s) const {
+        const DielectricCompensation<F>& c = s.compensation;
+        auto channel = [&](F color, F metal_color) {
+            return mul_add(compensation.transmitted, color, mul_add(compensation.metal, metal_color, compensation.reflected));
+        };
+        return {channel(s.transmission_color.r, c.metal_color.r), channel(s.transmission_color.g, c.metal_color.g),
+                channel(s.transmission_color.b, c.metal_color.b)};
+    }
 
     template <class S>
     Lobes2015<F> rgb(const S& s) const {
         auto grey = [](F x) { return Rgb<F>{x, x, x}; };
         auto specular = [&](F f0) { return mul_add(specular_f0, f0, specular_grey); };
+        Rgb<F> none = grey(F(0.0));
         return {diffuse * s.brdf.diffuse.color,
                 sheen * s.brdf.sheen.color,
                 {specular(s.schlick_f0.r), specular(s.schlick_f0.g), specular(s.schlick_f0.b)},
                 grey(clearcoat),
                 transmission * s.transmission_color,
-                diffuse_transmission * diffuse_transmission_of(s)};
+                diffuse_transmission * diffuse_transmission_of(s),
+                s.compensation.active() ? compensation_rgb(s) : none};
     }
 
     // f per channel, each lobe's product fused into one sum (a LobeSet's
@@ -220,9 +253,12 @@ struct LobeValues2015 {
         };
         const Shading<F>& b = s.brdf;
         Rgb<F> dt = diffuse_transmission_of(s);
-        return {channel(b.diffuse.color.r, b.sheen.color.r, s.schlick_f0.r, s.transmission_color.r, dt.r),
-                channel(b.diffuse.color.g, b.sheen.color.g, s.schlick_f0.g, s.transmission_color.g, dt.g),
-                channel(b.diffuse.color.b, b.sheen.color.b, s.schlick_f0.b, s.transmission_color.b, dt.b)};
+        Rgb<F> f{channel(b.diffuse.color.r, b.sheen.color.r, s.schlick_f0.r, s.transmission_color.r, dt.r),
+                 channel(b.diffuse.color.g, b.sheen.color.g, s.schlick_f0.g, s.transmission_color.g, dt.g),
+                 channel(b.diffuse.color.b, b.sheen.color.b, s.schlick_f0.b, s.transmission_color.b, dt.b)};
+        if (!s.compensation.active()) return f;
+        Rgb<F> added = compensation_rgb(s);
+        return {f.r + added.r, f.g + added.g, f.b + added.b};
     }
 };
 
@@ -393,6 +429,12 @@ PB_MODEL_INLINE LobeValues2015<F> lobe_values2015(const Pair2015<F>& p, const S&
         if (mode == TransportMode::kImportance) t = t * (side.eta_t * side.eta_t);
         out.transmission = select(p.scattered & m.transmits, t, zero);
     }
+    if (s.compensation.active()) {
+        CompensationValues<F> c = compensation_values(s.compensation, side.wo.z, max(side.wi.z, -side.wi.z), side.inside,
+                                                      side.wi.z < zero, side.eta_t, mode);
+        out.compensation = {select(p.scattered, c.reflected, zero), select(p.scattered, c.transmitted, zero),
+                            select(p.scattered, c.metal, zero)};
+    }
     return out;
 }
 
@@ -423,9 +465,11 @@ PB_MODEL_INLINE Rgb<F> eval2015(const Vec3<F>& wi, const Vec3<F>& wo, const S& s
 // interface does not draw. Inside only the interface exists (w0 = w1 = w2 =
 // 0). The thin sheet: w1 = max(lum(F_s), 0.02), w0 times 1 - dt, w3 = w_T (1 -
 // F_D) lum(c) its microfacet transmission, and w4 = w_D dt lum(c) (diffuse
-// transmission). The reflected lobes count only above the viewer's side and
-// the transmission only below: a draw that lands on the wrong side is no
-// sample (pdf and weight 0).
+// transmission). With the solid's energy compensation (model/dielectric_energy.hpp)
+// its added reflections join w0 and its added transmission is w4, a cosine
+// draw mirrored below like the sheet's. The reflected lobes count only above
+// the viewer's side and the transmission only below: a draw that lands on the
+// wrong side is no sample (pdf and weight 0).
 template <class F>
 struct LobeWeights2015 {
     F cosine, specular, clearcoat, transmission, diffuse_transmission;
@@ -460,6 +504,11 @@ PB_MODEL_INLINE LobeWeights2015<F> lobe_weights2015(const Side<F>& side, const S
         w.transmission = reflected + transmitted;
         w.interface_reflection = reflected;
         w.diffuse_transmission = zero;
+    }
+    if (s.compensation.active()) {  // the added lobes: reflected by the cosine lobe's draw, transmitted by its mirror image
+        CompensationWeights<F> added = compensation_weights(s.compensation, cos_v, side.inside, s.transmission_luminance);
+        w.cosine = w.cosine + added.reflected;
+        w.diffuse_transmission = w.diffuse_transmission + added.transmitted;
     }
     F total = w.cosine + w.specular + w.clearcoat + w.transmission + w.diffuse_transmission;
     w.inv_total = select(total > zero, one / total, zero);
@@ -507,12 +556,16 @@ PB_MODEL_INLINE F pdf2015(const Pair2015<F>& p, const LobeWeights2015<F>& w, con
         F through = mul_add(w.diffuse_transmission * F(kInvPi), -side.wi.z,
                             w.transmission * thin_transmission_pdf(side, s.transmission_ggx, sampler));
         pdf = select(below, through, pdf);
-    } else if (!s.opaque()) {
-        InterfaceSplit<F> split = interface_split(p.fresnel, w.transmitted_luminance);
-        F through_h = (side.eta_t * side.eta_t) * -m.wi_h * m.over * m.smith_wi;  // norm η_t² |wi·H| / (Q² S(wo))
-        F through = distribution ? through_h * m.smith_wo * m.h.hz : F(2.0) * through_h * m.wo_h;
-        F interface = select(below, select(m.transmits, split.refracts * through, zero), split.reflects * specular);
-        pdf = mul_add(w.transmission, interface, pdf);
+    } else {
+        // the compensation's transmission: the cosine lobe mirrored below
+        if (s.compensation.active()) pdf = select(below, w.diffuse_transmission * F(kInvPi) * -side.wi.z, pdf);
+        if (!s.opaque()) {
+            InterfaceSplit<F> split = interface_split(p.fresnel, w.transmitted_luminance);
+            F through_h = (side.eta_t * side.eta_t) * -m.wi_h * m.over * m.smith_wi;  // norm η_t² |wi·H| / (Q² S(wo))
+            F through = distribution ? through_h * m.smith_wo * m.h.hz : F(2.0) * through_h * m.wo_h;
+            F interface = select(below, select(m.transmits, split.refracts * through, zero), split.reflects * specular);
+            pdf = mul_add(w.transmission, interface, pdf);
+        }
     }
     return select(p.scattered, w.inv_total * pdf, zero);
 }

@@ -28,7 +28,7 @@ struct GradientShading2015 {
 };
 
 template <class S, class F>
-PB_MODEL_INLINE GradientShading2015<S> gradient_shading2015_of(const F* p) {
+PB_MODEL_INLINE GradientShading2015<S> gradient_shading2015_of(const F* p, bool compensated = false) {
     GradientShading2015<S> g;
     for (int q = 0; q < kGradientPasses; ++q) {
         PassDual<F> slots[kParamSlots];
@@ -36,7 +36,7 @@ PB_MODEL_INLINE GradientShading2015<S> gradient_shading2015_of(const F* p) {
             const int tangent = k - q * kSlotsAPass;
             slots[k] = tangent >= 0 && tangent < kSlotsAPass ? PassDual<F>::variable(p[k], tangent) : PassDual<F>(p[k]);
         }
-        g.pass[q] = S::of(slots);
+        g.pass[q] = shading2015_of<S>(slots, compensated);
     }
     return g;
 }
@@ -76,10 +76,20 @@ inline constexpr int kDirectionPasses2015 = (kDirectionSlots + kSlotsAPass - 1) 
 
 // S over PassDual<F>, its tangents 0
 template <class S, class F>
-PB_MODEL_INLINE S constant_shading2015_of(const F* p) {
+PB_MODEL_INLINE S constant_shading2015_of(const F* p, bool compensated = false) {
     PassDual<F> slots[kParamSlots];
     for (int k = 0; k < kParamSlots; ++k) slots[k] = PassDual<F>(p[k]);
-    return S::of(slots);
+    return shading2015_of<S>(slots, compensated);
+}
+
+// the reference's row caches take a function of the row alone
+template <class S, class F, bool compensated>
+PB_MODEL_INLINE GradientShading2015<S> gradient_shading2015_of_row(const F* p) {
+    return gradient_shading2015_of<S>(p, compensated);
+}
+template <class S, class F, bool compensated>
+PB_MODEL_INLINE S constant_shading2015_of_row(const F* p) {
+    return constant_shading2015_of<S>(p, compensated);
 }
 
 // f (times |cos θl| if `cosine`), returned, and ∂f_c/∂w_k given to

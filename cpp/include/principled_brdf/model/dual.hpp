@@ -50,6 +50,12 @@ struct Dual<double, N> {
     }
 };
 
+// its value, without the tangents (a table's node is found from it, model/dielectric_energy.hpp)
+template <class F, int N>
+PB_MODEL_INLINE F real_part(const Dual<F, N>& x) {
+    return x.v;
+}
+
 // The same tangent map applied to each of x's tangents.
 template <class F, int N, class Tangent>
 PB_MODEL_INLINE Dual<F, N> with_tangents(F value, Tangent tangent) {

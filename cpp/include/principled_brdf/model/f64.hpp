@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "principled_brdf/dielectric_energy_tables.hpp"
 #include "principled_brdf/energy_corners.hpp"
 #include "principled_brdf/model_table.hpp"
 

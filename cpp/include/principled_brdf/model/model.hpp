@@ -21,6 +21,7 @@
 #include "vector.hpp"
 #include "distributions.hpp"
 #include "dielectric.hpp"
+#include "dielectric_energy.hpp"
 #include "lobes.hpp"
 #include "principled.hpp"
 #include "bsdf2015.hpp"

@@ -39,6 +39,13 @@ inline std::pair<double, double> sincos_turns(double u) {
 inline int truncate_to_index(double x) { return static_cast<int>(x); }
 inline double index_to_real(int i) { return static_cast<double>(i); }
 inline int min(int a, int b) { return a < b ? a : b; }
+// table lookups of whole nodes (model/dielectric_energy.hpp): floor(x) for x >= 0, and
+// (table[i], table[i + 1]) for a whole i held as a real
+inline double floor_of(double x) { return std::floor(x); }
+inline std::pair<double, double> table_pair(const float* table, double index) {
+    const int i = static_cast<int>(index);
+    return {static_cast<double>(table[i]), static_cast<double>(table[i + 1])};
+}
 // the interval of ν = μ + 1/8 (the exact sum: one ulp lower where it rounded up),
 // 16 an octave from 1/8, and its end: ν's exponent and top four mantissa bits,
 // plus one; ν clamped to [1/8, 9/8] first (NaN to 1/8)
