@@ -287,8 +287,9 @@ namespace principled_brdf::energy {{
 {body}
 }}  // namespace principled_brdf::energy
 """
-    (out / HEADER).write_text(header)
-    (out / SOURCE).write_text(source)
+    for path, text in ((out / HEADER, header), (out / SOURCE, source)):
+        if not path.exists() or path.read_text() != text:  # an unchanged header rebuilds no kernel
+            path.write_text(text)
 
 
 def main() -> None:

@@ -474,7 +474,7 @@ void each_prepared(const Batch& b, const Variant& v, Function&& f) {
         for (int i = 0; i < b.n; ++i) f(i, cache.of(b.reference_row(i)));
     };
     if (v.bsdf()) {
-        ref::with_cache2015<ref::Shading2015Cache>(v.model, loop);
+        ref::with_cache2015<ref::Shading2015Cache>(v.model, false, loop);
     } else if (v.compensated && v.model == Model::kDisney2012) {
         ref::CompensatedCache<Model::kDisney2012> cache;
         loop(cache);
@@ -496,7 +496,7 @@ std::vector<double> reference_jacobian(const Batch& b, const Variant& v) {
         for (int i = 0; i < b.n; ++i) store(i, ref::eval_grad(cache.of(b.reference_row(i)), at(b.wi, i), at(b.wo, i), v.mode));
     };
     if (v.bsdf()) {
-        ref::with_cache2015<ref::GradientShading2015Cache>(v.model, loop_2015);
+        ref::with_cache2015<ref::GradientShading2015Cache>(v.model, false, loop_2015);
     } else {
         ref::GradientShadingCache cache;
         for (int i = 0; i < b.n; ++i) store(i, ref::eval_grad(cache.of(b.reference_row(i)), at(b.wi, i), at(b.wo, i), v.model));
@@ -516,7 +516,7 @@ std::vector<double> reference_direction_jacobian(const Batch& b, const Variant& 
             store(i, ref::eval_direction_grad(cache.of(b.reference_row(i)), at(b.wi, i), at(b.wo, i), cosine, v.mode));
     };
     if (v.bsdf()) {
-        ref::with_cache2015<ref::DirectionShading2015Cache>(v.model, loop_2015);
+        ref::with_cache2015<ref::DirectionShading2015Cache>(v.model, false, loop_2015);
     } else {
         ref::DirectionShadingCache cache;
         for (int i = 0; i < b.n; ++i)

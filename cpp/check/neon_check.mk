@@ -12,7 +12,7 @@ MAKEFLAGS += --no-builtin-rules
 # sources and the NEON kernel, this one with the kernels' flags and in the
 # parts CMakeLists.txt compiles it in (one per PB_KERNEL_PART_ of
 # cpp/src/kernel_parts.hpp), so that `make -j2` keeps two cores busy.
-LIBRARY := batch dispatch energy_corners energy_intercepts energy_tables thread_pool
+LIBRARY := batch dielectric_energy_tables dispatch energy_corners energy_intercepts energy_tables thread_pool
 CXXFLAGS := -std=c++17 -O2 -DNDEBUG -Wno-psabi -I$(ROOT)/cpp/include -I$(ROOT)/cpp/src -isystem /usr/include/eigen3 \
             -DPRINCIPLED_BRDF_HAVE_NEON
 KERNEL_FLAGS := -ffp-contract=off -fno-math-errno \

@@ -95,7 +95,7 @@ def eval_grad(material: Material, wi: RealArrayLike, wo: RealArrayLike, *,
     parameter still gets a per-element derivative. ``out=(value, jacobian)``
     writes into preallocated float32 arrays of exactly those shapes. The other
     arguments are :func:`eval`'s; ``energy_compensation=True`` raises
-    NotImplementedError. ``wrt`` may also name ``"wi"`` and ``"wo"``: three
+    NotImplementedError with the BRDFs (the 2015 solid's is differentiated). ``wrt`` may also name ``"wi"`` and ``"wo"``: three
     columns each (``wi_x, wi_y, wi_z``, ``wo_x, wo_y, wo_z``) after the
     parameters', the derivatives of f in the 3-vectors as given
     (docs/gradients.md, "Derivatives in the directions").
